@@ -1,0 +1,63 @@
+"""Exceptions raised by holofold when input is wrong.
+
+All subclass :class:`ValueError`, so callers (and the CLI) can catch one type. Messages name
+the offending value, where it is, and what is allowed.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "InvalidPatternError",
+    "DegenerateGeometryError",
+    "FormatError",
+    "ParameterError",
+    "check_range",
+]
+
+
+class InvalidPatternError(ValueError):
+    """A crease pattern's arrays are inconsistent (indices, assignments, angles, faces)."""
+
+
+class DegenerateGeometryError(ValueError):
+    """Geometry that cannot be used: zero lengths, zero areas, non-finite coordinates."""
+
+
+class FormatError(ValueError):
+    """A file (FOLD, SVG, CSV, ...) that cannot be read as the format it claims to be."""
+
+
+class ParameterError(ValueError):
+    """A design or model parameter outside its allowed range."""
+
+
+def check_range(
+    name: str,
+    value: float,
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    low_open: bool = False,
+    high_open: bool = False,
+) -> float:
+    """Return ``float(value)`` or raise :class:`ParameterError` naming ``name`` and its range.
+
+    ``low_open``/``high_open`` make the bound exclusive. Non-finite values are rejected.
+    """
+    import math
+
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number, got {value!r}") from None
+    lo = "(" if low_open else "["
+    hi = ")" if high_open else "]"
+    rng = f"{lo}{'-inf' if low is None else low}, {'inf' if high is None else high}{hi}"
+    if not math.isfinite(v):
+        raise ParameterError(f"{name} must be finite, got {value!r} (allowed range {rng})")
+    bad = (low is not None and (v < low or (low_open and v == low))) or (
+        high is not None and (v > high or (high_open and v == high))
+    )
+    if bad:
+        raise ParameterError(f"{name} = {value!r} is outside the allowed range {rng}")
+    return v

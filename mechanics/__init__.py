@@ -1,0 +1,1 @@
+"""mechanics layer of holofold."""

@@ -1,0 +1,1 @@
+"""Nonlinear static solvers (each returns a path and a status)."""

@@ -1,0 +1,31 @@
+"""The ``holofold`` command: every sub-command has --help, unknown ones fail cleanly."""
+
+import subprocess
+import sys
+
+import pytest
+
+from design.cli import _command_modules, build_parser, main
+
+
+def test_subcommands_are_discovered():
+    names = {m.__name__.rsplit(".", 1)[1] for m in _command_modules()}
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")
+    assert names == set(sub.choices)
+
+
+@pytest.mark.parametrize("name", [m.__name__.rsplit(".", 1)[1] for m in _command_modules()])
+def test_each_subcommand_has_help(name, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([name, "--help"])
+    assert exc.value.code == 0
+    assert "usage: holofold " + name in capsys.readouterr().out
+
+
+def test_unknown_subcommand_exits_nonzero():
+    proc = subprocess.run(
+        [sys.executable, "-m", "design.cli", "no-such-command"], capture_output=True, text=True
+    )
+    assert proc.returncode == 2
+    assert "invalid choice" in proc.stderr
