@@ -47,16 +47,50 @@ _REL_TOL = 1e-12  # relative tolerance for zero lengths and areas
 
 
 def _as_faces(faces) -> tuple[np.ndarray, ...]:
+    if isinstance(faces, tuple) and all(
+        isinstance(f, np.ndarray) and f.dtype == np.int64 and f.ndim == 1 and f.size >= 3
+        for f in faces
+    ):
+        return faces  # already normalised
     out = []
     for k, f in enumerate(faces):
         a = np.asarray(f)
         if a.ndim != 1 or a.size < 3:
             raise InvalidPatternError(f"face {k} must list at least 3 vertex ids, got {f!r}")
-        if not np.issubdtype(a.dtype, np.integer):
-            if not np.all(np.equal(np.mod(a, 1), 0)):
+        if a.dtype.kind not in "iu":
+            if a.dtype.kind != "f" or not np.all(np.equal(np.mod(a, 1), 0)):
                 raise InvalidPatternError(f"face {k} has non-integer vertex ids {f!r}")
-        out.append(a.astype(np.int64))
+        out.append(a.astype(np.int64, copy=False))
     return tuple(out)
+
+
+class _FaceTable:
+    """All faces' vertex loops flattened: the topology helpers work on these arrays.
+
+    ``fv`` (N,) vertex ids of all corners, face by face; ``owner`` (N,) face of each corner;
+    ``nxt`` (N,) position of the next corner in the same loop; ``starts``/``sizes`` (nf,).
+    """
+
+    __slots__ = ("fv", "owner", "nxt", "starts", "sizes")
+
+    def __init__(self, faces: tuple[np.ndarray, ...]):
+        self.sizes = np.array([len(f) for f in faces], np.int64)
+        self.fv = np.concatenate(faces) if faces else np.zeros(0, np.int64)
+        self.starts = np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
+        self.owner = np.repeat(np.arange(len(faces)), self.sizes)
+        nxt = np.arange(len(self.fv)) + 1
+        if len(faces):
+            nxt[self.starts + self.sizes - 1] = self.starts
+        self.nxt = nxt
+
+    def pairs(self) -> np.ndarray:
+        """(N, 2) directed corner-to-next-corner edges, in loop order."""
+        return np.stack([self.fv, self.fv[self.nxt]], axis=1)
+
+
+def _edge_keys(pairs: np.ndarray, nv: int) -> np.ndarray:
+    lo, hi = np.minimum(pairs[:, 0], pairs[:, 1]), np.maximum(pairs[:, 0], pairs[:, 1])
+    return lo * np.int64(nv) + hi
 
 
 def reference_edges(faces) -> tuple[np.ndarray, np.ndarray]:
@@ -78,35 +112,50 @@ def reference_edges(faces) -> tuple[np.ndarray, np.ndarray]:
     faces = _as_faces(faces)
     if not faces:
         return np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
-    pairs = []
-    for f in faces:
-        a = np.concatenate([[f[0]], f[:-1]])
-        b = np.concatenate([[f[-1]], f[1:]])
-        pairs.append(np.stack([a, b], axis=1))
-    p = np.sort(np.concatenate(pairs), axis=1)
-    uniq, first, inverse, counts = np.unique(
-        p, axis=0, return_index=True, return_inverse=True, return_counts=True
-    )
+    t = _FaceTable(faces)
+    # reference order inside a face: the closing edge (CN, C1) first, then (C1, C2), ...
+    perm = np.arange(len(t.fv)) - 1
+    perm[t.starts] = t.starts + t.sizes - 1
+    p = np.sort(t.pairs()[perm], axis=1)
+    nv = int(t.fv.max()) + 1
+    _, first, counts = np.unique(p[:, 0] * nv + p[:, 1], return_index=True, return_counts=True)
     order = np.argsort(first, kind="stable")
-    return uniq[order], counts[order]
+    return p[first[order]], counts[order]
 
 
 def _face_edge_pairs(faces: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
     """Directed boundary edges (u -> v, in loop order) of all faces and their face ids."""
-    pairs = [np.stack([f, np.roll(f, -1)], axis=1) for f in faces]
-    owner = np.repeat(np.arange(len(faces)), [len(f) for f in faces])
-    return np.concatenate(pairs), owner
+    t = _FaceTable(faces)
+    return t.pairs(), t.owner
 
 
 def newell_normals(coords: np.ndarray, faces) -> np.ndarray:
     """Area-weighted face normals (Newell's method), (nf, 3); length = polygon area."""
     faces = _as_faces(faces)
-    pairs, owner = _face_edge_pairs(faces)
-    a, b = coords[pairs[:, 0]], coords[pairs[:, 1]]
-    cr = np.cross(a, b)
+    t = _FaceTable(faces)
+    coords = np.asarray(coords, float)
+    cr = np.cross(coords[t.fv], coords[t.fv[t.nxt]])
     n = np.zeros((len(faces), 3))
-    np.add.at(n, owner, cr)
+    for d in range(3):
+        n[:, d] = np.bincount(t.owner, weights=cr[:, d], minlength=len(faces))
     return 0.5 * n
+
+
+def _edge_occurrences(pairs: np.ndarray, owner: np.ndarray, nv: int):
+    """For each undirected face edge: first and second occurrence positions (-1 if none).
+
+    Returns ``keys`` (ne_u,) sorted unique keys, ``first`` and ``second`` (ne_u,) positions into
+    ``pairs``.
+    """
+    keys = _edge_keys(pairs, nv)
+    order = np.argsort(keys, kind="stable")
+    k = keys[order]
+    head = np.concatenate([[True], k[1:] != k[:-1]])
+    starts = np.flatnonzero(head)
+    counts = np.diff(np.concatenate([starts, [len(k)]]))
+    first = order[starts]
+    second = np.where(counts >= 2, order[np.minimum(starts + 1, len(k) - 1)], -1)
+    return k[starts], first, second, counts
 
 
 def orient_faces(faces, n_vertices: int | None = None) -> tuple[np.ndarray, ...]:
@@ -117,33 +166,32 @@ def orient_faces(faces, n_vertices: int | None = None) -> tuple[np.ndarray, ...]
     Raises :class:`InvalidPatternError` for a non-orientable surface (a Moebius strip).
     """
     faces = _as_faces(faces)
-    pairs, owner = _face_edge_pairs(faces)
-    key = np.sort(pairs, axis=1)
+    if not faces:
+        return faces
+    t = _FaceTable(faces)
+    pairs = t.pairs()
+    nv = int(t.fv.max()) + 1
+    _, first, second, _ = _edge_occurrences(pairs, t.owner, nv)
+    two = second >= 0
+    i, j = first[two], second[two]
+    same = pairs[i, 0] == pairs[j, 0]  # traversed in the same direction
+    if not same.any():
+        return faces  # already consistent
     g = nx.Graph()
     g.add_nodes_from(range(len(faces)))
-    uniq, inv = np.unique(key, axis=0, return_inverse=True)
-    inv = inv.ravel()
-    by_edge: dict[int, list[int]] = {}
-    for idx, e in enumerate(inv):
-        by_edge.setdefault(int(e), []).append(idx)
-    for occ in by_edge.values():
-        if len(occ) == 2:
-            i, j = occ
-            same = pairs[i, 0] == pairs[j, 0]  # traversed in the same direction
-            g.add_edge(int(owner[i]), int(owner[j]), same=bool(same))
+    for u, v, sm in zip(t.owner[i].tolist(), t.owner[j].tolist(), same.tolist(), strict=True):
+        g.add_edge(u, v, same=sm)
     flip = np.zeros(len(faces), bool)
-    seen = np.zeros(len(faces), bool)
     for comp in nx.connected_components(g):
         root = min(comp)
-        seen[root] = True
         for u, v in nx.bfs_edges(g, root):
             flip[v] = flip[u] ^ g.edges[u, v]["same"]
-            seen[v] = True
-        for u, v, d in g.subgraph(comp).edges(data=True):
-            if (flip[u] ^ flip[v]) != d["same"]:
-                raise InvalidPatternError(
-                    f"faces {u} and {v} cannot be oriented consistently (non-orientable surface)"
-                )
+    bad = (flip[t.owner[i]] ^ flip[t.owner[j]]) != same
+    if bad.any():
+        u, v = int(t.owner[i][bad][0]), int(t.owner[j][bad][0])
+        raise InvalidPatternError(
+            f"faces {u} and {v} cannot be oriented consistently (non-orientable surface)"
+        )
     return tuple(f[::-1].copy() if fl else f for f, fl in zip(faces, flip, strict=True))
 
 
@@ -159,36 +207,33 @@ def measure_fold_angles(coords: np.ndarray, faces, edges: np.ndarray) -> np.ndar
     (ne,) float
     """
     coords = np.asarray(coords, float)
+    edges = np.asarray(edges, np.int64).reshape(-1, 2)
+    ne = len(edges)
+    angle = np.zeros(ne)
     faces = orient_faces(faces)
+    if not faces or not ne:
+        return angle
     normals = newell_normals(coords, faces)
     norms = np.linalg.norm(normals, axis=1, keepdims=True)
     normals = normals / np.where(norms > 0, norms, 1.0)
-    pairs, owner = _face_edge_pairs(faces)
-    edges = np.asarray(edges, np.int64).reshape(-1, 2)
-    # map each directed face edge to its undirected edge id
-    lookup = {(int(a), int(b)): i for i, (a, b) in enumerate(np.sort(edges, axis=1))}
-    eid = np.array([lookup.get((int(min(a, b)), int(max(a, b))), -1) for a, b in pairs])
-    ne = len(edges)
-    face_a = np.full(ne, -1)
-    face_b = np.full(ne, -1)
-    start = np.zeros((ne,), np.int64)
-    end = np.zeros((ne,), np.int64)
-    for idx in range(len(pairs)):  # one pass over face edges (topology only)
-        e = eid[idx]
-        if e < 0:
-            continue
-        if face_a[e] < 0:
-            face_a[e] = owner[idx]
-            start[e], end[e] = pairs[idx]
-        else:
-            face_b[e] = owner[idx]
-    angle = np.zeros(ne)
-    inner = (face_a >= 0) & (face_b >= 0)
+    t = _FaceTable(faces)
+    pairs = t.pairs()
+    nv = max(int(t.fv.max()), int(edges.max())) + 1
+    ukeys, first, second, _ = _edge_occurrences(pairs, t.owner, nv)
+    ekeys = _edge_keys(edges, nv)
+    pos = np.searchsorted(ukeys, ekeys)
+    pos = np.minimum(pos, len(ukeys) - 1)
+    found = ukeys[pos] == ekeys
+    ia = np.where(found, first[pos], -1)
+    ib = np.where(found, second[pos], -1)
+    inner = (ia >= 0) & (ib >= 0)
     if inner.any():
-        na, nb = normals[face_a[inner]], normals[face_b[inner]]
-        t = coords[end[inner]] - coords[start[inner]]
-        t /= np.linalg.norm(t, axis=1, keepdims=True)
-        s = -np.einsum("ij,ij->i", np.cross(na, nb), t)
+        fa, fb = t.owner[ia[inner]], t.owner[ib[inner]]
+        na, nb = normals[fa], normals[fb]
+        start, end = pairs[ia[inner], 0], pairs[ia[inner], 1]
+        tv = coords[end] - coords[start]
+        tv /= np.linalg.norm(tv, axis=1, keepdims=True)
+        s = -np.einsum("ij,ij->i", np.cross(na, nb), tv)
         c = np.einsum("ij,ij->i", na, nb)
         angle[inner] = np.degrees(np.arctan2(s, c))
     return angle
@@ -207,26 +252,44 @@ def _segments_cross(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) 
     return (d1 * d2 <= 0) & (d3 * d4 <= 0)
 
 
-def _check_simple(points2d: list[np.ndarray], label: str) -> list[int]:
-    """Indices of faces (given as 2-D loops) that are not simple polygons."""
+def _check_simple(t: _FaceTable, pts2d: np.ndarray) -> np.ndarray:
+    """Ids of faces that are not simple polygons; ``pts2d`` (N, 2) holds each corner's 2-D point."""
     bad = []
-    sizes = np.array([len(p) for p in points2d])
-    for k in np.unique(sizes):
-        idx = np.flatnonzero(sizes == k)
-        P = np.stack([points2d[i] for i in idx])  # (nf, k, 2)
+    for k in np.unique(t.sizes):
+        if k <= 3:
+            continue
+        idx = np.flatnonzero(t.sizes == k)
+        pos = t.starts[idx][:, None] + np.arange(k)
+        P = pts2d[pos]  # (nf_k, k, 2)
         Q = np.roll(P, -1, axis=1)
-        if k > 3:
-            i, j = np.triu_indices(k, 2)
-            keep = ~((i == 0) & (j == k - 1))  # adjacent through the wrap-around
-            i, j = i[keep], j[keep]
-            hit = _segments_cross(P[:, i], Q[:, i], P[:, j], Q[:, j]).any(axis=1)
-            bad.extend(idx[hit].tolist())
-    return bad
+        i, j = np.triu_indices(k, 2)
+        keep = ~((i == 0) & (j == k - 1))  # adjacent through the wrap-around
+        i, j = i[keep], j[keep]
+        hit = _segments_cross(P[:, i], Q[:, i], P[:, j], Q[:, j]).any(axis=1)
+        bad.append(idx[hit])
+    return np.sort(np.concatenate(bad)) if bad else np.zeros(0, np.int64)
 
 
-def _polygon_area2d(p: np.ndarray) -> float:
-    x, y = p[:, 0], p[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+def _corner_points_2d(coords: np.ndarray, t: _FaceTable) -> np.ndarray:
+    """(N, 2) corners of every face projected onto the face's own (Newell) plane."""
+    nf = len(t.sizes)
+    p = coords[t.fv]
+    cr = np.cross(p, coords[t.fv[t.nxt]])
+    n = np.stack([np.bincount(t.owner, weights=cr[:, d], minlength=nf) for d in range(3)], 1)
+    cen = np.stack([np.bincount(t.owner, weights=p[:, d], minlength=nf) for d in range(3)], 1)
+    cen /= t.sizes[:, None]
+    d = p - cen[t.owner]
+    norm = np.linalg.norm(n, axis=1)
+    ok = norm > 1e-300
+    nn = np.where(ok[:, None], n / np.where(ok, norm, 1.0)[:, None], 0.0)
+    for f in np.flatnonzero(~ok):  # bow-tie loops: best-fit plane of the points
+        rows = t.owner == f
+        nn[f] = np.linalg.svd(d[rows], full_matrices=False)[2][2]
+    helper = np.eye(3)[np.argmin(np.abs(nn), axis=1)]
+    u = np.cross(nn, helper)
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    w = np.cross(nn, u)
+    return np.stack([np.einsum("ij,ij->i", d, u[t.owner]), np.einsum("ij,ij->i", d, w[t.owner])], 1)
 
 
 @dataclass(frozen=True, eq=False)
@@ -272,7 +335,14 @@ class CreasePattern:
             raise InvalidPatternError(f"edges must have shape (ne, 2), got {edges.shape}")
         edges = np.sort(edges.astype(np.int64), axis=1)
         ne = len(edges)
-        assignment = np.asarray(self.assignment, dtype="<U1").reshape(-1)
+        raw = np.asarray(self.assignment, dtype=str).reshape(-1)
+        assignment = raw.astype("<U1")
+        long = np.flatnonzero(raw != assignment)  # "<U1" alone would truncate "Vx" to "V"
+        if long.size:
+            k = int(long[0])
+            raise InvalidPatternError(
+                f"edge {k} has assignment {raw[k]!r}; allowed: {' '.join(ASSIGNMENTS)}"
+            )
         fold_angle = np.asarray(self.fold_angle, dtype=float).reshape(-1)
         for name, arr in (("assignment", assignment), ("fold_angle", fold_angle)):
             if arr.shape != (ne,):
@@ -297,14 +367,21 @@ class CreasePattern:
             raise InvalidPatternError(
                 f"edge {k} = {e[k].tolist()} references a vertex outside 0..{nv - 1}"
             )
-        for k, f in enumerate(self.faces):
-            if f.min() < 0 or f.max() >= nv:
+        t = _FaceTable(self.faces)
+        if self.faces:
+            out = np.flatnonzero((t.fv < 0) | (t.fv >= nv))
+            if out.size:
+                k = int(t.owner[out[0]])
                 raise InvalidPatternError(
-                    f"face {k} = {f.tolist()} references a vertex outside 0..{nv - 1}"
+                    f"face {k} = {self.faces[k].tolist()} references a vertex outside 0..{nv - 1}"
                 )
-            if len(np.unique(f)) != len(f):
+            key = t.owner * np.int64(nv) + t.fv
+            ks = np.sort(key)
+            rep = np.flatnonzero(ks[1:] == ks[:-1])
+            if rep.size:
+                k = int(ks[rep[0]] // nv)
                 raise InvalidPatternError(
-                    f"face {k} = {f.tolist()} repeats a vertex (not a simple polygon)"
+                    f"face {k} = {self.faces[k].tolist()} repeats a vertex (not a simple polygon)"
                 )
         # edges: circular, duplicate, zero length
         circ = np.flatnonzero(e[:, 0] == e[:, 1])
@@ -329,14 +406,18 @@ class CreasePattern:
                 raise DegenerateGeometryError(f"edge {k} = {e[k].tolist()} has zero length")
         # every face boundary edge must be an edge
         if self.faces:
-            pairs, owner = _face_edge_pairs(self.faces)
-            key = np.sort(pairs, axis=1)
-            known = {(int(a), int(b)) for a, b in e}
-            for (a, b), o in zip(key, owner, strict=True):
-                if (int(a), int(b)) not in known:
-                    raise InvalidPatternError(
-                        f"face {int(o)} uses edge {[int(a), int(b)]}, which is not in edges"
-                    )
+            fkeys = _edge_keys(t.pairs(), nv)
+            ekeys = np.sort(_edge_keys(e, nv))
+            pos = np.minimum(np.searchsorted(ekeys, fkeys), max(len(ekeys) - 1, 0))
+            missing = np.flatnonzero(
+                (ekeys[pos] != fkeys) if len(ekeys) else np.ones_like(fkeys, bool)
+            )
+            if missing.size:
+                i = missing[0]
+                u, v = sorted((int(t.fv[i]), int(t.fv[t.nxt[i]])))
+                raise InvalidPatternError(
+                    f"face {int(t.owner[i])} uses edge {[u, v]}, which is not in edges"
+                )
         # assignments and fold angles
         unknown = np.flatnonzero(~np.isin(self.assignment, ASSIGNMENTS))
         if unknown.size:
@@ -368,27 +449,31 @@ class CreasePattern:
         # faces: simple polygons, non-zero area, counter-clockwise in the flat layout
         if self.faces:
             if self.flat is not None:
-                loops = [self.flat[f] for f in self.faces]
+                pts = self.flat[t.fv]
             else:
-                normals = newell_normals(self.coords, self.faces)
-                loops = []
-                for f, n in zip(self.faces, normals, strict=True):
-                    loops.append(_project(self.coords[f], n))
-            scale2 = max(float(np.ptp(self.coords, axis=0).max()), 1e-300) ** 2
-            for k, p in enumerate(loops):
-                area = _polygon_area2d(p)
-                if abs(area) <= _REL_TOL * scale2:
-                    raise DegenerateGeometryError(f"face {k} has zero area")
-                if self.flat is not None and area < 0:
-                    raise InvalidPatternError(
-                        f"face {k} = {self.faces[k].tolist()} is clockwise in the flat layout; "
-                        "faces must be counter-clockwise (reverse its vertex order)"
-                    )
-            bad = _check_simple(loops, "face")
-            if bad:
+                pts = _corner_points_2d(self.coords, t)
+            bad = _check_simple(t, pts)
+            if bad.size:
+                k = int(bad[0])
                 raise InvalidPatternError(
-                    f"face {bad[0]} = {self.faces[bad[0]].tolist()} is not a simple polygon "
-                    "(its sides cross)"
+                    f"face {k} = {self.faces[k].tolist()} is not a simple polygon (its sides cross)"
+                )
+            nxt = pts[t.nxt]
+            area = 0.5 * np.bincount(
+                t.owner,
+                weights=pts[:, 0] * nxt[:, 1] - nxt[:, 0] * pts[:, 1],
+                minlength=len(t.sizes),
+            )
+            ref = self.flat if self.flat is not None else self.coords
+            scale2 = max(float(np.ptp(ref, axis=0).max()), 1e-300) ** 2
+            zero = np.flatnonzero(np.abs(area) <= _REL_TOL * scale2)
+            if zero.size:
+                raise DegenerateGeometryError(f"face {int(zero[0])} has zero area")
+            if self.flat is not None and (area < 0).any():
+                k = int(np.flatnonzero(area < 0)[0])
+                raise InvalidPatternError(
+                    f"face {k} = {self.faces[k].tolist()} is clockwise in the flat layout; "
+                    "faces must be counter-clockwise (reverse its vertex order)"
                 )
 
     @classmethod
@@ -446,13 +531,14 @@ class CreasePattern:
     @property
     def edge_face_count(self) -> np.ndarray:
         """(ne,) int: number of faces using each edge (1 border, 2 interior)."""
-        if not self.faces:
+        if not self.faces or not self.n_edges:
             return np.zeros(self.n_edges, np.int64)
-        pairs, _ = _face_edge_pairs(self.faces)
-        key = np.sort(pairs, axis=1)
-        lookup = {(int(a), int(b)): i for i, (a, b) in enumerate(self.edges)}
-        ids = np.array([lookup[(int(a), int(b))] for a, b in key])
-        return np.bincount(ids, minlength=self.n_edges)
+        t = _FaceTable(self.faces)
+        nv = self.n_vertices
+        ekeys = _edge_keys(self.edges, nv)
+        order = np.argsort(ekeys)
+        pos = np.searchsorted(ekeys[order], _edge_keys(t.pairs(), nv))
+        return np.bincount(order[np.minimum(pos, len(order) - 1)], minlength=self.n_edges)
 
     @property
     def interior(self) -> np.ndarray:
@@ -553,20 +639,3 @@ class CreasePattern:
             flat=flat,
             meta=g.graph.get("meta", {}),
         )
-
-
-def _project(points3d: np.ndarray, normal: np.ndarray) -> np.ndarray:
-    """Project a 3-D loop onto the plane with the given normal, as 2-D coordinates.
-
-    A vanishing normal (a bow-tie loop) falls back to the best-fit plane of the points.
-    """
-    d = points3d - points3d.mean(axis=0)
-    if np.linalg.norm(normal) <= 1e-300 or not np.isfinite(normal).all():
-        basis = np.linalg.svd(d, full_matrices=False)[2]
-        return np.column_stack([d @ basis[0], d @ basis[1]])
-    n = normal / np.linalg.norm(normal)
-    helper = np.eye(3)[np.argmin(np.abs(n))]
-    u = np.cross(n, helper)
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
-    return np.column_stack([d @ u, d @ w])
