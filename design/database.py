@@ -1,0 +1,167 @@
+"""Reading performance databases, and what their columns mean.
+
+Small and generic on purpose: ``read_table`` reads CSV / Parquet with a header, or the
+published headerless comma-separated ``.txt`` files of Zhu & Filipov (2022) whose column names
+live in a sibling ``dataN_FeatureName.txt``; ``column_roles`` tells design features from
+performance columns for the published column sets.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["ColumnRoles", "PUBLISHED", "read_table", "column_roles", "feature_name_file"]
+
+
+@dataclass(frozen=True)
+class ColumnRoles:
+    """Roles of the columns of one database.
+
+    Attributes
+    ----------
+    features : tuple of str
+        Design features (inputs of the simulator).
+    performance : tuple of str
+        Performance columns (outputs); never to be used as features.
+    categorical : tuple of str
+        The features that are categorical (pattern type, cell counts).
+    """
+
+    features: tuple[str, ...]
+    performance: tuple[str, ...]
+    categorical: tuple[str, ...] = ()
+
+
+PUBLISHED: dict[str, ColumnRoles] = {
+    "data0": ColumnRoles(
+        ("tcrease", "tpanel", "W", "gama"),
+        ("axialstiff30", "axialstiff60", "axialstiff90"),
+    ),
+    "data1": ColumnRoles(
+        ("pattern", "m", "n", "tcrease", "tpanel", "W"),
+        (
+            "bendstiff30",
+            "bendstiff60",
+            "bendstiff90",
+            "axialstiff30",
+            "axialstiff60",
+            "axialstiff90",
+        ),
+        ("pattern", "m", "n"),
+    ),
+    "data2": ColumnRoles(
+        ("Pattern", "L1", "L2", "t1", "t2", "tpanel", "rate", "W"),
+        ("freqFinal", "finalQ", "Tmax", "stiff"),
+        ("Pattern",),
+    ),
+    "data3": ColumnRoles(
+        ("m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"),
+        ("Zstiff", "Zsnap", "Xstiff", "error"),
+        ("m",),
+    ),
+    "data4": ColumnRoles(
+        ("pattern", "m", "n", "tcrease", "tpanel", "W", "creaseE", "panelE"),
+        (
+            "bendstiff30",
+            "bendstiff60",
+            "bendstiff90",
+            "axialstiff30",
+            "axialstiff60",
+            "axialstiff90",
+        ),
+        ("pattern", "m", "n"),
+    ),
+}
+
+
+def feature_name_file(path) -> Path | None:
+    """The sibling ``<prefix>_FeatureName.txt`` of a published ``<prefix>_<name>.txt``."""
+    path = Path(path)
+    prefix = path.stem.split("_", 1)[0]
+    cand = path.with_name(f"{prefix}_FeatureName.txt")
+    return cand if cand.is_file() and cand != path else None
+
+
+def read_table(path, columns=None) -> pd.DataFrame:
+    """Read a database into a DataFrame with named columns.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.csv`` (header row), ``.parquet`` / ``.pq``, or a headerless comma-separated
+        ``.txt`` / ``.dat``.
+    columns : sequence of str, optional
+        Names of the columns of a headerless file. When omitted, a sibling
+        ``*_FeatureName.txt`` (whitespace-separated names) is used if present. For files with
+        a header, selects these columns.
+
+    Returns
+    -------
+    pandas.DataFrame
+
+    Raises
+    ------
+    ValueError
+        Unknown suffix, no column names for a headerless file, a count mismatch, non-numeric
+        values in a headerless file, or a requested column that does not exist.
+    OSError
+        The file cannot be read.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"database {path} does not exist")
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        frame = pd.read_csv(path)
+    elif suffix in (".parquet", ".pq"):
+        frame = pd.read_parquet(path)
+    elif suffix in (".txt", ".dat"):
+        names = list(columns) if columns is not None else None
+        if names is None:
+            sib = feature_name_file(path)
+            if sib is None:
+                raise ValueError(
+                    f"{path.name} has no header: give its column names (e.g. --columns), or put "
+                    "a <prefix>_FeatureName.txt beside it"
+                )
+            names = sib.read_text().split()
+        try:
+            data = np.loadtxt(path, delimiter=",", ndmin=2)
+        except ValueError as exc:
+            raise ValueError(f"{path.name}: not a comma-separated numeric table ({exc})") from exc
+        if data.shape[1] != len(names):
+            raise ValueError(
+                f"{path.name} has {data.shape[1]} columns but {len(names)} names were given: "
+                f"{' '.join(names)}"
+            )
+        if len(set(names)) != len(names):
+            raise ValueError(f"duplicate column names: {' '.join(names)}")
+        return pd.DataFrame(data, columns=names)
+    else:
+        raise ValueError(
+            f"unknown database type {suffix!r} for {path.name}; expected .csv, .parquet, .txt"
+        )
+    if columns is not None:
+        missing = [c for c in columns if c not in frame.columns]
+        if missing:
+            raise ValueError(
+                f"column {missing[0]!r} not in {path.name}; columns: {', '.join(frame.columns)}"
+            )
+        frame = frame[list(columns)]
+    return frame
+
+
+def column_roles(columns) -> ColumnRoles | None:
+    """Recognise a published column set (in any order).
+
+    Returns None when the columns are not one of the published sets.
+    """
+    cols = {str(c) for c in columns}
+    for roles in PUBLISHED.values():
+        if cols == set(roles.features + roles.performance):
+            return roles
+    return None

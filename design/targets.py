@@ -1,0 +1,317 @@
+"""A small, safe expression language for design targets over performance columns.
+
+Examples of valid targets::
+
+    axialstiff60 < 6000
+    Zstiff > 800 & Xstiff > 600 & error < 0.1
+    700 < bendstiff90 < 1600
+    Zsnap == 1 | (Zstiff > 3e3 & error <= .08)
+    `axial stiff` >= 1.5e4
+
+Grammar (``&`` binds tighter than ``|``)::
+
+    expr       := and_expr ("|" and_expr)*
+    and_expr   := atom ("&" atom)*
+    atom       := "(" expr ")" | comparison
+    comparison := operand (OP operand)+          # chained: a < b < c means a < b & b < c
+    operand    := NUMBER | ["+" | "-"] NUMBER | NAME | `quoted name`
+    OP         := "<" | "<=" | ">" | ">=" | "==" | "!="
+
+Every comparison chain must involve at least one column. The expression is tokenised and
+parsed by hand (recursive descent); nothing is ever passed to ``eval`` or ``DataFrame.query``.
+"""
+
+from __future__ import annotations
+
+import operator
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["TargetError", "Target", "parse_target"]
+
+
+class TargetError(ValueError):
+    """A target expression is malformed or names an unknown column."""
+
+
+_OPS = {
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+    "==": operator.eq,
+    "!=": operator.ne,
+}
+
+_TOKEN_RE = re.compile(
+    r"""
+    (?P<ws>\s+)
+  | (?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)
+  | (?P<name>[A-Za-z_][A-Za-z0-9_.]*)
+  | (?P<quoted>`[^`]*`)
+  | (?P<op><=|>=|==|!=|<|>)
+  | (?P<punct>[&|()+-])
+    """,
+    re.VERBOSE,
+)
+
+
+@dataclass(frozen=True)
+class _Token:
+    kind: str  # "number", "name", "op", "punct", "end"
+    text: str
+    pos: int
+    value: object = None
+
+
+def _tokenize(expr: str) -> list[_Token]:
+    tokens: list[_Token] = []
+    pos = 0
+    while pos < len(expr):
+        m = _TOKEN_RE.match(expr, pos)
+        if m is None:
+            raise TargetError(
+                f"unexpected character {expr[pos]!r} at position {pos} in target {expr!r}"
+            )
+        kind = m.lastgroup
+        text = m.group(kind)
+        if kind == "number":
+            tokens.append(_Token("number", text, pos, float(text)))
+        elif kind == "name":
+            tokens.append(_Token("name", text, pos, text))
+        elif kind == "quoted":
+            name = text[1:-1]
+            if not name:
+                raise TargetError(f"empty quoted column name at position {pos} in {expr!r}")
+            tokens.append(_Token("name", text, pos, name))
+        elif kind in ("op", "punct"):
+            tokens.append(_Token(kind, text, pos))
+        pos = m.end()
+    tokens.append(_Token("end", "end of expression", len(expr)))
+    return tokens
+
+
+# ---- syntax tree: plain frozen dataclasses --------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Column:
+    name: str
+    pos: int
+
+
+@dataclass(frozen=True)
+class _Number:
+    value: float
+
+
+@dataclass(frozen=True)
+class _Compare:
+    operands: tuple  # (_Column | _Number, ...), len = len(ops) + 1
+    ops: tuple  # (str, ...)
+
+
+@dataclass(frozen=True)
+class _BoolOp:
+    op: str  # "&" or "|"
+    args: tuple
+
+
+class _Parser:
+    def __init__(self, expr: str, tokens: list[_Token]):
+        self.expr = expr
+        self.tokens = tokens
+        self.i = 0
+
+    @property
+    def tok(self) -> _Token:
+        return self.tokens[self.i]
+
+    def error(self, what: str, tok: _Token | None = None) -> TargetError:
+        tok = tok or self.tok
+        shown = tok.text if tok.kind == "end" else repr(tok.text)
+        return TargetError(f"{what}, got {shown} at position {tok.pos} in target {self.expr!r}")
+
+    def parse(self):
+        node = self.parse_or()
+        if self.tok.kind != "end":
+            raise self.error("expected '&', '|' or the end of the target")
+        return node
+
+    def parse_or(self):
+        args = [self.parse_and()]
+        while self.tok.kind == "punct" and self.tok.text == "|":
+            self.i += 1
+            args.append(self.parse_and())
+        return args[0] if len(args) == 1 else _BoolOp("|", tuple(args))
+
+    def parse_and(self):
+        args = [self.parse_atom()]
+        while self.tok.kind == "punct" and self.tok.text == "&":
+            self.i += 1
+            args.append(self.parse_atom())
+        return args[0] if len(args) == 1 else _BoolOp("&", tuple(args))
+
+    def parse_atom(self):
+        if self.tok.kind == "punct" and self.tok.text == "(":
+            self.i += 1
+            node = self.parse_or()
+            if not (self.tok.kind == "punct" and self.tok.text == ")"):
+                raise self.error("expected ')'")
+            self.i += 1
+            return node
+        start = self.tok
+        operands = [self.parse_operand()]
+        ops = []
+        while self.tok.kind == "op":
+            ops.append(self.tok.text)
+            self.i += 1
+            operands.append(self.parse_operand())
+        if not ops:
+            raise self.error("expected a comparison operator (<, <=, >, >=, ==, !=)")
+        if not any(isinstance(o, _Column) for o in operands):
+            raise TargetError(
+                f"comparison at position {start.pos} in target {self.expr!r} involves no column"
+            )
+        return _Compare(tuple(operands), tuple(ops))
+
+    def parse_operand(self):
+        tok = self.tok
+        if tok.kind == "punct" and tok.text in "+-":
+            nxt = self.tokens[self.i + 1]
+            if nxt.kind != "number":
+                raise self.error("expected a number after the sign", nxt)
+            self.i += 2
+            return _Number(-nxt.value if tok.text == "-" else nxt.value)
+        if tok.kind == "number":
+            self.i += 1
+            return _Number(tok.value)
+        if tok.kind == "name":
+            self.i += 1
+            return _Column(tok.value, tok.pos)
+        raise self.error("expected a column name or a number")
+
+
+def _columns_of(node, out: list[_Column]) -> None:
+    if isinstance(node, _BoolOp):
+        for a in node.args:
+            _columns_of(a, out)
+    elif isinstance(node, _Compare):
+        out.extend(o for o in node.operands if isinstance(o, _Column))
+
+
+def _eval(node, frame) -> np.ndarray:
+    if isinstance(node, _BoolOp):
+        parts = [_eval(a, frame) for a in node.args]
+        func = np.logical_and if node.op == "&" else np.logical_or
+        return func.reduce(parts)
+    values = [
+        np.asarray(frame[o.name], dtype=float) if isinstance(o, _Column) else o.value
+        for o in node.operands
+    ]
+    result = None
+    for k, op in enumerate(node.ops):
+        part = np.asarray(_OPS[op](values[k], values[k + 1]), dtype=bool)
+        result = part if result is None else result & part
+    return result
+
+
+def _render(node) -> str:
+    if isinstance(node, _BoolOp):
+        inner = f" {node.op} ".join(
+            f"({_render(a)})" if isinstance(a, _BoolOp) else _render(a) for a in node.args
+        )
+        return inner
+    parts = []
+    for k, o in enumerate(node.operands):
+        if k:
+            parts.append(node.ops[k - 1])
+        if isinstance(o, _Column):
+            ok = re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", o.name)
+            parts.append(o.name if ok else f"`{o.name}`")
+        else:
+            parts.append(f"{o.value:g}")
+    return " ".join(parts)
+
+
+@dataclass(frozen=True)
+class Target:
+    """A parsed target expression.
+
+    Attributes
+    ----------
+    expression : str
+        The source text.
+    columns : tuple of str
+        The column names used, in order of first appearance.
+    """
+
+    expression: str
+    columns: tuple[str, ...]
+    _tree: object = field(repr=False, compare=False)
+
+    def evaluate(self, frame) -> np.ndarray:
+        """Evaluate on a table.
+
+        Parameters
+        ----------
+        frame : pandas.DataFrame or mapping of str to array of shape (n_rows,)
+            Must hold every column of :attr:`columns`.
+
+        Returns
+        -------
+        ndarray of bool, shape (n_rows,)
+            True where the row meets the target (comparisons with NaN are False, except ``!=``).
+        """
+        available = list(frame.keys())
+        missing = [c for c in self.columns if c not in available]
+        if missing:
+            raise TargetError(
+                f"unknown column {missing[0]!r} in target {self.expression!r}; "
+                f"available columns: {', '.join(map(str, available))}"
+            )
+        return np.asarray(_eval(self._tree, frame), dtype=bool)
+
+    def __str__(self) -> str:
+        return _render(self._tree)
+
+
+def parse_target(expr: str, columns=None) -> Target:
+    """Parse a target expression.
+
+    Parameters
+    ----------
+    expr : str
+        The target, e.g. ``"Zstiff > 800 & Xstiff > 600 & error < 0.1"``.
+    columns : iterable of str, optional
+        The allowed column names; when given, an unknown name raises at parse time with its
+        position.
+
+    Returns
+    -------
+    Target
+
+    Raises
+    ------
+    TargetError
+        (a ValueError) naming the bad token or unknown column and its position.
+    """
+    if not isinstance(expr, str):
+        raise TargetError(f"a target must be a string, got {type(expr).__name__}")
+    if not expr.strip():
+        raise TargetError("the target expression is empty")
+    tree = _Parser(expr, _tokenize(expr)).parse()
+    used: list[_Column] = []
+    _columns_of(tree, used)
+    if columns is not None:
+        allowed = [str(c) for c in columns]
+        for col in used:
+            if col.name not in allowed:
+                raise TargetError(
+                    f"unknown column {col.name!r} at position {col.pos} in target {expr!r}; "
+                    f"available columns: {', '.join(allowed)}"
+                )
+    names = tuple(dict.fromkeys(c.name for c in used))
+    return Target(expr, names, tree)
