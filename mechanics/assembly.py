@@ -1,0 +1,550 @@
+"""Global energy, internal force and tangent stiffness with a sparse pattern built once.
+
+The pattern (CSR ``indptr``/``indices`` and the data slot of every entry the element kernels
+produce) depends only on the connectivity, so it is computed once per topology and cached (keyed
+on a hash of the bar and spring connectivity: every sample of one Miura m x n or arch m shares
+it); each evaluation then fills the CSR data with ``np.bincount`` (bars; springs and the mirrors
+of their off-diagonal blocks). Supports are handled by elimination: the free-free slots, the
+reduced CSR pattern and the fill-reducing orderings are cached per support mask.
+
+Linear solves on the free DOFs (:meth:`Assembler.evaluate_factorized`) pick the fastest path:
+dense LAPACK up to :data:`DENSE_MAX_DOF` free DOFs, then a banded Cholesky on a cached reverse
+Cuthill-McKee ordering, and SuperLU (LU with a cached minimum-degree ordering, natural column
+order at factorisation time) when the band is too wide or the tangent is not positive definite.
+Supports by elimination are exactly the reference's "zero the row and column, keep the diagonal,
+zero the residual" (the supported increments are 0 either way).
+
+Typical use::
+
+    asm = Assembler(structure)
+    energy, f_int, K = asm.evaluate(U)                 # full system, K csr (ndof, ndof)
+    energy, f_int, K_ff = asm.evaluate_reduced(U)      # K on the free DOFs (dense or csr)
+    energy, f_int, solve = asm.evaluate_factorized(U)  # dU_f = solve(r[asm.free_dofs])
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import OrderedDict
+from functools import cached_property
+from typing import NamedTuple
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from mechanics.bars import bar_kernel
+from mechanics.springs import SPRING_BLOCKS, spring_kernel
+from mechanics.structure import Structure
+
+__all__ = [
+    "AssemblyPattern",
+    "Assembler",
+    "AssembledSystem",
+    "ReducedPattern",
+    "SingularSystemError",
+    "assembly_pattern",
+    "DENSE_MAX_DOF",
+    "BANDED_MAX_WORK",
+]
+
+#: Reduced systems with at most this many free DOFs are assembled and solved densely (LAPACK);
+#: larger ones sparsely (crossover measured at ~200 DOFs).
+DENSE_MAX_DOF = 200
+#: Sparse systems whose reverse Cuthill-McKee band costs at most this many flops
+#: (n * (bandwidth + 1)^2) first try a banded Cholesky factorisation; SuperLU (LU with a cached
+#: minimum-degree ordering) handles the rest and every matrix that is not positive definite.
+BANDED_MAX_WORK = 3e8
+
+
+class SingularSystemError(RuntimeError):
+    """The reduced tangent stiffness could not be factorised or solved."""
+
+
+_PATTERN_CACHE: OrderedDict[bytes, AssemblyPattern] = OrderedDict()
+_PATTERN_CACHE_SIZE = 8
+
+
+class AssembledSystem(NamedTuple):
+    """Result of one evaluation (unpacks as ``energy, force, stiffness``).
+
+    energy     float                     total strain energy, J
+    force      (ndof,) float             internal force vector T(U), N
+    stiffness  csr (n, n) | (n, n) array tangent stiffness (full, or free-free block), N/m
+    """
+
+    energy: float
+    force: np.ndarray
+    stiffness: sp.csr_matrix | np.ndarray
+
+
+class ReducedPattern:
+    """Free-DOF reduction of an :class:`AssemblyPattern` for one support mask.
+
+    Attributes
+    ----------
+    free : (nf,) int
+        Free global DOFs (increasing).
+    keep : (nnz_f,) int
+        CSR slots of the full pattern whose row and column are free.
+    indptr, indices : reduced CSR arrays (free DOFs in increasing order).
+    dense : (nnz_f,) int
+        Flat position ``row * nf + col`` of each kept slot in a dense (nf, nf) matrix.
+    banded, banded_slots : computed on first use
+        Reverse Cuthill-McKee ordering, half bandwidth, and the position of every element
+        entry in LAPACK upper banded storage (banded Cholesky path).
+    ordering : (order, perm_keep, perm_indptr, perm_indices), computed on first use
+        A fill-reducing symmetric ordering ``order`` (``K[order][:, order]``, multiple minimum
+        degree on K + K') and the CSR pattern of the permuted matrix, so that sparse solves
+        factorise with SuperLU's natural ordering and no per-iteration ordering cost.
+    """
+
+    def __init__(self, pattern: AssemblyPattern, free_mask: np.ndarray):
+        self._pattern = pattern
+        free = np.flatnonzero(free_mask)
+        n = pattern.n_dof
+        new = np.full(n, -1, np.intp)
+        new[free] = np.arange(free.size)
+        r = new[pattern._rows]
+        c = new[pattern.indices]
+        keep = np.flatnonzero((r >= 0) & (c >= 0))
+        nf = free.size
+        self.free = free
+        self.keep = keep
+        self._r = r[keep]
+        self._c = c[keep]
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(self._r, minlength=nf))]).astype(
+            np.int32
+        )
+        self.indices = self._c.astype(np.int32)
+        self.dense = (self._r * nf + self._c).astype(np.intp)
+
+    @property
+    def n_free(self) -> int:
+        return self.free.size
+
+    @cached_property
+    def banded(self):
+        """(perm, bandwidth, upper_keep, ab_pos): reverse Cuthill-McKee permutation of the
+        free DOFs, its half bandwidth, the kept slots of the upper triangle of the permuted
+        matrix and their flat positions in LAPACK upper banded storage (bw + 1, nf)."""
+        nf = self.free.size
+        A = sp.csr_matrix((np.ones(self._r.size), self.indices, self.indptr), shape=(nf, nf))
+        perm = reverse_cuthill_mckee(A, symmetric_mode=True).astype(np.intp)
+        inv = np.empty(nf, np.intp)
+        inv[perm] = np.arange(nf)
+        pr = inv[self._r]
+        pc = inv[self._c]
+        bw = int(np.abs(pr - pc).max()) if pr.size else 0
+        up = pr <= pc
+        ab_pos = (bw + pr[up] - pc[up]) * nf + pc[up]
+        return perm, bw, self.keep[up], ab_pos.astype(np.intp)
+
+    @cached_property
+    def banded_slots(self):
+        """(bar_ab, spring_ab, size): position in the flat upper banded storage of every bar
+        entry (kernel layout (3, 3, 2, 2, nb)) and every distinct spring-block entry ((3, 3,
+        10, ns)), ``size`` (= (bw + 1) nf) for entries that are dropped: supported DOFs and the
+        duplicate halves of symmetric pairs (lower node blocks of bars, the strictly lower
+        triangle of diagonal blocks), so that one bincount per family fills the band."""
+        pat = self._pattern
+        perm, bw, _, _ = self.banded
+        nf = self.free.size
+        size = (bw + 1) * nf
+        new = np.full(pat.n_dof, -1, np.intp)
+        inv = np.empty(nf, np.intp)
+        inv[perm] = np.arange(nf)
+        new[self.free] = inv  # global DOF -> permuted reduced index
+
+        def positions(slots, keep_mask):
+            r = new[pat._rows[slots]]
+            c = new[pat.indices[slots]]
+            lo = np.minimum(r, c)
+            hi = np.maximum(r, c)
+            pos = (bw + lo - hi) * nf + hi
+            ok = keep_mask & (lo >= 0)
+            return np.where(ok, pos, size).astype(np.intp)
+
+        nb = pat.bar_dofs.shape[0]
+        ns = pat.spring_dofs.shape[0]
+        i = np.arange(3)[:, None]
+        j = np.arange(3)[None, :]
+        upper3 = i <= j  # (3, 3)
+        # bars (3, 3, 2, 2, nb): keep blocks (0,0), (1,1) upper halves and (0,1) whole
+        a = np.arange(2)[:, None]
+        b = np.arange(2)[None, :]
+        keep_b = ((a < b) | ((a == b) & upper3[:, :, None, None]))[..., None]
+        keep_b = np.broadcast_to(keep_b, (3, 3, 2, 2, nb)).ravel()
+        # springs (3, 3, 10, ns): off-diagonal blocks whole, diagonal blocks upper halves
+        diag = SPRING_BLOCKS[:, 0] == SPRING_BLOCKS[:, 1]
+        keep_s = (~diag[None, None, :] | upper3[:, :, None])[..., None]
+        keep_s = np.broadcast_to(keep_s, (3, 3, 10, ns)).ravel()
+        return positions(pat.bar_slot, keep_b), positions(pat.spring_slot, keep_s), size
+
+    @cached_property
+    def ordering(self):
+        nf = self.free.size
+        # symbolic ordering from the pattern alone (diagonally dominant stand-in values)
+        vals = np.where(self._r == self._c, float(nf + 1), -1.0 / max(nf, 1))
+        A = sp.csc_matrix((vals, self.indices, self.indptr), shape=(nf, nf))
+        lu = spla.splu(
+            A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
+        )
+        order = np.argsort(lu.perm_c)
+        inv = np.empty(nf, np.intp)
+        inv[order] = np.arange(nf)
+        pr = inv[self._r]
+        pc = inv[self._c]
+        srt = np.argsort(pr.astype(np.int64) * nf + pc)
+        perm_indptr = np.concatenate([[0], np.cumsum(np.bincount(pr, minlength=nf))])
+        return (
+            order,
+            self.keep[srt],
+            perm_indptr.astype(np.int32),
+            pc[srt].astype(np.int32),
+        )
+
+
+class AssemblyPattern:
+    """CSR sparsity pattern of the bar-and-spring tangent and the slot map of local entries.
+
+    Parameters
+    ----------
+    n_dof : int
+        Number of global DOFs (3 per node).
+    bar_dofs : (nb, 6) int
+        Global DOFs of each bar.
+    spring_dofs : (ns, 12) int
+        Global DOFs of each spring.
+
+    Attributes
+    ----------
+    indptr, indices : CSR arrays of the (structurally symmetric) pattern; every diagonal is
+        included.
+    bar_slot : (36 nb,) int
+        CSR data slot of every entry of the bar tangents in kernel layout (3, 3, 2, 2, nb)
+        (see :func:`mechanics.bars.bar_kernel`).
+    spring_slot, spring_slot_mirror : (90 ns,) int
+        Slots of the ten distinct spring tangent blocks in kernel layout (3, 3, 10, ns) (see
+        :func:`mechanics.springs.spring_kernel`), and of their transposes (``nnz`` = discard,
+        for the diagonal blocks).
+    bar_force_dofs, spring_force_dofs : (6 nb,), (12 ns,) int
+        Global DOF of every entry of the kernels' force arrays ((3, 2, nb) and (3, 4, ns)).
+    nnz : int
+    """
+
+    def __init__(self, n_dof: int, bar_dofs: np.ndarray, spring_dofs: np.ndarray):
+        self.n_dof = int(n_dof)
+        self.bar_dofs = np.ascontiguousarray(bar_dofs, dtype=np.intp)
+        self.spring_dofs = np.ascontiguousarray(spring_dofs, dtype=np.intp)
+        nd = np.int64(self.n_dof)
+
+        def keys(dofs, nodes):
+            # bar kernel layout (3, 3, 2, 2, nb): entry [i, j, a, b, e] couples global
+            # DOF (3 n_a + i) of element e with (3 n_b + j)
+            d = dofs.astype(np.int64).reshape(-1, nodes, 3).transpose(2, 1, 0)  # (3, nodes, ne)
+            return (d[:, None, :, None, :] * nd + d[None, :, None, :, :]).ravel()
+
+        # spring kernel layout (3, 3, 10, ns): the ten distinct blocks (a, b) of SPRING_BLOCKS;
+        # each is scattered to (a, b) and, if a != b, transposed to (b, a)
+        ds = self.spring_dofs.astype(np.int64).reshape(-1, 4, 3).transpose(2, 1, 0)  # (3, 4, ns)
+        ra = ds[:, None, SPRING_BLOCKS[:, 0], :]  # (3, 1, 10, ns): row DOF 3 n_a + i
+        cb = ds[None, :, SPRING_BLOCKS[:, 1], :]  # (1, 3, 10, ns): column DOF 3 n_b + j
+        ks_direct = (ra * nd + cb).ravel()
+        offdiag = SPRING_BLOCKS[:, 0] != SPRING_BLOCKS[:, 1]
+        ks_mirror_full = cb * nd + ra  # (3, 3, 10, ns)
+        ks_mirror = ks_mirror_full[:, :, offdiag, :].ravel()
+
+        diag = np.arange(nd, dtype=np.int64) * (nd + 1)
+        kb = keys(self.bar_dofs, 2)
+        allkeys = np.concatenate([kb, ks_direct, ks_mirror, diag])
+        ukeys, inverse = np.unique(allkeys, return_inverse=True)
+        inverse = inverse.ravel()
+        nnz = int(ukeys.size)
+        self.bar_slot = inverse[: kb.size].astype(np.intp)
+        n1 = kb.size + ks_direct.size
+        self.spring_slot = inverse[kb.size : n1].astype(np.intp)
+        # mirror slots for every block; diagonal blocks go to a dump slot (index nnz)
+        mirror = np.full(ks_mirror_full.shape, nnz, dtype=np.intp)
+        mirror[:, :, offdiag, :] = inverse[n1 : n1 + ks_mirror.size].reshape(
+            3, 3, int(offdiag.sum()), -1
+        )
+        self.spring_slot_mirror = mirror.ravel()
+        rows = ukeys // nd
+        self.indices = (ukeys % nd).astype(np.int32)
+        self.indptr = np.concatenate(
+            [[0], np.cumsum(np.bincount(rows, minlength=self.n_dof))]
+        ).astype(np.int32)
+        self.nnz = int(ukeys.size)
+        self._rows = rows.astype(np.intp)
+        self.bar_force_dofs = self.bar_dofs.reshape(-1, 2, 3).transpose(2, 1, 0).ravel()
+        self.spring_force_dofs = self.spring_dofs.reshape(-1, 4, 3).transpose(2, 1, 0).ravel()
+        self._reduced: dict[bytes, ReducedPattern] = {}
+
+    def reduced(self, free_mask: np.ndarray) -> ReducedPattern:
+        """The free-DOF reduction for a boolean (ndof,) mask (cached per mask)."""
+        free_mask = np.asarray(free_mask, bool).ravel()
+        if free_mask.size != self.n_dof:
+            raise ValueError(f"free mask must have {self.n_dof} entries, got {free_mask.size}")
+        key = np.packbits(free_mask).tobytes()
+        red = self._reduced.get(key)
+        if red is None:
+            red = ReducedPattern(self, free_mask)
+            self._reduced[key] = red
+        return red
+
+    def compatible(self, n_dof: int, bar_dofs: np.ndarray, spring_dofs: np.ndarray) -> bool:
+        """True if this pattern was built for exactly this connectivity."""
+        return (
+            self.n_dof == n_dof
+            and np.array_equal(self.bar_dofs, bar_dofs)
+            and np.array_equal(self.spring_dofs, spring_dofs)
+        )
+
+
+def assembly_pattern(structure: Structure) -> AssemblyPattern:
+    """The (cached) :class:`AssemblyPattern` of a structure's connectivity.
+
+    Structures with the same number of nodes, bars and springs (e.g. every sample of one Miura
+    m x n sheet) share one pattern; a small LRU cache keyed on a hash of the connectivity avoids
+    rebuilding it.
+    """
+    h = hashlib.blake2b(digest_size=16)
+    h.update(np.int64(structure.n_dof).tobytes())
+    h.update(np.ascontiguousarray(structure.bars, np.int64).tobytes())
+    h.update(b"|")
+    h.update(np.ascontiguousarray(structure.springs, np.int64).tobytes())
+    key = h.digest()
+    pat = _PATTERN_CACHE.get(key)
+    if pat is not None:
+        _PATTERN_CACHE.move_to_end(key)
+        return pat
+    pat = AssemblyPattern(structure.n_dof, structure.bar_dofs, structure.spring_dofs)
+    _PATTERN_CACHE[key] = pat
+    while len(_PATTERN_CACHE) > _PATTERN_CACHE_SIZE:
+        _PATTERN_CACHE.popitem(last=False)
+    return pat
+
+
+class Assembler:
+    """Evaluate the global energy, internal force and tangent of a :class:`Structure`.
+
+    Parameters
+    ----------
+    structure : Structure
+        The model (reference coordinates, element properties, supports).
+    pattern : AssemblyPattern, optional
+        A pattern built for the same connectivity (default: the cached one).
+    dense_max : int
+        Reduced systems with at most this many free DOFs are built and solved dense
+        (:meth:`evaluate_reduced` with ``dense=None``, :meth:`evaluate_factorized`).
+
+    The assembler reads the structure's arrays once; build a new one for a changed structure
+    (it is cheap: the pattern comes from the cache).
+    """
+
+    def __init__(
+        self,
+        structure: Structure,
+        pattern: AssemblyPattern | None = None,
+        *,
+        dense_max: int = DENSE_MAX_DOF,
+    ):
+        if pattern is None:
+            pattern = assembly_pattern(structure)
+        elif not pattern.compatible(structure.n_dof, structure.bar_dofs, structure.spring_dofs):
+            raise ValueError("pattern was built for another connectivity than this structure")
+        self.structure = structure
+        self.pattern = pattern
+        self.dense_max = int(dense_max)
+        self.X = structure.nodes
+        self.bars = structure.bars
+        self.springs = structure.springs
+        self.L0 = structure.bar_length
+        self.EA = structure.bar_E * structure.bar_area
+        self.k = structure.spring_k
+        self.theta0 = structure.spring_rest
+        self.n_dof = structure.n_dof
+        self._XT = np.ascontiguousarray(self.X.T)
+        self._b0 = self.bars[:, 0].copy()
+        self._b1 = self.bars[:, 1].copy()
+        self._D0 = self._XT[:, self._b1] - self._XT[:, self._b0]  # (3, nb)
+        self._sT = np.ascontiguousarray(self.springs.T)  # (4, ns)
+
+    @cached_property
+    def reduction(self) -> ReducedPattern:
+        """Free-DOF reduction for the structure's supports."""
+        return self.pattern.reduced(~self.structure.supports.ravel())
+
+    @property
+    def free_dofs(self) -> np.ndarray:
+        """(nf,) int: free global DOFs."""
+        return self.reduction.free
+
+    # ------------------------------------------------------------------ evaluation
+    def element_response(self, U, spring_rest=None, *, tangent: bool = True):
+        """Element-level bar and spring responses ``(bar, spring)`` in the kernels' layouts
+        (see :func:`mechanics.bars.bar_kernel` and :func:`mechanics.springs.spring_kernel`)."""
+        UT = np.asarray(U, float).reshape(-1, 3).T
+        if UT.shape[1] != self.X.shape[0]:
+            raise ValueError(f"U must have shape ({self.X.shape[0]}, 3), got {np.shape(U)}")
+        if spring_rest is None:
+            theta0 = self.theta0
+        else:
+            theta0 = np.asarray(spring_rest, float)
+            if theta0.shape != self.theta0.shape:
+                raise ValueError(
+                    f"spring_rest must have shape {self.theta0.shape}, got {theta0.shape}"
+                )
+        rb = bar_kernel(
+            self._D0, UT[:, self._b1] - UT[:, self._b0], self.L0, self.EA, tangent=tangent
+        )
+        rs, _ = spring_kernel((self._XT + UT)[:, self._sT], self.k, theta0, tangent=tangent)
+        return rb, rs
+
+    def _elements(self, U, spring_rest, tangent=True):
+        rb, rs = self.element_response(U, spring_rest, tangent=tangent)
+        pat = self.pattern
+        n = self.n_dof
+        energy = float(rb.energy.sum() + rs.energy.sum())
+        f = np.bincount(pat.bar_force_dofs, weights=rb.force.ravel(), minlength=n)
+        if rs.force.size:
+            f += np.bincount(pat.spring_force_dofs, weights=rs.force.ravel(), minlength=n)
+        return energy, f, rb, rs
+
+    def _scatter(self, rb, rs):
+        """CSR data of the full tangent from the element tangents."""
+        pat = self.pattern
+        data = np.bincount(pat.bar_slot, weights=rb.tangent.ravel(), minlength=pat.nnz)
+        if rs.tangent.size:
+            w = rs.tangent.ravel()
+            data += np.bincount(pat.spring_slot, weights=w, minlength=pat.nnz)
+            data += np.bincount(pat.spring_slot_mirror, weights=w, minlength=pat.nnz + 1)[:-1]
+        return data
+
+    def _data(self, U, spring_rest, tangent=True):
+        energy, f, rb, rs = self._elements(U, spring_rest, tangent)
+        return energy, f, (self._scatter(rb, rs) if tangent else None)
+
+    def internal_force(self, U, spring_rest=None) -> tuple[float, np.ndarray]:
+        """Energy (J) and internal force (ndof,) N, without the tangent."""
+        energy, f, _ = self._data(U, spring_rest, tangent=False)
+        return energy, f
+
+    def evaluate(self, U, spring_rest=None) -> AssembledSystem:
+        """Energy, internal force (ndof,) and full tangent (csr ndof x ndof) at displacement U.
+
+        Parameters
+        ----------
+        U : (nn, 3) or (ndof,) float
+            Displacements from the reference coordinates, m.
+        spring_rest : (ns,) float, optional
+            Rest angles to use instead of ``structure.spring_rest``, rad.
+        """
+        energy, f, data = self._data(U, spring_rest)
+        pat = self.pattern
+        K = sp.csr_matrix((data, pat.indices, pat.indptr), shape=(self.n_dof, self.n_dof))
+        return AssembledSystem(energy, f, K)
+
+    def evaluate_reduced(self, U, spring_rest=None, *, dense: bool | None = None):
+        """Energy, full internal force (ndof,) and the free-free tangent block.
+
+        The block is a dense ``(nf, nf)`` array when ``dense`` is True (default: when
+        ``nf <= dense_max``), otherwise a csr matrix. Its rows/columns follow
+        :attr:`free_dofs`.
+        """
+        energy, f, data = self._data(U, spring_rest)
+        red = self.reduction
+        nf = red.free.size
+        if dense is None:
+            dense = nf <= self.dense_max
+        if dense:
+            K = np.zeros(nf * nf)
+            K[red.dense] = data[red.keep]
+            K = K.reshape(nf, nf)
+        else:
+            K = sp.csr_matrix((data[red.keep], red.indices, red.indptr), shape=(nf, nf))
+        return AssembledSystem(energy, f, K)
+
+    def evaluate_factorized(self, U, spring_rest=None):
+        """Energy, full internal force (ndof,) and a solver for the free-free tangent.
+
+        Returns
+        -------
+        energy : float
+        force : (ndof,) float
+        solve : callable
+            ``solve(rhs)`` with ``rhs`` (nf,) or (nf, k) on :attr:`free_dofs` returns
+            ``K_ff^-1 rhs``; one factorisation serves every call. Raises
+            :class:`SingularSystemError` if ``K_ff`` is singular or the solution is not finite.
+        """
+        energy, f, rb, rs = self._elements(U, spring_rest)
+        red = self.reduction
+        nf = red.free.size
+        if nf == 0:
+            return energy, f, lambda rhs: np.zeros_like(rhs, dtype=float)
+        if nf <= self.dense_max:
+            data = self._scatter(rb, rs)
+            K = np.zeros(nf * nf)
+            K[red.dense] = data[red.keep]
+            K = K.reshape(nf, nf)
+
+            def solve(rhs):
+                try:
+                    x = np.linalg.solve(K, rhs)
+                except np.linalg.LinAlgError as exc:
+                    raise SingularSystemError(f"singular stiffness matrix ({exc})") from None
+                return _finite(x)
+
+            return energy, f, solve
+        perm, bw, _, _ = red.banded
+        if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK:
+            # upper band filled straight from the element values (one bincount per family)
+            bar_ab, spring_ab, size = red.banded_slots
+            ab = np.bincount(bar_ab, weights=rb.tangent.ravel(), minlength=size + 1)
+            if rs.tangent.size:
+                ab += np.bincount(spring_ab, weights=rs.tangent.ravel(), minlength=size + 1)
+            try:
+                c = cholesky_banded(ab[:size].reshape(bw + 1, nf), lower=False, check_finite=False)
+            except LinAlgError:
+                c = None  # not positive definite: LU below
+            if c is not None:
+
+                def solve(rhs):
+                    y = cho_solve_banded((c, False), rhs[perm], check_finite=False)
+                    x = np.empty_like(y)
+                    x[perm] = y
+                    return _finite(x)
+
+                return energy, f, solve
+        data = self._scatter(rb, rs)
+        order, perm_keep, perm_indptr, perm_indices = red.ordering
+        # csc from the permuted CSR arrays is Kp^T; factorise it and solve with trans='T'
+        KpT = sp.csc_matrix((data[perm_keep], perm_indices, perm_indptr), shape=(nf, nf))
+        try:
+            lu = spla.splu(
+                KpT,
+                permc_spec="NATURAL",
+                diag_pivot_thresh=0.01,
+                relax=3,
+                panel_size=10,
+                options={"SymmetricMode": True},
+            )
+        except RuntimeError as exc:
+            raise SingularSystemError(f"singular stiffness matrix ({exc})") from None
+
+        def solve(rhs):
+            y = lu.solve(np.ascontiguousarray(rhs[order]), trans="T")
+            x = np.empty_like(y)
+            x[order] = y
+            return _finite(x)
+
+        return energy, f, solve
+
+
+def _finite(x):
+    if not np.all(np.isfinite(x)):
+        raise SingularSystemError("non-finite solution of the linear system (singular stiffness)")
+    return x
