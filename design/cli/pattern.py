@@ -1,0 +1,110 @@
+"""``holofold pattern``: generate a Miura or Tachi-Miura polyhedron sheet and export it.
+
+Examples::
+
+    holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --a 0.02 --b 0.02 -o out/
+    holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --size 0.2 \\
+        --thickness 0.5e-3 --crease-width 2e-3 -o out/
+    holofold pattern tmp --m 6 --n 6 --size 0.2 --ext 0.6 -o out/
+
+Writes ``pattern.fold`` (flat crease pattern + folded frame), ``pattern.svg`` (cut/score
+layers), ``folded.stl`` and ``folded.obj`` (folded surface) and, with ``--thickness``,
+``thick.stl`` (printable panels with hinge gaps). Angles in degrees here, lengths in metres.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "pattern",
+        help="generate a Miura or TMP sheet folded to an extension, and export it",
+        description=__doc__.split("\n\n")[0],
+        epilog="Lengths in metres, angles in degrees.",
+    )
+    p.add_argument("kind", choices=["miura", "tmp"], help="pattern type")
+    p.add_argument("--m", type=int, required=True, help="panels along x (TMP: even)")
+    p.add_argument("--n", type=int, required=True, help="panels along y (TMP: multiple of 3)")
+    p.add_argument("--ext", type=float, required=True, help="extension ratio in (0, 1]")
+    p.add_argument("--gamma", type=float, help="Miura sector angle, degrees in (0, 90)")
+    p.add_argument("--a", type=float, help="Miura panel side a, m")
+    p.add_argument("--b", type=float, help="Miura panel side b, m")
+    p.add_argument(
+        "--size", type=float, help="sheet size L, m (Miura: b = L/m, a = (L - b cot g)/n)"
+    )
+    p.add_argument("--thickness", type=float, help="panel thickness for thick.stl, m")
+    p.add_argument("--crease-width", type=float, default=0.0, help="hinge gap W, m (default 0)")
+    p.add_argument("-o", "--output", required=True, help="output folder")
+    return p
+
+
+def _build(args):
+    from geometry.errors import ParameterError, check_range
+    from geometry.miura import miura_sheet
+    from geometry.tmp import tmp_sheet
+
+    check_range("--ext", args.ext, 0.0, 1.0, low_open=True)
+    if args.kind == "miura":
+        if args.gamma is None:
+            raise ParameterError("--gamma is required for a Miura sheet (degrees in (0, 90))")
+        check_range("--gamma", args.gamma, 0.0, 90.0, low_open=True, high_open=True)
+        if args.size is None and (args.a is None or args.b is None):
+            raise ParameterError("give --size, or both --a and --b, for a Miura sheet")
+        if args.size is not None and (args.a is not None or args.b is not None):
+            raise ParameterError("give either --size or --a/--b, not both")
+        for name in ("a", "b", "size"):
+            v = getattr(args, name)
+            if v is not None:
+                check_range(f"--{name}", v, 0.0, None, low_open=True)
+        return miura_sheet(
+            args.m, args.n, a=args.a, b=args.b, gamma=math.radians(args.gamma), ext=args.ext,
+            size=args.size,
+        )  # fmt: skip
+    if args.size is None:
+        raise ParameterError("--size (sheet size L, m) is required for a TMP sheet")
+    if args.m % 2:
+        raise ParameterError(f"--m = {args.m} must be even for a TMP sheet")
+    if args.n % 3:
+        raise ParameterError(f"--n = {args.n} must be a multiple of 3 for a TMP sheet")
+    check_range("--size", args.size, 0.0, None, low_open=True)
+    return tmp_sheet(args.m, args.n, args.size, args.ext)
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    import numpy as np
+
+    from geometry.errors import check_range
+    from geometry.export import export
+    from geometry.solid import shrunk_panels, thick_solid
+
+    pattern = _build(args)
+    W = check_range("--crease-width", args.crease_width, 0.0, None)
+    solid = None
+    if args.thickness is not None:
+        t = check_range("--thickness", args.thickness, 0.0, None, low_open=True)
+        shrunk_panels(pattern, W)  # a crease wider than a panel fails here, before any output
+        solid = thick_solid(pattern, t, W)
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [
+        export(pattern, out / "pattern.fold", crease_width=np.where(pattern.interior, W, 0.0)),
+        export(pattern, out / "pattern.svg"),
+        export(pattern, out / "folded.stl"),
+        export(pattern, out / "folded.obj"),
+    ]
+    if solid is not None:
+        written.append(export(solid, out / "thick.stl"))
+    ext = np.ptp(pattern.coords, axis=0)
+    print(
+        f"{args.kind} {args.m}x{args.n} at ext {args.ext:g}: {pattern.n_vertices} vertices, "
+        f"{int(pattern.interior.sum())} creases, {pattern.n_faces} panels, extent "
+        f"{ext[0]:.4g} x {ext[1]:.4g} x {ext[2]:.4g} m; wrote "
+        + ", ".join(p.name for p in written)
+        + f" to {out}"
+    )
+    return 0

@@ -1,0 +1,84 @@
+"""Triangulated surfaces of crease patterns, as ``trimesh.Trimesh``.
+
+Every panel is fanned from a centre vertex at the mean of its corners, one triangle per panel
+edge, exactly like the concentrated-hinge model of the mechanics layer. The mesh therefore
+has the pattern's vertices first (ids kept) and one centre per panel after them
+(``nv + panel id``); triangle ``3k..`` belong to panel ``face_index[k]``. A fan of a warped
+(non-planar) quad is the same surface the simulator sees. Faces are oriented consistently
+(:func:`geometry.pattern.orient_faces`), so normals point to one side of the sheet.
+
+STL, OBJ and PLY are written by trimesh (:func:`export_mesh`); nothing is written by hand.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from geometry.pattern import CreasePattern, orient_faces
+
+__all__ = ["fan_triangulation", "folded_mesh", "flat_mesh", "export_mesh", "MESH_TYPES"]
+
+MESH_TYPES = ("stl", "obj", "ply")
+
+
+def fan_triangulation(coords: np.ndarray, faces) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fan every polygon from a centre vertex.
+
+    Parameters
+    ----------
+    coords : (nv, d) float
+    faces : sequence of (k,) int vertex loops
+
+    Returns
+    -------
+    vertices : (nv + nf, d) float
+        ``coords`` then one centre per face.
+    triangles : (sum k, 3) int
+        (corner j, corner j+1, centre) for each face, in face order.
+    face_index : (sum k,) int
+        Face of each triangle.
+    """
+    coords = np.asarray(coords, float)
+    faces = [np.asarray(f, np.int64) for f in faces]
+    nv = len(coords)
+    sizes = np.array([len(f) for f in faces])
+    fv = np.concatenate(faces)
+    owner = np.repeat(np.arange(len(faces)), sizes)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    nxt = np.arange(len(fv)) + 1
+    nxt[starts + sizes - 1] = starts
+    centres = np.stack(
+        [np.bincount(owner, weights=coords[fv, d]) / sizes for d in range(coords.shape[1])], 1
+    )
+    tris = np.stack([fv, fv[nxt], nv + owner], axis=1)
+    return np.vstack([coords, centres]), tris, owner
+
+
+def folded_mesh(pattern: CreasePattern) -> trimesh.Trimesh:
+    """The folded (3-D) surface of ``pattern``; metadata holds ``face_index`` (panel ids)."""
+    faces = orient_faces(pattern.faces)
+    v, t, owner = fan_triangulation(pattern.coords, faces)
+    mesh = trimesh.Trimesh(vertices=v, faces=t, process=False)
+    mesh.metadata["face_index"] = owner
+    mesh.metadata["name"] = pattern.meta.get("kind", "pattern")
+    return mesh
+
+
+def flat_mesh(pattern: CreasePattern) -> trimesh.Trimesh:
+    """The flat crease pattern as a mesh in the z = 0 plane (raises if there is none)."""
+    if pattern.flat is None:
+        raise ValueError("this pattern has no flat layout")
+    flat = np.column_stack([pattern.flat, np.zeros(pattern.n_vertices)])
+    v, t, owner = fan_triangulation(flat, pattern.faces)
+    mesh = trimesh.Trimesh(vertices=v, faces=t, process=False)
+    mesh.metadata["face_index"] = owner
+    return mesh
+
+
+def export_mesh(mesh: trimesh.Trimesh, file_type: str) -> bytes | str:
+    """Serialise ``mesh`` as STL (binary), OBJ or PLY (binary) through trimesh."""
+    file_type = file_type.lower().lstrip(".")
+    if file_type not in MESH_TYPES:
+        raise ValueError(f"unknown mesh type {file_type!r}; known: {', '.join(MESH_TYPES)}")
+    return trimesh.exchange.export.export_mesh(mesh, None, file_type=file_type)

@@ -1,0 +1,168 @@
+"""SVG crease patterns for Origami Simulator, laser cutters and plotters.
+
+Colours follow Origami Simulator's import convention: mountain red ``#ff0000``, valley blue
+``#0000ff``, border black, flat and join (facet) yellow ``#ffff00``, cut green ``#00ff00``,
+unassigned magenta ``#ff00ff``; ``stroke-opacity`` = |fold angle| / 180 for M and V (1 when a
+crease's fold angle is 0, i.e. a flat pattern whose M/V is known but not its target angle).
+Each line also carries ``data-assignment`` and ``data-foldAngle``.
+
+Lines are grouped for fabrication: ``<g id="cut">`` holds border and cut lines (to cut
+through), ``<g id="score">`` the creases (to score, perforate or plot). Coordinates are in
+millimetres (``width``/``height`` in mm, ``viewBox`` in mm), and the y axis is flipped (SVG's y
+points down) so that the drawing is not mirrored: a mirrored crease pattern swaps M and V.
+:func:`load_svg` reads such files back (with :mod:`xml.etree`, nothing evaluated).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+
+import numpy as np
+
+from geometry.errors import FormatError
+from geometry.pattern import CreasePattern
+
+__all__ = ["COLOURS", "export_svg", "load_svg", "SvgLines"]
+
+COLOURS = {
+    "M": "#ff0000",
+    "V": "#0000ff",
+    "B": "#000000",
+    "F": "#ffff00",
+    "J": "#ffff00",
+    "C": "#00ff00",
+    "U": "#ff00ff",
+}
+_CUT = ("B", "C")
+_SVG_NS = "http://www.w3.org/2000/svg"
+
+
+def export_svg(
+    pattern: CreasePattern,
+    *,
+    margin_mm: float = 5.0,
+    stroke_mm: float = 0.2,
+    show_facets: bool = False,
+) -> str:
+    """SVG text of the flat crease pattern (metres in, millimetres out).
+
+    ``show_facets`` also draws ``J`` edges (triangulation lines); they are left out by default
+    because they are neither cut nor folded.
+    """
+    if pattern.flat is None:
+        raise ValueError(
+            "this pattern has no flat layout to draw as a crease pattern; export FOLD instead"
+        )
+    xy = pattern.flat * 1000.0  # mm
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    w, h = hi - lo + 2 * margin_mm
+    px = xy[:, 0] - lo[0] + margin_mm
+    py = hi[1] - xy[:, 1] + margin_mm  # flip: SVG y points down
+    groups: dict[str, list[str]] = {"cut": [], "score": []}
+    for i, (a, b) in enumerate(pattern.edges):
+        code = str(pattern.assignment[i])
+        if code == "J" and not show_facets:
+            continue
+        ang = float(pattern.fold_angle[i])
+        opacity = abs(ang) / 180.0 if code in ("M", "V") and ang != 0 else 1.0
+        groups["cut" if code in _CUT else "score"].append(
+            f'<line x1="{px[a]:.6f}" y1="{py[a]:.6f}" x2="{px[b]:.6f}" y2="{py[b]:.6f}" '
+            f'stroke="{COLOURS[code]}" stroke-opacity="{opacity:.6g}" '
+            f'data-assignment="{code}" data-foldAngle="{ang:.12g}" data-edge="{i}"/>'
+        )
+    body = []
+    for gid, lines in groups.items():
+        body.append(
+            f'<g id="{gid}" fill="none" stroke-width="{stroke_mm}" stroke-linecap="round">\n  '
+            + "\n  ".join(lines)
+            + "\n</g>"
+        )
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        f'<svg xmlns="{_SVG_NS}" width="{w:.6f}mm" height="{h:.6f}mm" '
+        f'viewBox="0 0 {w:.6f} {h:.6f}">\n'
+        f"<title>holofold crease pattern ({pattern.meta.get('kind', 'pattern')})</title>\n"
+        + "\n".join(body)
+        + "\n</svg>\n"
+    )
+
+
+@dataclass(frozen=True)
+class SvgLines:
+    """Lines read from an SVG crease pattern.
+
+    ``segments`` (n, 2, 2) end points in metres with y up; ``assignment`` (n,) FOLD codes;
+    ``fold_angle`` (n,) degrees; ``group`` (n,) "cut" or "score" ("" outside those groups);
+    ``edge`` (n,) the pattern edge id of each line (``data-edge``), -1 where absent.
+    """
+
+    segments: np.ndarray
+    assignment: np.ndarray
+    fold_angle: np.ndarray
+    group: np.ndarray
+    edge: np.ndarray
+
+
+def _code_of(el) -> str:
+    code = el.get("data-assignment")
+    if code:
+        return code
+    colour = (el.get("stroke") or "").lower()
+    for k, v in COLOURS.items():
+        if v == colour:
+            return k
+    return "U"
+
+
+def load_svg(text: str | bytes) -> SvgLines:
+    """Read the ``<line>`` elements of an SVG crease pattern written by :func:`export_svg`.
+
+    Coordinates are converted back from millimetres with y flipped up, relative to the
+    drawing's lower-left corner (the margin removed only if the file is one of ours, i.e. all
+    lines share the viewBox convention).
+    """
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise FormatError(f"SVG: not well-formed XML ({exc})") from None
+    if not root.tag.endswith("svg"):
+        raise FormatError("SVG: the root element is not <svg>")
+    vb = root.get("viewBox")
+    try:
+        height = float(vb.split()[3]) if vb else float(root.get("height", "0").removesuffix("mm"))
+    except (ValueError, IndexError):
+        raise FormatError(f"SVG: cannot read the drawing height from viewBox {vb!r}") from None
+    segs, codes, angles, groups, ids = [], [], [], [], []
+
+    def walk(el, group):
+        for child in el:
+            tag = child.tag.rsplit("}", 1)[-1]
+            if tag == "g":
+                walk(child, child.get("id", group))
+            elif tag == "line":
+                try:
+                    x1, y1, x2, y2 = (float(child.get(k)) for k in ("x1", "y1", "x2", "y2"))
+                except (TypeError, ValueError):
+                    raise FormatError("SVG: a <line> lacks numeric x1 y1 x2 y2") from None
+                segs.append([[x1, height - y1], [x2, height - y2]])
+                code = _code_of(child)
+                codes.append(code)
+                ang = child.get("data-foldAngle")
+                if ang is None:
+                    op = float(child.get("stroke-opacity", "1"))
+                    ang = {"M": -180.0 * op, "V": 180.0 * op}.get(code, 0.0)
+                angles.append(float(ang))
+                groups.append(group)
+                ids.append(int(child.get("data-edge", "-1")))
+
+    walk(root, "")
+    if not segs:
+        raise FormatError("SVG: no <line> elements found")
+    return SvgLines(
+        np.asarray(segs) / 1000.0,
+        np.asarray(codes),
+        np.asarray(angles),
+        np.asarray(groups),
+        np.asarray(ids),
+    )

@@ -1,0 +1,54 @@
+"""Fan-triangulated surfaces and trimesh exports."""
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+
+from geometry.export import export
+from geometry.mesh import export_mesh, fan_triangulation, flat_mesh, folded_mesh
+from geometry.miura import miura_sheet
+
+
+@pytest.fixture(scope="module")
+def miura():
+    return miura_sheet(3, 4, a=0.02, b=0.015, gamma=math.radians(65), ext=0.7)
+
+
+def test_fan_keeps_vertex_ids_and_area(miura):
+    v, t, owner = fan_triangulation(miura.coords, miura.faces)
+    assert np.array_equal(v[: miura.n_vertices], miura.coords)
+    assert len(t) == 4 * miura.n_faces and np.array_equal(np.bincount(owner), [4] * miura.n_faces)
+    # planar parallelogram panels: the fan area equals |a x b| of each panel
+    mesh = folded_mesh(miura)
+    a, b = 0.02, 0.015
+    assert mesh.area == pytest.approx(miura.n_faces * a * b * math.sin(math.radians(65)), rel=1e-12)
+
+
+def test_folded_mesh_is_consistently_oriented_and_flat_mesh_is_flat(miura):
+    mesh = folded_mesh(miura)
+    assert mesh.is_winding_consistent
+    flat = flat_mesh(miura)
+    assert np.allclose(flat.vertices[:, 2], 0)
+    assert flat.area == pytest.approx(mesh.area, rel=1e-12)  # rigid folding keeps the area
+    assert (flat.face_normals[:, 2] > 0.999).all()  # counter-clockwise panels face +z
+
+
+@pytest.mark.parametrize("kind", ["stl", "obj", "ply"])
+def test_round_trip_through_trimesh(miura, kind, tmp_path):
+    path = export(miura, tmp_path / f"s.{kind}")
+    back = trimesh.load(path, force="mesh", process=True)
+    mesh = folded_mesh(miura)
+    assert back.area == pytest.approx(mesh.area, rel=1e-6)
+    assert np.allclose(back.bounds, mesh.bounds, atol=1e-7)
+    data = export_mesh(mesh, kind)
+    assert len(data if isinstance(data, bytes) else data.encode()) > 100
+
+
+def test_unknown_export_type_is_named(miura, tmp_path):
+    with pytest.raises(ValueError, match="unknown file type 'dxf'; known: fold, svg, stl"):
+        export(miura, tmp_path / "x.dxf")
+    assert not (tmp_path / "x.dxf").exists()
+    with pytest.raises(ValueError, match="unknown mesh type"):
+        export_mesh(folded_mesh(miura), "gltf")

@@ -1,0 +1,72 @@
+"""Thick panels with hinge gaps, unioned with manifold3d."""
+
+import math
+
+import manifold3d as m3d
+import numpy as np
+import pytest
+
+from geometry.errors import ParameterError
+from geometry.miura import miura_sheet
+from geometry.solid import panel_solids, shrunk_panels, thick_solid
+from geometry.tmp import tmp_sheet
+
+W, T = 2e-3, 0.5e-3
+
+
+def _area(corners):
+    n = np.zeros(3)
+    for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        n += np.cross(a, b)
+    return 0.5 * np.linalg.norm(n)
+
+
+@pytest.mark.parametrize("ext", [1.0, 0.6])
+def test_miura_solid_is_watertight_with_the_expected_volume(ext):
+    p = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=ext)
+    solid = thick_solid(p, T, W)
+    assert solid.is_watertight and solid.is_volume
+    expected = sum(_area(c) for c in shrunk_panels(p, W)) * T
+    assert solid.volume == pytest.approx(expected, rel=1e-2)
+    assert abs(solid.volume / expected - 1) < 1e-5  # disjoint panels: the union loses nothing
+
+
+def test_flat_gap_is_the_crease_width_and_borders_stay():
+    p = miura_sheet(2, 2, a=0.02, b=0.02, gamma=math.radians(60), ext=1.0)
+    sh = shrunk_panels(p, W)
+    # Parallelogram panel: each interior side pulled in by W/2 along its normal; area shrinks by
+    # exactly (side_a - W/(2 sin g)) * (height_b - W/2) for one interior side of each kind.
+    g = math.radians(60)
+    h_full = 0.02 * math.sin(g)
+    area = _area(sh[0])
+    assert area == pytest.approx((0.02 - W / 2 / math.sin(g)) * (h_full - W / 2), rel=1e-12)
+    # border vertices of the corner panel stay where they were
+    assert np.allclose(sh[0][0], p.coords[p.faces[0][0]])
+
+
+def test_no_two_panels_intersect_in_a_folded_miura():
+    p = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
+    parts = [
+        m3d.Manifold(m3d.Mesh(vert_properties=np.asarray(s.vertices, np.float32),
+                              tri_verts=np.asarray(s.faces, np.uint32)))
+        for s in panel_solids(p, T, W)
+    ]  # fmt: skip
+    worst = max((parts[i] ^ parts[j]).volume() for i in range(len(parts)) for j in range(i))
+    assert worst == 0.0
+    assert len(thick_solid(p, T, W).split()) == p.n_faces  # every panel its own body
+
+
+def test_tmp_solid_and_per_panel_option():
+    p = tmp_sheet(4, 3, 0.1, 0.8)
+    solids = thick_solid(p, 0.3e-3, 1e-3, union=False)
+    assert len(solids) == p.n_faces and all(s.is_watertight for s in solids)
+
+
+def test_crease_wider_than_panel_and_bad_thickness_raise():
+    p = miura_sheet(2, 2, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
+    with pytest.raises(ParameterError, match="wider than panel"):
+        thick_solid(p, T, 0.05)
+    with pytest.raises(ParameterError, match="thickness"):
+        thick_solid(p, -1e-3, W)
+    with pytest.raises(ParameterError, match="crease width"):
+        shrunk_panels(p, -1.0)
