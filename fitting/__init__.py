@@ -1,1 +1,42 @@
-"""fitting layer of holofold."""
+"""Fitting layer of holofold: planar target curves and Miura-like strips fitted to them.
+
+Modules: :mod:`fitting.curves` (curve types, parsing, lengths, distances),
+:mod:`fitting.strip` (the analytic strip of specs/scenarios.md 5.3-5.4),
+:mod:`fitting.error` (published index-matched error and closest-point error) and
+:mod:`fitting.auto` (choosing m and offset for a tolerance).
+"""
+
+from fitting.auto import AutoFit, FitNotFoundError, fit_auto
+from fitting.curves import (
+    BUILTIN_CURVES,
+    CurveError,
+    PlanarCurve,
+    builtin_curve,
+    load_curve,
+    parse_curve_spec,
+    read_points_csv,
+    read_svg_curve,
+)
+from fitting.error import ClosestPointError, closest_point_error, index_matched_error, paper_error
+from fitting.strip import SAMPLINGS, StripFit, fit_strip
+
+__all__ = [
+    "BUILTIN_CURVES",
+    "CurveError",
+    "PlanarCurve",
+    "builtin_curve",
+    "load_curve",
+    "parse_curve_spec",
+    "read_points_csv",
+    "read_svg_curve",
+    "ClosestPointError",
+    "closest_point_error",
+    "index_matched_error",
+    "paper_error",
+    "SAMPLINGS",
+    "StripFit",
+    "fit_strip",
+    "AutoFit",
+    "FitNotFoundError",
+    "fit_auto",
+]

@@ -1,0 +1,229 @@
+"""``holofold fit``: fit a Miura-like strip to a planar curve and export it.
+
+Examples::
+
+    holofold fit --curve half-circle:radius=2 --m 12 --offset 0.2 --strip-width 0.02 \\
+        --extrude 0.1 -o out/
+    holofold fit --curve points.csv --m 8 --offset 0.1 --strip-width 0.01 --extrude 0.1 -o out/
+    holofold fit --curve drawing.svg#arch --curve-scale 0.01 --auto --tolerance 0.05 -o out/
+
+Writes ``strip.fold`` (FOLD 1.2: the flat sector-angle development as crease pattern plus the
+3-D strip as a folded-form frame, published node numbering; side-B panel loops are reversed so
+that every panel is counter-clockwise in the layout), ``strip.svg`` (that development as an
+Origami-Simulator-coloured crease pattern in mm; the x-z plan view of centre and side lines if
+no development exists), ``strip.stl`` and ``strip.obj`` (the 3-D strip surface, each quad
+fanned from its centre), ``candidates.csv`` with ``--auto``, and ``strip_solid.stl`` (panel
+prisms with hinge gaps, geometry.solid) when ``--panel-thickness`` and ``--crease-width`` are
+given. The last line printed is a JSON object
+with the fit parameters, the errors and the files written. All inputs are validated before any
+file is created.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+from pathlib import Path
+
+import numpy as np
+
+from fitting.auto import DEFAULT_M_RANGE, fit_auto
+from fitting.curves import load_curve
+from fitting.strip import SAMPLINGS, StripFit, fit_strip
+from geometry.errors import ParameterError, check_range
+from geometry.export import export
+from geometry.solid import thick_solid
+
+log = logging.getLogger(__name__)
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "fit",
+        help="fit a Miura-like strip to a planar curve and export it",
+        description=__doc__.split("\n\n")[0]
+        + " Curves: a built-in spec (half-circle:radius=2, arc:radius=..,angle=.., "
+        "parabola:span=..,height=.., sine:span=..,amplitude=..,periods=.., "
+        "catenary:span=..,height=..), a CSV of x,z points, or an SVG file[#path-id].",
+    )
+    p.add_argument("--curve", required=True, help="built-in spec, points.csv or drawing.svg[#id]")
+    p.add_argument(
+        "--curve-scale",
+        type=float,
+        default=1.0,
+        help="scale factor applied to the curve (e.g. SVG units to metres; default 1)",
+    )
+    p.add_argument("--m", type=float, help="number of Miura units (integer >= 2)")
+    p.add_argument("--offset", type=float, help="offset l_o of the middle vertices, m")
+    p.add_argument("--strip-width", type=float, help="side-line shift parameter W_s, m")
+    p.add_argument("--extrude", type=float, help="half-width l_e of the strip in y, m")
+    p.add_argument(
+        "--sampling",
+        choices=SAMPLINGS,
+        default=None,
+        help="sample spacing (default: paper for the half circle, else arclength)",
+    )
+    p.add_argument("--auto", action="store_true", help="choose m and offset for --tolerance")
+    p.add_argument("--tolerance", type=float, help="closest-point error tolerance for --auto, m")
+    p.add_argument(
+        "--m-range",
+        default=None,
+        help="m values for --auto as start:stop[:step], stop included (default 2:60:2)",
+    )
+    p.add_argument(
+        "--metric",
+        choices=("max", "mean"),
+        default="max",
+        help="closest-point error that --auto compares with --tolerance (default max)",
+    )
+    p.add_argument("--panel-thickness", type=float, help="write a thick solid of this thickness, m")
+    p.add_argument("--crease-width", type=float, help="crease width of the thick solid, m")
+    p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
+    return p
+
+
+# ---------------------------------------------------------------------- validation
+def _m_range(text: str | None) -> list[int]:
+    if text is None:
+        return list(DEFAULT_M_RANGE)
+    parts = text.split(":")
+    try:
+        nums = [int(p) for p in parts]
+    except ValueError:
+        raise ParameterError(
+            f"--m-range must be start:stop[:step] integers, got {text!r}"
+        ) from None
+    if len(nums) == 1:
+        return nums
+    if len(nums) not in (2, 3) or (len(nums) == 3 and nums[2] <= 0):
+        raise ParameterError(f"--m-range must be start:stop[:step] with step > 0, got {text!r}")
+    step = nums[2] if len(nums) == 3 else 1
+    values = list(range(nums[0], nums[1] + 1, step))
+    if not values:
+        raise ParameterError(f"--m-range {text!r} is empty")
+    return values
+
+
+def _validate(args) -> dict:
+    opts: dict = {}
+    for name in ("strip_width", "extrude", "offset", "tolerance"):
+        v = getattr(args, name)
+        if v is not None:
+            opts[name] = check_range(f"--{name.replace('_', '-')}", v, 0.0, None, low_open=True)
+    if args.auto:
+        if args.tolerance is None:
+            raise ParameterError("--auto needs --tolerance (metres)")
+        if args.m is not None or args.offset is not None:
+            raise ParameterError("--auto chooses --m and --offset itself; do not give them")
+        opts["m_range"] = _m_range(args.m_range)
+    else:
+        missing = [
+            f"--{n.replace('_', '-')}"
+            for n in ("m", "offset", "strip_width", "extrude")
+            if getattr(args, n) is None
+        ]
+        if missing:
+            raise ParameterError(f"missing {', '.join(missing)} (or use --auto --tolerance)")
+        m = args.m
+        if not (math.isfinite(m) and m == round(m) and m >= 2):
+            raise ParameterError(f"--m must be an integer >= 2, got {m!r}")
+        opts["m"] = int(m)
+    thick = (args.panel_thickness, args.crease_width)
+    if any(v is not None for v in thick):
+        if any(v is None for v in thick):
+            raise ParameterError("a thick solid needs both --panel-thickness and --crease-width")
+        check_range("--panel-thickness", args.panel_thickness, 0.0, None, low_open=True)
+        check_range("--crease-width", args.crease_width, 0.0, None, low_open=True)
+        opts["solid"] = True
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"--output {str(out)!r} exists and is not a folder")
+    return opts
+
+
+# ---------------------------------------------------------------------- writers
+def _plan_view_svg(fit: StripFit) -> str:
+    """SVG (mm) of the centre line (black) and side line (grey) in the x-z plane."""
+    P = fit.centre_line * np.array([1000.0, -1000.0])
+    S = fit.side_line * np.array([1000.0, -1000.0])
+    pts = np.vstack([P, S])
+    lo, hi = pts.min(axis=0) - 5.0, pts.max(axis=0) + 5.0
+    w, h = hi - lo
+    lines = [
+        f'<polyline fill="none" stroke="{c}" stroke-width="0.5" points="'
+        + " ".join(f"{x - lo[0]:.6f},{y - lo[1]:.6f}" for x, y in L)
+        + '"/>'
+        for L, c in ((P, "#000000"), (S, "#7f7f7f"))
+    ]
+    return (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.6f}mm" height="{h:.6f}mm" '
+        f'viewBox="0 0 {w:.6f} {h:.6f}">\n<title>plan view (x-z) of the strip: centre line '
+        "and side line (no flat layout)</title>\n" + "\n".join(lines) + "\n</svg>\n"
+    )
+
+
+def run(args) -> int:
+    opts = _validate(args)
+    curve = load_curve(args.curve)
+    if args.curve_scale != 1.0:
+        curve = curve.scaled(args.curve_scale)
+    table = None
+    if args.auto:
+        res = fit_auto(
+            curve,
+            opts["tolerance"],
+            m_range=opts["m_range"],
+            strip_width=opts.get("strip_width"),
+            extrude=opts.get("extrude"),
+            sampling=args.sampling,
+            metric=args.metric,
+        )
+        fit, table = res.strip, res.candidates
+    else:
+        fit = fit_strip(
+            curve,
+            opts["m"],
+            opts["offset"],
+            opts["strip_width"],
+            opts["extrude"],
+            sampling=args.sampling,
+        )
+    flat = fit.flat_pattern  # layout + 3-D state, side B loops counter-clockwise
+    solid = None
+    if opts.get("solid"):  # built before any file is written: it can reject the widths
+        solid = thick_solid(fit.pattern, args.panel_thickness, args.crease_width)
+    # everything is valid: create the output
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    fold_kw = {}
+    if solid is not None:
+        fold_kw = {"panel_thickness": args.panel_thickness, "crease_width": args.crease_width}
+    written = [export(flat if flat is not None else fit.pattern, out / "strip.fold", **fold_kw)]
+    if flat is not None:
+        written.append(export(flat, out / "strip.svg"))
+    else:
+        (out / "strip.svg").write_text(_plan_view_svg(fit))
+        written.append(out / "strip.svg")
+    written.append(export(fit.pattern, out / "strip.stl"))
+    written.append(export(fit.pattern, out / "strip.obj"))
+    if solid is not None:
+        written.append(export(solid, out / "strip_solid.stl"))
+    if table is not None:
+        p_csv = out / "candidates.csv"
+        table.to_csv(p_csv, index=False)
+        written.append(p_csv)
+    summary = {
+        "curve": fit.meta["curve"],
+        "m": fit.m,
+        "offset": fit.meta["offset"],
+        "strip_width": fit.meta["strip_width"],
+        "extrude": fit.meta["extrude"],
+        "sampling": fit.meta["sampling"],
+        **fit.errors,
+        "files": [str(w) for w in written],
+    }
+    print(f"fitted m={fit.m} strip ({fit.pattern.n_vertices} nodes) to {fit.meta['curve']}")
+    print(json.dumps(summary))
+    return 0

@@ -1,0 +1,181 @@
+"""Choosing a strip automatically: the smallest m and an offset meeting an error tolerance.
+
+:func:`fit_auto` walks m upwards over ``m_range``; for each m it evaluates every offset
+(centre line, side line and closest-point error, without building the crease pattern), and
+stops at the first m where some offset meets the tolerance and gives a valid, non-overlapping
+strip. Among the offsets that meet the tolerance it prefers the **largest** (deepest
+corrugation: the most turning at the centre-line vertices, so the smallest side-line shifts
+W_s cot(phi); the paper's stiffest arches also have large offsets), unless
+``prefer="smallest-error"``.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable
+from typing import NamedTuple
+
+import numpy as np
+import pandas as pd
+
+from fitting.curves import load_curve
+from fitting.error import closest_point_error, index_matched_error
+from fitting.strip import (
+    StripFit,
+    _check_m,
+    _check_sampling,
+    fit_strip,
+    side_line,
+    strip_samples,
+    zigzag_centre_line,
+)
+from geometry.errors import DegenerateGeometryError, ParameterError, check_range
+
+__all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"]
+
+log = logging.getLogger(__name__)
+
+_SLACK = 1e-9  # relative slack on the tolerance (an error equal to it up to rounding meets it)
+
+#: default m values tried: even m (the curve's mid-parameter is then a vertex), 2..60
+DEFAULT_M_RANGE = tuple(range(2, 61, 2))
+
+
+class FitNotFoundError(ParameterError):
+    """No (m, offset) in the given ranges meets the tolerance; ``candidates`` holds the table."""
+
+    def __init__(self, message: str, candidates: pd.DataFrame):
+        super().__init__(message)
+        self.candidates = candidates
+
+
+class AutoFit(NamedTuple):
+    """Result of :func:`fit_auto`: the chosen strip and the table of candidates tried."""
+
+    strip: StripFit
+    candidates: pd.DataFrame
+
+
+def fit_auto(
+    curve,
+    tolerance: float,
+    *,
+    m_range: Iterable[int] = DEFAULT_M_RANGE,
+    offsets: Iterable[float] | None = None,
+    strip_width: float | None = None,
+    extrude: float | None = None,
+    sampling: str | None = None,
+    metric: str = "max",
+    prefer: str = "largest-offset",
+) -> AutoFit:
+    """Smallest m (and an offset) whose strip's closest-point error meets ``tolerance``.
+
+    Parameters
+    ----------
+    curve : PlanarCurve or anything :func:`fitting.curves.load_curve` accepts
+    tolerance : float
+        Allowed closest-point error, metres (> 0); met if error <= tolerance (1 + 1e-9).
+    m_range : iterable of int
+        m values to try (each >= 2), tried in increasing order.
+    offsets : iterable of float, optional
+        Offsets l_o to try, metres (> 0). Default: ``tolerance * [0.1, 0.2, ..., 2.0]``.
+    strip_width : float, optional
+        W_s, metres. Default: offset / 8 for each candidate (the paper's median ratio).
+    extrude : float, optional
+        l_e, metres. Default: curve length / 40 (the paper's median for its half circle).
+    sampling : {"paper", "arclength"}, optional
+        Default: the curve's default.
+    metric : {"max", "mean"}
+        Which closest-point error (centre line -> curve) must be <= tolerance.
+    prefer : {"largest-offset", "smallest-error"}
+        Which qualifying offset to take at the smallest m.
+
+    Returns
+    -------
+    AutoFit
+        ``strip`` (:class:`StripFit`) and ``candidates`` (DataFrame with columns m, offset,
+        strip_width, extrude, closest_mean, closest_max, index_error, valid, meets, chosen,
+        reason), one row per candidate tried.
+
+    Raises
+    ------
+    FitNotFoundError
+        When no candidate qualifies (the message names the best error reached).
+    """
+    curve = load_curve(curve)
+    tol = check_range("tolerance", tolerance, 0.0, None, low_open=True)
+    if metric not in ("max", "mean"):
+        raise ParameterError(f"metric must be 'max' or 'mean', got {metric!r}")
+    if prefer not in ("largest-offset", "smallest-error"):
+        raise ParameterError(f"prefer must be 'largest-offset' or 'smallest-error', got {prefer!r}")
+    ms = sorted({_check_m(m) for m in m_range})
+    if not ms:
+        raise ParameterError("m_range is empty")
+    if offsets is None:
+        offs = tol * np.linspace(0.1, 2.0, 20)
+    else:
+        offs = np.array([check_range("offset", o, 0.0, None, low_open=True) for o in offsets])
+        if offs.size == 0:
+            raise ParameterError("offsets is empty")
+    offs = np.unique(offs)
+    if strip_width is not None:
+        strip_width = check_range("strip_width", strip_width, 0.0, None, low_open=True)
+    le = (
+        curve.length / 40.0
+        if extrude is None
+        else check_range("extrude", extrude, 0.0, None, low_open=True)
+    )
+    sampling = _check_sampling(sampling, curve)
+    col = "closest_max" if metric == "max" else "closest_mean"
+
+    rows: list[dict] = []
+    for m in ms:
+        t, samples = strip_samples(curve, m, sampling)
+        start = len(rows)
+        for off in offs:
+            ws = off / 8.0 if strip_width is None else strip_width
+            row = {"m": m, "offset": float(off), "strip_width": ws, "extrude": le}
+            P = zigzag_centre_line(samples, off)
+            err = closest_point_error(curve, P, both=False)
+            row.update(
+                closest_mean=err.mean,
+                closest_max=err.max,
+                index_error=index_matched_error(curve, P, t),
+                valid=True,
+                meets=(err.max if metric == "max" else err.mean) <= tol * (1 + _SLACK),
+                chosen=False,
+                reason="",
+            )
+            try:
+                side_line(P, ws)
+            except DegenerateGeometryError as exc:
+                row.update(valid=False, meets=False, reason=str(exc))
+            rows.append(row)
+        # candidates of this m that meet the tolerance, best first
+        ok = [r for r in rows[start:] if r["meets"]]
+        if prefer == "largest-offset":
+            ok.sort(key=lambda r: -r["offset"])
+        else:
+            ok.sort(key=lambda r: r[col])
+        for r in ok:
+            try:
+                fit = fit_strip(curve, m, r["offset"], r["strip_width"], le, sampling=sampling)
+            except DegenerateGeometryError as exc:
+                r.update(valid=False, meets=False, reason=str(exc))
+                continue
+            r["chosen"] = True
+            log.info("fit_auto: m=%d offset=%.4g %s=%.4g", m, r["offset"], col, r[col])
+            return AutoFit(fit, pd.DataFrame(rows))
+    table = pd.DataFrame(rows)
+    good = table[table["valid"]]
+    if len(good):
+        best = good.loc[good[col].idxmin()]
+        msg = (
+            f"no strip with m in {ms[0]}..{ms[-1]} and offset in {offs.min():.4g}.."
+            f"{offs.max():.4g} m meets {col} <= {tol:.4g} m; the best valid candidate reaches "
+            f"{best[col]:.4g} m (m={int(best['m'])}, offset={best['offset']:.4g}): "
+            "allow larger m, smaller offsets or a larger tolerance"
+        )
+    else:
+        msg = f"no valid strip in the ranges tried ({table['reason'].iloc[0]})"
+    raise FitNotFoundError(msg, table)

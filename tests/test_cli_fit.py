@@ -1,0 +1,175 @@
+"""``holofold fit``: files written, JSON summary, exit codes, nothing written on bad input."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import trimesh
+
+from design.cli import main
+from fitting.error import paper_error
+
+BASE = ["fit", "--curve", "half-circle:radius=2"]
+DESIGN = ["--m", "12", "--offset", "0.2", "--strip-width", "0.02", "--extrude", "0.1"]
+
+
+def _summary(capsys) -> dict:
+    out = capsys.readouterr().out.strip().splitlines()
+    return json.loads(out[-1])
+
+
+def test_fit_half_circle_writes_files(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main([*BASE, *DESIGN, "-o", str(out)]) == 0
+    s = _summary(capsys)
+    for name in ("strip.fold", "strip.svg", "strip.stl", "strip.obj"):
+        assert (out / name).is_file() and (out / name).stat().st_size > 0
+    assert s["m"] == 12 and s["sampling"] == "paper"
+    np.testing.assert_allclose(s["index_error"], paper_error("half-circle", 12, 0.2), rtol=1e-14)
+    np.testing.assert_allclose(s["index_error"], 0.097180, atol=6e-7)
+    np.testing.assert_allclose(s["closest_max"], 0.2, rtol=1e-9)
+    fold = json.loads((out / "strip.fold").read_text())
+    # crease pattern (flat development) with the 3-D strip as folded-form frame
+    assert fold["frame_classes"] == ["creasePattern"]
+    assert len(fold["vertices_coords"]) == 6 * 12 + 3
+    assert len(fold["faces_vertices"]) == 4 * 12
+    assert len(fold["edges_vertices"]) == 10 * 12 + 2
+    X3 = np.array(fold["file_frames"][0]["vertices_coords"])
+    np.testing.assert_allclose(X3[12], [2.0, 0.0, 2.0], atol=1e-15)  # apex = node m
+    mesh = trimesh.load(out / "strip.stl")
+    # surface area of the fanned strip: a positive number, bounded by the bounding box
+    assert mesh.area > 0
+    np.testing.assert_allclose(mesh.bounds[:, 1], [-0.1, 0.1], atol=1e-6)
+    assert "<svg" in (out / "strip.svg").read_text()
+
+
+def test_fit_points_csv_and_svg(tmp_path, capsys):
+    t = np.linspace(0, 1, 15)
+    pts = np.column_stack([4 * t, 4 * t * (1 - t)])
+    csv = tmp_path / "points.csv"
+    csv.write_text("x,z\n" + "\n".join(f"{x:.12g},{z:.12g}" for x, z in pts))
+    args = ["--m", "6", "--offset", "0.15", "--strip-width", "0.01", "--extrude", "0.1"]
+    assert main(["fit", "--curve", str(csv), *args, "-o", str(tmp_path / "a")]) == 0
+    s = _summary(capsys)
+    assert s["sampling"] == "arclength" and s["m"] == 6
+    svg = tmp_path / "drawing.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg"><path id="other" d="M 0 0 L 5 5"/>'
+        '<path id="arch" d="M 0 200 Q 200 -200 400 200"/></svg>'
+    )
+    out = tmp_path / "b"
+    ref = ["--curve", f"{svg}#arch", "--curve-scale", "0.01"]
+    assert main(["fit", *ref, *args, "-o", str(out)]) == 0
+    s2 = _summary(capsys)
+    assert s2["curve"] == "arch"
+    # the quadratic Bezier is a parabola: span 4 m, height 2 m after scaling
+    fold = json.loads((out / "strip.fold").read_text())
+    X = np.array(fold["file_frames"][0]["vertices_coords"])
+    np.testing.assert_allclose(X[[0, 12], 0], [0.0, 4.0], atol=1e-9)
+
+
+def test_fit_auto(tmp_path, capsys):
+    out = tmp_path / "auto"
+    args = [*BASE, "--auto", "--tolerance", "0.05", "--m-range", "2:24:2", "-o", str(out)]
+    assert main(args) == 0
+    s = _summary(capsys)
+    assert s["closest_max"] <= 0.05 * (1 + 1e-9)
+    assert (out / "candidates.csv").is_file()
+    assert s["m"] in range(2, 25, 2)
+
+
+def test_thick_solid(tmp_path, capsys):
+    out = tmp_path / "solid"
+    thick = ["--panel-thickness", "0.004", "--crease-width", "0.002"]
+    assert main([*BASE, *DESIGN, *thick, "-o", str(out)]) == 0
+    s = _summary(capsys)
+    assert str(out / "strip_solid.stl") in s["files"]
+    mesh = trimesh.load(out / "strip_solid.stl")
+    assert mesh.is_watertight
+    # volume: panel area (shrunk by the hinge gaps) x thickness, below the unshrunk bound
+    area = trimesh.load(out / "strip.stl").area
+    assert 0.9 * area * 0.004 < mesh.volume < area * 0.004
+    fold = json.loads((out / "strip.fold").read_text())
+    assert fold["faces_holofold:thickness"][0] == 0.004
+    # a crease wider than the panels: rejected before anything is written
+    bad = tmp_path / "bad"
+    argv = [*BASE, *DESIGN, "--panel-thickness", "0.004", "--crease-width", "5", "-o", str(bad)]
+    assert main(argv) == 2
+    assert "wider than panel" in capsys.readouterr().err
+    assert not bad.exists()
+
+
+def test_plan_view_svg_without_layout():
+    from design.cli.fit import _plan_view_svg
+    from fitting.strip import fit_strip
+
+    fit = fit_strip("half-circle", 8, 0.2, 0.02, 0.1)
+    svg = _plan_view_svg(fit)
+    assert svg.count("<polyline") == 2 and "plan view" in svg
+    # first point P_0 = (0, 0), in mm from the lower-left corner minus a 5 mm margin, y down
+    first = svg.split('points="')[1].split()[0]
+    pts = np.vstack([fit.centre_line, fit.side_line]) * 1000.0
+    expect = [5.0 - pts[:, 0].min(), 5.0 + pts[:, 1].max()]
+    np.testing.assert_allclose([float(v) for v in first.split(",")], expect, atol=1e-5)
+    np.testing.assert_allclose(expect[0], 5.0 + 157.7276, atol=1e-3)
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (
+            [*BASE, "--m", "12", "--offset", "0.2", "--strip-width", "-0.02", "--extrude", "0.1"],
+            "--strip-width",
+        ),
+        (
+            [*BASE, "--m", "1", "--offset", "0.2", "--strip-width", "0.02", "--extrude", "0.1"],
+            "--m must be an integer >= 2",
+        ),
+        (
+            [*BASE, "--m", "12", "--offset", "0.2", "--strip-width", "0.02", "--extrude", "-1"],
+            "--extrude",
+        ),
+        (["fit", "--curve", "spiral:turns=2", *DESIGN], "unknown curve"),
+        (["fit", "--curve", "missing.csv", *DESIGN], "does not exist"),
+        ([*BASE, "--m", "12"], "missing --offset"),
+        ([*BASE, "--auto"], "--auto needs --tolerance"),
+        ([*BASE, *DESIGN, "--panel-thickness", "0.001"], "both --panel-thickness"),
+    ],
+)
+def test_bad_input_writes_nothing(tmp_path, capsys, argv, match):
+    out = tmp_path / "out"
+    assert main([*argv, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "holofold fit: error:" in err and match in err
+    assert not out.exists()
+
+
+def test_unreadable_file(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,z\n0,0\n1,what\n")
+    out = tmp_path / "out"
+    assert main(["fit", "--curve", str(bad), *DESIGN, "-o", str(out)]) == 2
+    assert "line 3" in capsys.readouterr().err
+    assert not out.exists()
+
+
+@pytest.mark.slow
+def test_example_fit_curves(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "fit_curves.py"
+    spec = importlib.util.spec_from_file_location("fit_curves_example", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    res = mod.main(tmp_path)
+    assert res is mod.RESULT
+    assert res["backend"] in ("pyvista", "matplotlib")
+    assert Path(res["png"]).stat().st_size > 10_000
+    half, cat, roof = res["strips"]
+    np.testing.assert_allclose(half["index_error"], 0.097180, atol=6e-7)
+    np.testing.assert_allclose(half["closest_max"], 0.2, rtol=1e-9)
+    assert cat["closest_max"] <= 0.02 * (1 + 1e-9) and cat["m"] >= 2
+    assert roof["m"] == 10 and roof["closest_max"] > 0

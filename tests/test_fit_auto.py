@@ -1,0 +1,80 @@
+"""Automatic choice of m and offset (fitting.auto)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fitting.auto import FitNotFoundError, fit_auto
+from fitting.curves import parse_curve_spec
+from fitting.strip import fit_strip
+from geometry.errors import ParameterError
+
+HALF = parse_curve_spec("half-circle:radius=2")
+
+
+def test_half_circle_smallest_m_and_largest_offset():
+    res = fit_auto(HALF, 0.1, m_range=[2, 4, 6, 8], offsets=[0.05, 0.1, 0.15, 0.2])
+    fit, table = res
+    # the circle's odd vertices lie at R + l_o, so the max closest-point error is >= offset,
+    # and equal to it once the chords are short enough (m >= 4 here)
+    assert (table["closest_max"] >= table["offset"] * (1 - 1e-9)).all()
+    fine = table["m"] >= 4
+    np.testing.assert_allclose(table["closest_max"][fine], table["offset"][fine], rtol=1e-9)
+    # m = 2: the long chords cut inside the circle by more than 0.1 for small offsets
+    np.testing.assert_allclose(table["closest_max"][:2], [0.129119485, 0.110257353], rtol=1e-8)
+    assert fit.meta["m"] == 4
+    assert fit.meta["offset"] == 0.1
+    chosen = table[table["chosen"]]
+    assert len(chosen) == 1 and int(chosen["m"].iloc[0]) == fit.meta["m"]
+    # every smaller m tried has no valid candidate meeting the tolerance
+    smaller = table[table["m"] < fit.meta["m"]]
+    assert not (smaller["meets"] & smaller["valid"]).any()
+    assert fit.closest.max <= 0.1 * (1 + 1e-9)
+    # strip_width default: offset / 8; extrude default: length / 40
+    np.testing.assert_allclose(fit.meta["strip_width"], 0.1 / 8)
+    np.testing.assert_allclose(fit.meta["extrude"], np.pi * 2 / 40, rtol=1e-6)
+    # the candidates' numbers are those of the full fit
+    row = chosen.iloc[0]
+    ref = fit_strip(HALF, int(row["m"]), row["offset"], row["strip_width"], row["extrude"])
+    np.testing.assert_allclose(row["index_error"], ref.index_error, rtol=1e-14)
+
+
+def test_mean_metric_and_smallest_error_preference():
+    res = fit_auto(
+        "parabola:span=4,height=1",
+        0.02,
+        m_range=range(2, 21, 2),
+        metric="mean",
+        prefer="smallest-error",
+        strip_width=0.002,
+        extrude=0.05,
+    )
+    t = res.candidates
+    row = t[t["chosen"]].iloc[0]
+    same_m = t[(t["m"] == row["m"]) & t["meets"]]
+    assert row["closest_mean"] == same_m["closest_mean"].min()
+    assert row["closest_mean"] <= 0.02
+    assert res.strip.meta["strip_width"] == 0.002 and res.strip.meta["extrude"] == 0.05
+
+
+def test_no_fit_found_reports_best():
+    with pytest.raises(FitNotFoundError, match="best valid candidate reaches") as info:
+        fit_auto(HALF, 0.01, m_range=[8], offsets=[0.1, 0.2])
+    assert len(info.value.candidates) == 2
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"tolerance": 0.0}, "tolerance"),
+        ({"tolerance": 0.1, "m_range": [1]}, "m must be an integer >= 2"),
+        ({"tolerance": 0.1, "m_range": []}, "m_range is empty"),
+        ({"tolerance": 0.1, "offsets": [-0.1]}, "offset"),
+        ({"tolerance": 0.1, "metric": "rms"}, "metric"),
+        ({"tolerance": 0.1, "strip_width": 0.0}, "strip_width"),
+    ],
+)
+def test_bad_input(kwargs, match):
+    with pytest.raises(ParameterError, match=match):
+        fit_auto(HALF, **kwargs)
