@@ -1,0 +1,31 @@
+"""The paper's design scenarios (single Miura, canopy, arch, gripper), by command-line name.
+
+Each module defines ``SCENARIO`` (:class:`design.scenarios.base.Scenario`): feature and
+performance columns with units and the paper's sampling ranges, a validity check and an
+``evaluate(row) -> dict`` that reproduces the published rows.
+"""
+
+from __future__ import annotations
+
+from design.scenarios.base import STATUS_OK, Column, Scenario
+
+__all__ = ["Column", "Scenario", "STATUS_OK", "SCENARIO_NAMES", "get_scenario"]
+
+#: command-line name -> module
+_MODULES = {
+    "single-miura": "design.scenarios.single_miura",
+    "canopy": "design.scenarios.canopy",
+    "arch": "design.scenarios.arch",
+    "gripper": "design.scenarios.gripper",
+}
+SCENARIO_NAMES = tuple(_MODULES)
+
+
+def get_scenario(name: str) -> Scenario:
+    """The :class:`Scenario` called ``name`` (one of :data:`SCENARIO_NAMES`)."""
+    import importlib
+
+    key = str(name).strip().lower().replace("_", "-")
+    if key not in _MODULES:
+        raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIO_NAMES)}")
+    return importlib.import_module(_MODULES[key]).SCENARIO

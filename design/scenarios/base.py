@@ -1,0 +1,180 @@
+"""A small, declarative description of a design scenario and its evaluator.
+
+A :class:`Scenario` names the feature columns (with units and the paper's sampling ranges), the
+categorical features, the performance columns, a physical-validity check and the function that
+simulates one design. The runner (:mod:`design.runner`) and the ``holofold evaluate`` command
+work from this description only.
+
+``evaluate(row)`` takes a mapping of feature name -> value (SI units) and returns a dict with one
+entry per performance column plus ``status``: ``"converged"`` or a sentence naming what did not
+converge (the outputs are still those the paper defines for that case).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+__all__ = ["Column", "Scenario", "STATUS_OK", "single_thread"]
+
+STATUS_OK = "converged"
+
+_CONTROLLER = None
+
+
+def single_thread():
+    """Context manager limiting BLAS/OpenMP to one thread (cheap after the first call).
+
+    The models' small dense solves get much slower (10x and more on a busy machine) when
+    several BLAS threads contend for the cores, so every evaluation runs single-threaded;
+    parallelism comes from running rows on several processes (:mod:`design.runner`).
+    """
+    global _CONTROLLER
+    if _CONTROLLER is None:
+        from threadpoolctl import ThreadpoolController
+
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER.limit(limits=1)
+
+
+@dataclass(frozen=True)
+class Column:
+    """One feature or performance column.
+
+    Attributes
+    ----------
+    name : str
+        Column name as in the published ``*_FeatureName.txt``.
+    unit : str
+        SI unit ("m", "rad", "Pa", "N/m", "-").
+    description : str
+        One line.
+    low, high : float or None
+        The paper's sampling range (features only); values outside merely warn.
+    choices : tuple of float, optional
+        Allowed values of a categorical feature (values outside warn, or fail if ``strict``).
+    required : bool
+        False for optional features (with ``default``).
+    default : float or None
+        Value used when an optional feature is missing.
+    """
+
+    name: str
+    unit: str
+    description: str = ""
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[float, ...] = ()
+    required: bool = True
+    default: float | None = None
+
+    def out_of_range(self, value: float) -> str | None:
+        """A warning text if ``value`` is outside the paper's sampling range, else None."""
+        if self.choices:
+            if not any(math.isclose(value, c, rel_tol=0, abs_tol=1e-12) for c in self.choices):
+                allowed = ", ".join(f"{c:g}" for c in self.choices)
+                return f"{self.name} = {value:g} is not one of the paper's values ({allowed})"
+            return None
+        if self.low is not None and self.high is not None and not (self.low <= value <= self.high):
+            return (
+                f"{self.name} = {value:g} {self.unit} is outside the paper's sampling range "
+                f"[{self.low:g}, {self.high:g}]"
+            )
+        return None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A design scenario of the paper.
+
+    Attributes
+    ----------
+    name : str
+        Command-line name (``single-miura``, ``canopy``, ``arch``).
+    description : str
+        One paragraph.
+    features : tuple of Column
+        Feature columns in the published order (optional ones last).
+    performance : tuple of Column
+        Performance (output) columns in the published order.
+    categorical : tuple of str
+        Names of the categorical features.
+    check : callable(row) -> list of str
+        Physical validity problems of one row (empty list if valid); run before any
+        simulation.
+    evaluate : callable(row) -> dict
+        Simulates one row; returns every performance column and ``status``.
+    reference_files : tuple of str
+        Stems of the published files this scenario reproduces.
+    """
+
+    name: str
+    description: str
+    features: tuple[Column, ...]
+    performance: tuple[Column, ...]
+    check: Callable[[Mapping[str, float]], list[str]]
+    evaluate: Callable[[Mapping[str, float]], dict]
+    categorical: tuple[str, ...] = ()
+    reference_files: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def feature_names(self) -> list[str]:
+        return [c.name for c in self.features]
+
+    @property
+    def required_features(self) -> list[str]:
+        return [c.name for c in self.features if c.required]
+
+    @property
+    def performance_names(self) -> list[str]:
+        return [c.name for c in self.performance]
+
+    def complete(self, row: Mapping[str, float]) -> dict[str, float]:
+        """The row's features as floats, optional ones filled with their defaults."""
+        out = {}
+        for c in self.features:
+            if c.name in row and row[c.name] is not None and not _is_nan(row[c.name]):
+                out[c.name] = float(row[c.name])
+            elif not c.required:
+                out[c.name] = c.default
+            else:
+                raise KeyError(c.name)
+        return out
+
+    def warnings(self, row: Mapping[str, float]) -> list[str]:
+        """Values outside the paper's sampling ranges (informational only)."""
+        msgs = []
+        for c in self.features:
+            v = row.get(c.name)
+            if v is None or _is_nan(v):
+                continue
+            w = c.out_of_range(float(v))
+            if w:
+                msgs.append(w)
+        return msgs
+
+
+def _is_nan(v) -> bool:
+    try:
+        return math.isnan(float(v))
+    except (TypeError, ValueError):
+        return False
+
+
+def positive(row: Mapping[str, float], names) -> list[str]:
+    """Problems for the named values that are not finite and > 0."""
+    out = []
+    for n in names:
+        v = row.get(n)
+        if v is None or not math.isfinite(v) or v <= 0:
+            out.append(f"{n} = {v!r} must be a finite value > 0")
+    return out
+
+
+def integer(row: Mapping[str, float], name: str, low: int = 1) -> list[str]:
+    """Problems if ``row[name]`` is not an integer >= low."""
+    v = row.get(name)
+    if v is None or not math.isfinite(v) or v != round(v) or v < low:
+        return [f"{name} = {v!r} must be an integer >= {low}"]
+    return []

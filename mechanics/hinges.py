@@ -1,0 +1,645 @@
+"""Bar-and-hinge models of a crease pattern: concentrated hinges and compliant creases.
+
+Two builders turn a :class:`~geometry.pattern.CreasePattern` (in its as-built 3-D state) and
+section/material data into a :class:`~mechanics.structure.Structure`:
+
+* :func:`build_concentrated` -- one rotational spring on every interior crease, panels fanned
+  from a centre node (specs/mechanics.md 2.3, specs/scenarios.md 1.2). Used by the single Miura,
+  canopy and arch scenarios of the paper.
+* :func:`build_compliant` -- creases of finite width W: every panel is shrunk by W/2 next to its
+  creases and each crease strip gets 3 nodes, 10 bars, 6 triangles and 8 springs on three spring
+  lines (specs/mechanics.md 2.2).
+
+Both use the reference simulator's numbering, so node and crease ids of the paper's scripts
+carry over (0-based here). Stiffnesses and areas follow specs/mechanics.md 2.4; the reference
+quirks are switched by a :class:`~mechanics.compat.Profile` (default :data:`PAPER`). Every spring
+rest angle is the dihedral angle measured on the as-built geometry, so the model is exactly
+stress free in the state it was built in (specs/scenarios.md 1.4).
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from geometry.errors import ParameterError, check_range
+from geometry.pattern import CreasePattern
+from mechanics.compat import PAPER, Profile
+from mechanics.springs import dihedral_angle
+from mechanics.structure import BarType, SpringRole, Structure
+
+__all__ = [
+    "build_concentrated",
+    "build_compliant",
+    "crease_rest_targets",
+    "orient_springs",
+]
+
+
+# --------------------------------------------------------------------------- helpers
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of (n, 3) arrays (faster than np.cross for small n)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
+def _group_mean(values: np.ndarray, group: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """Mean of (n, 3) ``values`` per group id, (len(sizes), 3)."""
+    n = len(sizes)
+    out = np.empty((n, 3))
+    for c in range(3):
+        out[:, c] = np.bincount(group, weights=values[:, c], minlength=n)
+    return out / sizes[:, None]
+
+
+def orient_springs(x: np.ndarray, springs: np.ndarray, *, z_only: bool = True) -> np.ndarray:
+    """Polarity normalisation of specs/mechanics.md 2.2-E (returns a new (ns, 4) array).
+
+    Swaps i and l where the z component of ``(x_j - x_i) x (x_k - x_j)`` is positive, so that
+    ``m = r_ij x r_kj`` points to +z (theta > pi when the wings rotate towards +z). With
+    ``z_only=False`` a spring whose z component vanishes (relative 1e-12) is judged by the y,
+    then the x component instead.
+    """
+    springs = np.array(springs, dtype=np.intp, copy=True)
+    if len(springs) == 0:
+        return springs
+    v = _cross(x[springs[:, 1]] - x[springs[:, 0]], x[springs[:, 2]] - x[springs[:, 1]])
+    if z_only:
+        comp = v[:, 2]
+    else:
+        tiny = 1e-12 * np.linalg.norm(v, axis=1)
+        comp = np.where(
+            np.abs(v[:, 2]) > tiny, v[:, 2], np.where(np.abs(v[:, 1]) > tiny, v[:, 1], v[:, 0])
+        )
+    swap = comp > 0
+    springs[swap, 0], springs[swap, 3] = springs[swap, 3], springs[swap, 0].copy()
+    return springs
+
+
+def _per_item(value, n: int, name: str, where: np.ndarray | None = None) -> np.ndarray:
+    """Broadcast a scalar or (n,) array to (n,); check it is finite and > 0 where ``where``."""
+    if isinstance(value, int | float) and value > 0 and np.isfinite(value):
+        return np.full(n, float(value))
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 0:
+        a = np.full(n, float(a))
+    if a.shape != (n,):
+        raise ParameterError(f"{name} must be a scalar or have length {n}, got shape {a.shape}")
+    sel = np.ones(n, bool) if where is None else where
+    bad = np.flatnonzero(sel & ~(np.isfinite(a) & (a > 0)))
+    if bad.size:
+        k = int(bad[0])
+        raise ParameterError(f"{name}[{k}] = {a[k]!r} is outside the allowed range (0, inf)")
+    return a
+
+
+def _scalar(value, name: str, low: float, high: float, *, low_open=False, high_open=False):
+    return check_range(name, value, low, high, low_open=low_open, high_open=high_open)
+
+
+def _flat_faces(pattern: CreasePattern):
+    """Concatenated face loops: vertex, face id, position, next and previous corner index."""
+    sizes = np.array([len(f) for f in pattern.faces], np.intp)
+    verts = np.concatenate(pattern.faces).astype(np.intp)
+    start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    face = np.repeat(np.arange(len(sizes)), sizes)
+    pos = np.arange(len(verts)) - start[face]
+    nxt = start[face] + (pos + 1) % sizes[face]
+    prv = start[face] + (pos - 1) % sizes[face]
+    return sizes, verts, start, face, nxt, prv
+
+
+def _edge_ids(pattern: CreasePattern, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Index in ``pattern.edges`` of the undirected vertex pairs (a, b)."""
+    nv = pattern.n_vertices
+    keys = pattern.edges[:, 0].astype(np.int64) * nv + pattern.edges[:, 1]
+    order = np.argsort(keys)
+    q = np.minimum(a, b).astype(np.int64) * nv + np.maximum(a, b)
+    pos = np.searchsorted(keys, q, sorter=order)
+    pos = np.minimum(pos, len(keys) - 1)
+    ids = order[pos]
+    if not np.array_equal(keys[ids], q):
+        raise ParameterError("a face side is not an edge of the pattern")
+    return ids
+
+
+_TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _topology(pattern: CreasePattern) -> dict:
+    """Index arrays of a pattern's faces and edges (cached per pattern object).
+
+    ``side[q]`` is the edge joining corner q to the next corner of its face.
+    """
+    topo = _TOPOLOGY.get(pattern)
+    if topo is None:
+        sizes, verts, start, face, nxt, prv = _flat_faces(pattern)
+        side = _edge_ids(pattern, verts, verts[nxt])
+        first, last, count = _edge_faces(pattern, side, face)
+        topo = dict(
+            sizes=sizes,
+            verts=verts,
+            face=face,
+            nxt=nxt,
+            prv=prv,
+            side=side,
+            first=first,
+            last=last,
+            interior=count == 2,
+        )
+        _TOPOLOGY[pattern] = topo
+    return topo
+
+
+def _edge_faces(pattern, side_edge: np.ndarray, side_face: np.ndarray):
+    """First and last face visiting each edge, (ne,) each (-1 where none)."""
+    ne = pattern.n_edges
+    first = np.full(ne, np.iinfo(np.intp).max, np.intp)
+    last = np.full(ne, -1, np.intp)
+    np.minimum.at(first, side_edge, side_face)
+    np.maximum.at(last, side_edge, side_face)
+    first[first == np.iinfo(np.intp).max] = -1
+    count = np.bincount(side_edge, minlength=ne)
+    return first, last, count
+
+
+def _panel_width(profile, panel_width, crease_width, interior, nf, spoke_len, face_of_spoke):
+    """Length scale ``w`` of the panel bending springs, per spoke."""
+    if panel_width is not None:
+        w = _per_item(panel_width, nf, "panel_width")
+        return w[face_of_spoke]
+    if profile.panel_spring_width_is_crease_width:
+        wi = crease_width[interior]
+        w = float(wi.mean()) if wi.size else 1.0
+        return np.full(len(spoke_len), w)
+    mean_spoke = np.bincount(face_of_spoke, weights=spoke_len, minlength=nf) / np.maximum(
+        np.bincount(face_of_spoke, minlength=nf), 1
+    )
+    return mean_spoke[face_of_spoke]
+
+
+# --------------------------------------------------------------------------- concentrated
+def build_concentrated(
+    pattern: CreasePattern,
+    *,
+    crease_width,
+    crease_thickness,
+    panel_thickness,
+    E_panel: float = 2e9,
+    E_crease: float = 2e9,
+    nu_panel: float = 0.3,
+    nu_crease: float = 0.3,
+    panel_width=None,
+    profile: Profile = PAPER,
+    coords=None,
+    supports=None,
+) -> Structure:
+    """Concentrated-hinge bar-and-hinge model (specs/mechanics.md 2.3-2.4).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Pattern in its as-built (stress-free) 3-D state, ``nv`` vertices, ``ne`` edges,
+        ``nf`` faces.
+    crease_width, crease_thickness : float or (ne,) float
+        Crease width W and thickness t_c, metres (border edges ignored).
+    panel_thickness : float or (nf,) float
+        Panel thickness t_p, metres.
+    E_panel, E_crease : float
+        Young's moduli, Pa. ``E_crease`` enters only the crease springs (the model has no
+        crease bars).
+    nu_panel, nu_crease : float
+        Poisson's ratios (``nu_crease`` is unused here; kept for a uniform signature).
+    panel_width : float or (nf,) float, optional
+        Length scale ``w`` of the panel bending springs ``k = E_p t_p^3 L / (12 w)``. Default:
+        the crease width (``profile.panel_spring_width_is_crease_width``, the paper's
+        ``panelW = W``; the mean interior width if W varies) or the panel's mean spoke length.
+    profile : Profile
+        Quirk switches (:data:`~mechanics.compat.PAPER` reproduces the published data).
+    coords : (nv, 3) float, optional
+        Other as-built vertex coordinates for the same faces (default ``pattern.coords``).
+        Lets a sweep over fold states (extensions) reuse one validated pattern.
+    supports : (nv + nf, 3) bool, optional
+        Fixed degrees of freedom of the model's nodes (default: none).
+
+    Returns
+    -------
+    Structure
+        Nodes: the ``nv`` vertices, then one centre per panel (node ``nv + p``). Bars: edge ``i``
+        is bar ``i`` (type 1), then the spokes panel by panel, corner by corner (type 5).
+        Springs: one per interior edge in edge order (role HINGE, ``spring_crease`` = edge
+        id), then one per spoke (role PANEL). ``meta`` holds ``crease_ids`` (interior edge ids),
+        ``hinge_springs`` (their spring indices), ``panel_centres`` (nf,), ``node_vertex``
+        (vertex id, -2 for centres), ``model = "concentrated"`` and ``profile``.
+    """
+    E_panel = _scalar(E_panel, "E_panel", 0.0, None, low_open=True)
+    E_crease = _scalar(E_crease, "E_crease", 0.0, None, low_open=True)
+    nu_panel = _scalar(nu_panel, "nu_panel", -1.0, 0.5, low_open=True, high_open=True)
+    _scalar(nu_crease, "nu_crease", -1.0, 0.5, low_open=True, high_open=True)
+    nv, ne, nf = pattern.n_vertices, pattern.n_edges, pattern.n_faces
+    t = _topology(pattern)
+    sizes, verts, face, nxt, prv = t["sizes"], t["verts"], t["face"], t["nxt"], t["prv"]
+    side_edge, first, last, interior = t["side"], t["first"], t["last"], t["interior"]
+    W = _per_item(crease_width, ne, "crease_width", interior)
+    tc = _per_item(crease_thickness, ne, "crease_thickness", interior)
+    tp = _per_item(panel_thickness, nf, "panel_thickness")
+
+    if coords is None:
+        X = pattern.coords
+    else:
+        X = np.asarray(coords, float)
+        if X.shape != (nv, 3) or not np.isfinite(X).all():
+            raise ParameterError(f"coords must be a finite ({nv}, 3) array, got shape {X.shape}")
+    centres = _group_mean(X[verts], face, sizes)
+    nodes = np.vstack([X, centres])
+    cnode = nv + face  # centre node of each corner's panel
+
+    # bars: edges, then spokes
+    spokes = np.column_stack([verts, cnode])
+    bars = np.vstack([pattern.edges.astype(np.intp), spokes])
+    L = np.linalg.norm(nodes[bars[:, 1]] - nodes[bars[:, 0]], axis=1)
+    edge_len, spoke_len = L[:ne], L[ne:]
+
+    # panel areas: fan triangles (centre, C_q, C_q+1)
+    tri_area = 0.5 * np.linalg.norm(
+        _cross(X[verts] - centres[face], X[verts[nxt]] - centres[face]), axis=1
+    )
+    area = np.bincount(face, weights=tri_area, minlength=nf)
+    perim = np.bincount(face, weights=edge_len[side_edge] + spoke_len, minlength=nf)
+    A_p = 2.0 * tp * area / ((1.0 - nu_panel) * perim)
+    bar_area = np.empty(len(bars))
+    bar_area[ne:] = A_p[face]
+    if profile.edge_bar_area_last_panel:
+        bar_area[:ne] = 2.0 * A_p[last]
+    else:
+        bar_area[:ne] = np.bincount(side_edge, weights=A_p[face], minlength=ne)
+    bar_type = np.concatenate(
+        [np.full(ne, BarType.PANEL_EDGE, np.int8), np.full(len(spokes), BarType.PANEL_SPOKE)]
+    )
+
+    # springs: hinges on interior edges, then panel springs on spokes
+    cid = np.flatnonzero(interior)
+    e = pattern.edges[cid]
+    hinge = np.column_stack([nv + first[cid], e[:, 0], e[:, 1], nv + last[cid]])
+    panel = np.column_stack([verts[nxt], verts, cnode, verts[prv]])
+    springs = orient_springs(
+        nodes, np.vstack([hinge, panel]).astype(np.intp), z_only=profile.polarity_z_only
+    )
+    k_hinge = E_crease * tc[cid] ** 3 * edge_len[cid] / (12.0 * W[cid])
+    w = _panel_width(profile, panel_width, W, interior, nf, spoke_len, face)
+    k_panel = E_panel * tp[face] ** 3 * spoke_len / (12.0 * w)
+    spring_k = np.concatenate([k_hinge, k_panel])
+    role = np.concatenate(
+        [np.full(len(cid), SpringRole.HINGE, np.int8), np.full(len(panel), SpringRole.PANEL)]
+    )
+    crease_of = np.concatenate([cid, np.full(len(panel), -1)])
+
+    # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1)
+    triangles = np.column_stack([cnode, verts, verts[prv]])
+    return Structure(
+        nodes=nodes,
+        bars=bars,
+        bar_area=bar_area,
+        bar_E=np.full(len(bars), E_panel),
+        bar_length=L,
+        bar_type=bar_type,
+        springs=springs,
+        spring_k=spring_k,
+        spring_rest=dihedral_angle(nodes, springs),
+        spring_role=role,
+        spring_crease=crease_of,
+        triangles=triangles,
+        tri_thickness=tp[face],
+        tri_crease=np.full(len(triangles), -1),
+        tri_panel=face,
+        supports=supports,
+        meta={
+            "model": "concentrated",
+            "profile": profile,
+            "crease_ids": cid,
+            "hinge_springs": np.arange(len(cid)),
+            "panel_centres": nv + np.arange(nf),
+            "node_vertex": np.concatenate([np.arange(nv), np.full(nf, -2)]),
+            "n_vertices": nv,
+        },
+    )
+
+
+# --------------------------------------------------------------------------- compliant
+def _unit(v):
+    return v / np.linalg.norm(v)
+
+
+def build_compliant(
+    pattern: CreasePattern,
+    *,
+    crease_width,
+    crease_thickness,
+    panel_thickness,
+    E_panel: float,
+    E_crease: float,
+    nu_panel: float,
+    nu_crease: float,
+    panel_width=None,
+    diagonal_rate: float = 4.0,
+    split_factor: float = 0.5,
+    profile: Profile = PAPER,
+) -> Structure:
+    """Compliant-crease bar-and-hinge model of finite-width creases (specs/mechanics.md 2.2).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        As-built pattern (``nv`` vertices, ``ne`` edges, ``nf`` faces); every interior edge
+        becomes a compliant crease.
+    crease_width, crease_thickness : float or (ne,) float
+        Crease width W and thickness t_c, metres (border edges ignored).
+    panel_thickness : float or (nf,) float
+        Panel thickness t_p, metres.
+    E_panel, E_crease : float
+        Young's moduli, Pa (panel bars/springs and crease bars/springs).
+    nu_panel, nu_crease : float
+        Poisson's ratios.
+    panel_width : float or (nf,) float, optional
+        Length ``w`` of the panel springs ``k = E_p t_p^3 L / (12 w)`` (see
+        :func:`build_concentrated`).
+    diagonal_rate : float
+        Stiffness ratio of the crease diagonal springs to the crease-line springs.
+    split_factor : float
+        Share f of a crease's fold given to the centre spring line (used by
+        :func:`crease_rest_targets`; rest angles here are the measured ones).
+    profile : Profile
+        Quirk switches.
+
+    Returns
+    -------
+    Structure
+        Nodes: shrunk panel corners panel by panel (``meta["n_corner_nodes"]`` of them), then
+        (p1, p2, c) per interior crease in crease order, then one centre per panel. Bars:
+        perimeter bars (same numbering as the corner nodes), 10 per crease, then the spokes.
+        Springs are ordered by the bar they sit on (the reference's slot order). ``meta``:
+        ``crease_ids (nci,)``, ``crease_nodes (nci, 7)`` = [N11, N12, N21, N22, p1, p2, c],
+        ``crease_springs (nci, 8)`` = [edge1, edge2, diag N11-c, diag N12-c, centre p1-c,
+        centre p2-c, diag N21-c, diag N22-c], ``panel_centres (nf,)``, ``node_vertex (nn,)``
+        (vertex id, -1 crease node, -2 centre), ``n_corner_nodes``, ``spring_bar (ns,)``,
+        ``split_factor``, ``diagonal_rate``.
+    """
+    E_panel = _scalar(E_panel, "E_panel", 0.0, None, low_open=True)
+    E_crease = _scalar(E_crease, "E_crease", 0.0, None, low_open=True)
+    nu_panel = _scalar(nu_panel, "nu_panel", -1.0, 0.5, low_open=True, high_open=True)
+    nu_crease = _scalar(nu_crease, "nu_crease", -1.0, 0.5, low_open=True, high_open=True)
+    diagonal_rate = _scalar(diagonal_rate, "diagonal_rate", 0.0, None, low_open=True)
+    split_factor = _scalar(split_factor, "split_factor", 0.0, 1.0)
+    ne, nf = pattern.n_edges, pattern.n_faces
+    t = _topology(pattern)
+    sizes, verts, face, nxt, prv = t["sizes"], t["verts"], t["face"], t["nxt"], t["prv"]
+    side_edge = t["side"][prv]  # side j joins C(j-1)-C(j)
+    interior = t["interior"]
+    W = _per_item(crease_width, ne, "crease_width", interior)
+    tc = _per_item(crease_thickness, ne, "crease_thickness", interior)
+    tp = _per_item(panel_thickness, nf, "panel_thickness")
+    X = pattern.coords
+
+    # A. shrunk panel copies (one node per corner, numbered like the corners)
+    nc0 = len(verts)
+    corner = X[verts].copy()
+    for q in range(nc0):
+        e_prev = side_edge[q]  # C(j-1)-C(j)
+        e_next = side_edge[nxt[q]]  # C(j)-C(j+1)
+        cp, cn = interior[e_prev], interior[e_next]
+        if not (cp or cn):
+            continue
+        p = X[verts[q]]
+        v1 = _unit(X[verts[nxt[q]]] - p)  # towards the next vertex
+        v2 = _unit(X[verts[prv[q]]] - p)  # towards the previous vertex
+        sin_b = np.linalg.norm(np.cross(v1, v2))
+        if sin_b <= 1e-12:
+            continue  # collinear sides: not moved
+        if cp and cn:
+            W1, W2 = W[e_next], W[e_prev]
+            off = 0.5 * W1 * v2 + 0.5 * W2 * v1
+            if not profile.approximate_corner_offset:
+                off = off / sin_b
+        elif cp:  # crease on the previous side: slide along the next side
+            off = W[e_prev] / (2.0 * sin_b) * v1
+        else:
+            off = W[e_next] / (2.0 * sin_b) * v2
+        corner[q] = p + off
+    # perimeter bars: bar q joins corner nodes prv[q] and q
+    perim = np.sort(np.column_stack([prv, np.arange(nc0)]), axis=1)
+
+    # B. crease regions
+    cid = np.flatnonzero(interior)
+    nci = len(cid)
+    side_of = {}
+    for q in range(nc0):
+        side_of.setdefault(int(side_edge[q]), []).append(q)
+    new_nodes = []
+    crease_nodes = np.zeros((nci, 7), np.intp)
+    cbars, cbar_type, cbar_slot_spring = [], [], []
+    ctris = []
+    crease_edge_bars = np.zeros((nci, 2), np.intp)
+    for r, e in enumerate(cid):
+        b1, b2 = side_of[int(e)]  # earlier panel first (corners are in panel order)
+        n11, n12 = perim[b1]
+        n21, n22 = perim[b2]
+        if np.linalg.norm(corner[n11] - corner[n21]) > np.linalg.norm(corner[n11] - corner[n22]):
+            n21, n22 = n22, n21
+        p1 = 0.5 * (corner[n11] + corner[n21])
+        p2 = 0.5 * (corner[n12] + corner[n22])
+        c = 0.25 * (corner[n11] + corner[n12] + corner[n21] + corner[n22])
+        base = nc0 + 3 * r
+        ip1, ip2, ic = base, base + 1, base + 2
+        new_nodes += [p1, p2, c]
+        crease_nodes[r] = [n11, n12, n21, n22, ip1, ip2, ic]
+        crease_edge_bars[r] = [b1, b2]
+        rows = [
+            (2, (n11, ip1), None),
+            (3, (n11, ic), (n12, ic, n11, ip1)),
+            (3, (n12, ic), (ip2, ic, n12, n11)),
+            (2, (n12, ip2), None),
+            (4, (ip1, ic), (n11, ic, ip1, n21)),
+            (4, (ip2, ic), (n12, ip2, ic, n22)),
+            (2, (n21, ip1), None),
+            (3, (n21, ic), (ip1, ic, n21, n22)),
+            (3, (n22, ic), (ip2, n22, ic, n21)),
+            (2, (n22, ip2), None),
+        ]
+        for t, bar, spr in rows:
+            cbars.append(sorted(bar))
+            cbar_type.append(t)
+            cbar_slot_spring.append(spr)
+        ctris += [
+            (ic, ip1, n11),
+            (n21, ip1, ic),
+            (n21, ic, n22),
+            (n22, ip2, ic),
+            (n12, ic, ip2),
+            (n12, ic, n11),
+        ]
+    n_cnodes = nc0 + 3 * nci
+
+    # C. panel fans (centres of the shrunk panels)
+    centres = np.zeros((nf, 3))
+    np.add.at(centres, face, corner)
+    centres /= sizes[:, None]
+    cnode = n_cnodes + face
+    nodes = np.vstack([corner, np.array(new_nodes).reshape(-1, 3), centres])
+    spokes = np.column_stack([np.arange(nc0), cnode])
+    bars = np.vstack([perim, np.array(cbars, np.intp).reshape(-1, 2), spokes])
+    L = np.linalg.norm(nodes[bars[:, 1]] - nodes[bars[:, 0]], axis=1)
+    nb = len(bars)
+    b_crease0 = nc0
+    b_spoke0 = nc0 + 10 * nci
+    bar_type = np.concatenate(
+        [
+            np.full(nc0, BarType.PANEL_EDGE, np.int8),
+            np.array(cbar_type, np.int8),
+            np.full(nc0, BarType.PANEL_SPOKE, np.int8),
+        ]
+    )
+
+    # springs by slot (bar id)
+    slot_spr = np.full((nb, 4), -1, np.intp)
+    for r in range(nci):
+        n11, n12, n21, n22, ip1, ip2, ic = crease_nodes[r]
+        b1, b2 = crease_edge_bars[r]
+        slot_spr[b1] = (ic, n11, n12, cnode[b1])
+        slot_spr[b2] = (ic, n22, n21, cnode[b2])
+        for t in range(10):
+            s = cbar_slot_spring[10 * r + t]
+            if s is not None:
+                slot_spr[b_crease0 + 10 * r + t] = s
+    slot_spr[b_spoke0:] = np.column_stack([prv, np.arange(nc0), cnode, nxt])
+    slots = np.flatnonzero(slot_spr[:, 0] >= 0)
+    springs = orient_springs(nodes, slot_spr[slots], z_only=profile.polarity_z_only)
+    slot_to_spring = np.full(nb, -1, np.intp)
+    slot_to_spring[slots] = np.arange(len(slots))
+    crease_springs = np.zeros((nci, 8), np.intp)
+    crease_springs[:, 0] = slot_to_spring[crease_edge_bars[:, 0]]
+    crease_springs[:, 1] = slot_to_spring[crease_edge_bars[:, 1]]
+    for col, t in zip(range(2, 8), (1, 2, 4, 5, 7, 8), strict=True):
+        crease_springs[:, col] = slot_to_spring[b_crease0 + 10 * np.arange(nci) + t]
+
+    # stiffness and areas
+    ell = L[crease_edge_bars[:, 0]] if nci else np.zeros(0)
+    Wc, tcc = W[cid], tc[cid]
+    k1 = E_crease * tcc**3 / (4.0 * Wc)
+    spring_k = np.zeros(len(slots))
+    role = np.full(len(slots), SpringRole.PANEL, np.int8)
+    crease_of = np.full(len(slots), -1, np.intp)
+    spring_k[crease_springs[:, :2]] = (k1[:, None] * L[crease_edge_bars]).reshape(nci, 2)
+    role[crease_springs[:, :2]] = SpringRole.CREASE_EDGE
+    cb = b_crease0 + 10 * np.arange(nci)
+    for col, t, rl in (
+        (2, 1, SpringRole.CREASE_DIAGONAL),
+        (3, 2, SpringRole.CREASE_DIAGONAL),
+        (4, 4, SpringRole.CREASE_CENTRE),
+        (5, 5, SpringRole.CREASE_CENTRE),
+        (6, 7, SpringRole.CREASE_DIAGONAL),
+        (7, 8, SpringRole.CREASE_DIAGONAL),
+    ):
+        rate = diagonal_rate if rl == SpringRole.CREASE_DIAGONAL else 1.0
+        spring_k[crease_springs[:, col]] = rate * k1 * L[cb + t]
+        role[crease_springs[:, col]] = rl
+    crease_of[crease_springs.ravel()] = np.repeat(cid, 8)
+    spk_slots = slots >= b_spoke0
+    spoke_len = L[b_spoke0:]
+    w = _panel_width(profile, panel_width, W, interior, nf, spoke_len, face)
+    spring_k[spk_slots] = E_panel * tp[face] ** 3 * spoke_len / (12.0 * w)
+
+    tri_area = 0.5 * np.linalg.norm(
+        np.cross(corner - centres[face], corner[nxt] - centres[face]), axis=1
+    )
+    area = np.bincount(face, weights=tri_area, minlength=nf)
+    per = np.bincount(face, weights=L[:nc0] + spoke_len, minlength=nf)
+    A_p = 2.0 * tp * area / ((1.0 - nu_panel) * per)
+    bar_area = np.zeros(nb)
+    bar_area[:nc0] = A_p[face]
+    bar_area[b_spoke0:] = A_p[face]
+    A1 = ell * tcc / (2.0 * (1.0 - nu_crease**2))
+    A2 = (ell**2 + Wc**2) ** 1.5 * tcc / (4.0 * (1.0 + nu_crease) * ell * Wc)
+    for t in range(10):
+        bar_area[cb + t] = A1 if cbar_type[t] == 2 else A2
+    bar_E = np.where(np.isin(bar_type, (1, 5)), E_panel, E_crease)
+
+    triangles = np.vstack(
+        [np.array(ctris, np.intp).reshape(-1, 3), np.column_stack([cnode, np.arange(nc0), nxt])]
+    )
+    nct = 6 * nci
+    node_vertex = np.concatenate([verts, np.full(3 * nci, -1), np.full(nf, -2)])
+    return Structure(
+        nodes=nodes,
+        bars=bars,
+        bar_area=bar_area,
+        bar_E=bar_E,
+        bar_length=L,
+        bar_type=bar_type,
+        springs=springs,
+        spring_k=spring_k,
+        spring_rest=dihedral_angle(nodes, springs),
+        spring_role=role,
+        spring_crease=crease_of,
+        triangles=triangles,
+        tri_thickness=np.concatenate([np.repeat(tcc, 6), tp[face]]),
+        tri_crease=np.concatenate([np.repeat(cid, 6), np.full(nc0, -1)]),
+        tri_panel=np.concatenate([np.full(nct, -1), face]),
+        meta={
+            "model": "compliant",
+            "profile": profile,
+            "crease_ids": cid,
+            "crease_nodes": crease_nodes,
+            "crease_springs": crease_springs,
+            "panel_centres": n_cnodes + np.arange(nf),
+            "node_vertex": node_vertex,
+            "n_corner_nodes": nc0,
+            "spring_bar": slots,
+            "split_factor": split_factor,
+            "diagonal_rate": diagonal_rate,
+        },
+    )
+
+
+def crease_rest_targets(structure: Structure, crease_angle, *, profile: Profile | None = None):
+    """Spring rest angles that make each crease's stress-free fold angle ``crease_angle``.
+
+    Parameters
+    ----------
+    structure : Structure
+        Built by :func:`build_concentrated` or :func:`build_compliant`.
+    crease_angle : (ne,) float
+        Crease-level rest angle per pattern edge, rad (pi = flat, the spring convention);
+        border edges are ignored.
+    profile : Profile, optional
+        Defaults to the profile the structure was built with. With
+        ``reset_non_crease_rest_angles`` (the reference, specs/mechanics.md 2.5) every other
+        spring (panel, diagonal) is set to pi; otherwise it keeps its current rest angle.
+
+    Returns
+    -------
+    (ns,) float
+        Compliant creases: the two edge springs get ``pi + (1 - f)/2 (theta_c - pi)`` and the
+        two centre springs ``pi + f (theta_c - pi)`` (f = ``meta["split_factor"]``);
+        concentrated hinges get ``theta_c``.
+    """
+    profile = profile or structure.meta.get("profile", PAPER)
+    theta = np.asarray(crease_angle, float)
+    cid = np.asarray(structure.meta["crease_ids"])
+    out = (
+        np.full(len(structure.springs), np.pi)
+        if profile.reset_non_crease_rest_angles
+        else structure.spring_rest.copy()
+    )
+    tc = theta[cid]
+    if structure.meta.get("model") == "compliant":
+        f = float(structure.meta["split_factor"])
+        cs = structure.meta["crease_springs"]
+        out[cs[:, 0]] = out[cs[:, 1]] = np.pi + 0.5 * (1.0 - f) * (tc - np.pi)
+        out[cs[:, 4]] = out[cs[:, 5]] = np.pi + f * (tc - np.pi)
+    else:
+        out[structure.meta["hinge_springs"]] = tc
+    return out
