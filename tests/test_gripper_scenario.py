@@ -1,0 +1,109 @@
+"""The gripper scenario (data2): published formulas, full runs against published rows."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from design.scenarios.gripper import (
+    SCENARIO,
+    STATUS_NO_CLOSURE,
+    GripperOptions,
+    check,
+    decode_closing_step,
+    published_q,
+    simulate,
+)
+
+STEMS = ["data2_MiuraBased_sample", "data2_SplittedMiura_sample", "data2_TwoPanel_sample"]
+STEP_RANGE = {1: (67, 387), 2: (72, 398), 3: (41, 298)}  # scenarios.md 4.7
+
+
+@pytest.mark.parametrize("stem", STEMS)
+def test_published_final_q_decodes_to_whole_heating_steps(reference_data, stem):
+    df = reference_data.load(stem)
+    P = int(df["Pattern"].iloc[0])
+    step = decode_closing_step(P, df["L1"].to_numpy(), df["L2"].to_numpy(), df["finalQ"])
+    np.testing.assert_allclose(step, np.round(step), atol=1e-9)
+    lo, hi = STEP_RANGE[P]
+    assert lo <= step.min() and step.max() <= hi
+    back = published_q(P, df["L1"].iloc[0], df["L2"].iloc[0], np.round(step[0]))
+    assert back == pytest.approx(df["finalQ"].iloc[0], rel=1e-13)
+
+
+def _row(df, i):
+    return {k: float(df[k].iloc[i]) for k in SCENARIO.feature_names}
+
+
+# (file, row index, closing step): two-panel row 2, splitted row 1, Miura-based row 2
+FULL_RUNS = [
+    ("data2_TwoPanel_sample", 1, 88),
+    ("data2_SplittedMiura_sample", 0, 117),
+    ("data2_MiuraBased_sample", 1, 145),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stem,i,step", FULL_RUNS)
+def test_full_run_reproduces_published_row(reference_data, stem, i, step):
+    df = reference_data.load(stem)
+    res = simulate(_row(df, i))
+    P = int(df["Pattern"].iloc[i])
+    pub_step = decode_closing_step(P, df["L1"].iloc[i], df["L2"].iloc[i], df["finalQ"].iloc[i])
+    assert pub_step == pytest.approx(step, abs=1e-9)
+    assert res.closing_step == step
+    # (the Miura-based prying run starts with a 29-iteration increment, as in the reference)
+    assert "heating" not in res.status and "failed" not in res.status
+    assert res.freqFinal == pytest.approx(df["freqFinal"].iloc[i], rel=1e-6)
+    assert res.finalQ == pytest.approx(df["finalQ"].iloc[i], rel=1e-12)
+    assert res.Tmax == pytest.approx(df["Tmax"].iloc[i], rel=1e-6)
+    assert res.stiff == pytest.approx(df["stiff"].iloc[i], rel=1e-3)
+
+
+@pytest.mark.slow
+def test_physical_polarity_gives_the_same_folding(reference_data):
+    """Normalised springs with the pattern's fold_sign fold exactly like the reference's raw
+    springs with the scripts' signs (first 25 heating steps of a splitted gripper)."""
+    df = reference_data.load("data2_SplittedMiura_sample")
+    row = _row(df, 0)
+    a = simulate(row, GripperOptions(step_cap=25, keep_history=True))
+    b = simulate(row, GripperOptions(step_cap=25, keep_history=True, raw_polarity=False))
+    assert a.status == b.status == STATUS_NO_CLOSURE
+    np.testing.assert_allclose(a.tip_distance, b.tip_distance, rtol=1e-7)
+    np.testing.assert_allclose(a.Tmax_history, b.Tmax_history, rtol=1e-12)
+    assert a.tip_distance[-1] < a.tip_distance[0] - 1e-5  # the arms do move
+
+
+def test_no_closure_within_cap(reference_data):
+    df = reference_data.load("data2_TwoPanel_sample")
+    res = simulate(_row(df, 1), GripperOptions(step_cap=5, keep_history=True))
+    assert res.status == STATUS_NO_CLOSURE
+    assert res.closing_step is None
+    assert all(math.isnan(v) for v in (res.finalQ, res.Tmax, res.stiff))
+    assert res.freqFinal == pytest.approx(df["freqFinal"].iloc[1], rel=1e-6)
+    assert len(res.tip_distance) == 5
+    assert np.all(np.diff(res.tip_distance) < 0)  # closing, slowly
+    assert np.all(np.diff(res.Tmax_history) > 0)
+    row = res.as_row()
+    assert set(row) == {"freqFinal", "finalQ", "Tmax", "stiff", "status"}
+
+
+def test_check_rejects_invalid_designs():
+    good = dict(Pattern=3, L1=4e-3, L2=3e-3, t1=0.2e-6, t2=0.8e-6, tpanel=20e-6, rate=0.4,
+                W=200e-6)  # fmt: skip
+    assert check(good) == []
+    assert any("Pattern" in e for e in check(good | {"Pattern": 4}))
+    assert any("L2/2" in e for e in check(good | {"Pattern": 1, "rate": 0.9}))
+    assert any("t1" in e for e in check(good | {"t1": -1.0}))
+    assert any("W" in e for e in check(good | {"W": 2e-3}))
+    with pytest.raises(ValueError, match="rate"):
+        simulate(good | {"Pattern": 2, "rate": 0.95})
+
+
+def test_scenario_columns():
+    assert SCENARIO.name == "gripper"
+    assert SCENARIO.feature_names == ["Pattern", "L1", "L2", "t1", "t2", "tpanel", "rate", "W"]
+    assert SCENARIO.performance_names == ["freqFinal", "finalQ", "Tmax", "stiff"]
+    assert [c.unit for c in SCENARIO.performance] == ["rad/s", "W", "degC", "N/m"]
