@@ -155,12 +155,29 @@ def read_table(path, columns=None) -> pd.DataFrame:
     return frame
 
 
-def column_roles(columns) -> ColumnRoles | None:
-    """Recognise a published column set (in any order).
+def column_roles(columns, path=None) -> ColumnRoles | None:
+    """Recognise the roles of a database's columns.
 
-    Returns None when the columns are not one of the published sets.
+    A holofold database folder (``holofold generate``) has a ``meta.json`` beside its Parquet
+    file naming the scenario's features, performance columns and categorical features; that is
+    used first when ``path`` is given. Otherwise a published column set is recognised (in any
+    order). Returns None when neither applies.
     """
     cols = {str(c) for c in columns}
+    if path is not None:
+        meta = Path(path).with_name("meta.json")
+        if meta.is_file():
+            import json
+
+            try:
+                info = json.loads(meta.read_text())
+                feats = tuple(f for f in info["features"] if f in cols)
+                perf = tuple(f for f in info["performance"] if f in cols)
+                cat = tuple(f for f in info.get("categorical", ()) if f in feats)
+            except (ValueError, KeyError, TypeError):
+                info = None
+            if info is not None and feats:
+                return ColumnRoles(feats, perf, cat)
     for roles in PUBLISHED.values():
         if cols == set(roles.features + roles.performance):
             return roles

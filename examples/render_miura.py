@@ -21,7 +21,8 @@ from geometry.miura import miura_sheet
 from geometry.solid import thick_solid
 
 pv.OFF_SCREEN = True
-OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[1] / "docs" / "miura.png"
+DEFAULT = Path(__file__).resolve().parents[1] / "docs" / "miura.png"
+OUT = Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT
 WINDOW = (1400, 600)
 
 pattern = miura_sheet(6, 6, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)

@@ -120,9 +120,14 @@ def run(args) -> int:
     plot_path = _check_output(args.plot, "--plot", _PLOT_SUFFIXES)
 
     table = read_table(args.database, columns=_names(args.columns))
+    if "status" in table.columns:  # a holofold database: failed simulations have no outputs
+        failed = table["status"].astype(str).str.startswith("failed")
+        if failed.any():
+            print(f"note: {int(failed.sum())} failed simulation(s) left out")
+            table = table.loc[~failed].reset_index(drop=True)
     columns = [str(c) for c in table.columns]
     target = parse_target(args.target, columns=columns)
-    roles = column_roles(columns)
+    roles = column_roles(columns, args.database)
     features = _names(args.features)
     if features is None:
         if roles is None:

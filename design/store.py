@@ -1,0 +1,161 @@
+"""A resumable, chunked Parquet database of simulated designs.
+
+Layout of a database folder::
+
+    designs.parquet        the design table to simulate (written first, never changed)
+    meta.json              scenario, column units, sampling, holofold version
+    chunks/part-00000.parquet ...   results, ``chunk_size`` rows each, written atomically
+    database.parquet       all chunks concatenated, written when every chunk exists
+
+Running :func:`build_database` again on the same folder skips the chunks already on disk, so an
+interrupted run (Ctrl-C, a killed job) resumes without losing or duplicating rows. A folder that
+holds a *different* design table is refused rather than mixed.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from design.runner import evaluate_designs, validate_designs
+from design.scenarios import Scenario, get_scenario
+
+__all__ = ["build_database", "load_database"]
+
+log = logging.getLogger(__name__)
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+
+        return version("holofold")
+    except Exception:  # noqa: BLE001 - not installed: running from a checkout
+        return "unknown"
+
+
+def _write_atomic(df: pd.DataFrame, path: Path) -> None:
+    tmp = path.with_suffix(".tmp")
+    df.to_parquet(tmp, index=False)
+    os.replace(tmp, path)
+
+
+def build_database(
+    scenario: Scenario | str,
+    designs: pd.DataFrame,
+    folder: str | os.PathLike,
+    *,
+    chunk_size: int = 100,
+    workers: int = 1,
+    progress: bool | None = None,
+    meta: dict | None = None,
+) -> pd.DataFrame:
+    """Simulate ``designs`` into ``folder``, resuming whatever an earlier run left there.
+
+    Parameters
+    ----------
+    scenario : Scenario or str
+    designs : DataFrame
+        Feature columns in SI units (plus any bookkeeping columns such as ``sample``).
+    folder : path
+        Database folder (created if needed).
+    chunk_size : int
+        Rows per result chunk: the unit of work lost at most when a run is interrupted.
+    workers : int
+        Worker processes per chunk (joblib).
+    progress : bool, optional
+        Progress bar on stderr (default: only on a terminal).
+    meta : dict, optional
+        Extra metadata stored in ``meta.json`` (seed, sampling method, ...).
+
+    Returns
+    -------
+    DataFrame
+        All rows in order with performance columns and ``status``; also written to
+        ``database.parquet``.
+    """
+    if isinstance(scenario, str):
+        scenario = get_scenario(scenario)
+    chunk_size = int(chunk_size)
+    if chunk_size < 1:
+        raise ValueError(f"chunk_size = {chunk_size} must be >= 1")
+    validate_designs(scenario, designs)  # every row checked before anything is simulated
+    folder = Path(folder)
+    chunks = folder / "chunks"
+    chunks.mkdir(parents=True, exist_ok=True)
+    designs = designs.reset_index(drop=True)
+    dpath = folder / "designs.parquet"
+    if dpath.exists():
+        old = pd.read_parquet(dpath)
+        same = list(old.columns) == list(designs.columns) and len(old) == len(designs)
+        if same:
+            a = old.to_numpy(dtype=float, na_value=np.nan)
+            b = designs.to_numpy(dtype=float, na_value=np.nan)
+            same = np.array_equal(a, b, equal_nan=True)
+        if not same:
+            raise ValueError(
+                f"{folder} already holds a different design table; use another folder "
+                "(or delete it) instead of mixing two databases"
+            )
+    else:
+        _write_atomic(designs, dpath)
+        info = {
+            "scenario": scenario.name,
+            "features": {c.name: c.unit for c in scenario.features},
+            "performance": {c.name: c.unit for c in scenario.performance},
+            "categorical": list(scenario.categorical),
+            "rows": len(designs),
+            "chunk_size": chunk_size,
+            "holofold_version": _version(),
+            **(meta or {}),
+        }
+        (folder / "meta.json").write_text(json.dumps(info, indent=2))
+    n_chunks = (len(designs) + chunk_size - 1) // chunk_size
+    todo = [k for k in range(n_chunks) if not (chunks / f"part-{k:05d}.parquet").exists()]
+    if len(todo) < n_chunks:
+        log.info("resuming: %d of %d chunks already done", n_chunks - len(todo), n_chunks)
+    if progress is None:
+        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    bar = None
+    if progress and todo:
+        from tqdm import tqdm
+
+        done_rows = sum(
+            min(chunk_size, len(designs) - k * chunk_size) for k in range(n_chunks)
+        ) - sum(min(chunk_size, len(designs) - k * chunk_size) for k in todo)
+        bar = tqdm(
+            total=len(designs),
+            initial=done_rows,
+            desc=scenario.name,
+            unit="design",
+            file=sys.stderr,
+        )
+    try:
+        for k in todo:
+            part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
+            res = evaluate_designs(scenario, part, workers=workers, progress=False)
+            _write_atomic(res, chunks / f"part-{k:05d}.parquet")
+            if bar is not None:
+                bar.update(len(part))
+    finally:
+        if bar is not None:
+            bar.close()
+    return load_database(folder, _write=True)
+
+
+def load_database(folder: str | os.PathLike, *, _write: bool = False) -> pd.DataFrame:
+    """All finished chunks of a database folder, in row order."""
+    folder = Path(folder)
+    parts = sorted((folder / "chunks").glob("part-*.parquet"))
+    if not parts:
+        raise FileNotFoundError(f"{folder} holds no finished chunks")
+    df = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
+    if _write:
+        _write_atomic(df, folder / "database.parquet")
+    return df

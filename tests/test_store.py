@@ -1,0 +1,82 @@
+"""Sampling and the resumable chunked database."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import design.store as store
+from design.cli import main
+from design.sampling import sample_designs
+from design.scenarios import get_scenario
+
+
+@pytest.fixture(scope="module")
+def scen():
+    return get_scenario("single-miura")
+
+
+def test_random_rows_are_independent_of_n_and_start(scen):
+    a = sample_designs(scen, 10, seed=3)
+    b = sample_designs(scen, 4, seed=3, start=6)
+    pd.testing.assert_frame_equal(a.iloc[6:].reset_index(drop=True), b)
+    c = sample_designs(scen, 10, seed=4)
+    assert not np.allclose(a["tpanel"], c["tpanel"])
+
+
+@pytest.mark.parametrize("method", ["random", "lhs", "sobol"])
+def test_samples_stay_in_the_papers_ranges(scen, method):
+    d = sample_designs(scen, 64, seed=0, method=method)
+    for col in scen.features:
+        if col.required:
+            assert d[col.name].between(col.low, col.high).all(), col.name
+    if method == "lhs":  # one sample in each of the 64 strata of every feature
+        strata = np.floor((d["W"] - 1e-3) / 3e-3 * 64).astype(int)
+        assert sorted(strata) == list(range(64))
+
+
+def test_ranges_override_and_errors(scen):
+    d = sample_designs(scen, 20, seed=0, ranges={"W": (2e-3, 2.5e-3)}, fixed={"gama": 1.0})
+    assert d["W"].between(2e-3, 2.5e-3).all() and (d["gama"] == 1.0).all()
+    with pytest.raises(ValueError, match="unknown feature 'Wx'"):
+        sample_designs(scen, 5, ranges={"Wx": (0, 1)})
+    with pytest.raises(ValueError, match="method"):
+        sample_designs(scen, 5, method="grid")
+
+
+def test_interrupted_build_resumes_without_duplicates(scen, tmp_path, monkeypatch):
+    designs = sample_designs(scen, 7, seed=1)
+    calls = []
+    real = store.evaluate_designs
+
+    def counting(scenario, part, **kw):
+        calls.append(list(part["sample"]))
+        if len(calls) == 2 and not hasattr(counting, "interrupted"):
+            counting.interrupted = True
+            raise KeyboardInterrupt
+        return real(scenario, part, **kw)
+
+    monkeypatch.setattr(store, "evaluate_designs", counting)
+    with pytest.raises(KeyboardInterrupt):
+        store.build_database(scen, designs, tmp_path / "db", chunk_size=3)
+    assert len(list((tmp_path / "db" / "chunks").glob("*.parquet"))) == 1
+    calls.clear()
+    db = store.build_database(scen, designs, tmp_path / "db", chunk_size=3)
+    assert calls == [[3, 4, 5], [6]]  # only the missing chunks were simulated
+    assert list(db["sample"]) == list(range(7))
+    assert (db["status"] == "converged").all()
+    again = pd.read_parquet(tmp_path / "db" / "database.parquet")
+    pd.testing.assert_frame_equal(db, again)
+    other = sample_designs(scen, 7, seed=2)
+    with pytest.raises(ValueError, match="different design table"):
+        store.build_database(scen, other, tmp_path / "db", chunk_size=3)
+
+
+def test_generate_command(tmp_path, capsys):
+    out = tmp_path / "db"
+    assert main(["generate", "single-miura", "-n", "3", "-o", str(out), "--csv"]) == 0
+    db = pd.read_csv(out / "database.csv")
+    assert len(db) == 3 and (db["axialstiff60"] > 0).all()
+    assert "3 designs" in capsys.readouterr().out
+    assert main(["generate", "single-miura", "-n", "0", "-o", str(tmp_path / "x")]) == 2
+    assert not (tmp_path / "x").exists()
+    assert main(["generate", "nosuch", "-n", "3", "-o", str(tmp_path / "y")]) == 2

@@ -1,0 +1,63 @@
+"""Verifying mined rules by fresh simulations, and the end-to-end demo."""
+
+import json
+
+import pytest
+
+from design.cli import main
+from design.scenarios import get_scenario
+from design.verify import rule_ranges, verify_rule
+
+
+def test_rule_ranges_intersect_the_scenario_box():
+    arch = get_scenario("arch")
+    r = rule_ranges(
+        arch, {"m": {"in": [8]}, "offset": {"gt": None, "le": 0.2}, "W": {"gt": 0.0035, "le": 0.01}}
+    )
+    assert r["m"] == [8.0]
+    assert r["offset"] == (0.1, 0.2)
+    assert r["W"] == (0.0035, 0.004)
+    with pytest.raises(ValueError, match="not a feature"):
+        rule_ranges(arch, {"Zstiff": {"gt": 1, "le": None}})
+    with pytest.raises(ValueError, match="outside the scenario's range"):
+        rule_ranges(arch, {"W": {"gt": 0.01, "le": None}})
+
+
+def test_verify_counts_designs_meeting_the_target():
+    # thin, soft creases and thin panels make a soft cell: the paper's axialstiff60 < 6000 rule
+    box = {"tcrease": {"gt": None, "le": 0.6e-3}, "tpanel": {"gt": None, "le": 1.2e-3},
+           "W": {"gt": 3.5e-3, "le": None}}  # fmt: skip
+    v = verify_rule("single-miura", box, "axialstiff60 < 6000", n=8, seed=1)
+    assert v.n_ok == 8 and v.n_failed == 0
+    d = v.designs
+    assert d["tcrease"].le(0.6e-3).all() and d["W"].ge(3.5e-3).all()
+    assert v.n_meeting == int((d["axialstiff60"] < 6000).sum())
+    assert v.precision == v.n_meeting / 8
+    lo, hi = v.interval
+    assert 0 <= lo <= v.precision <= hi <= 1
+    stiff = {"tcrease": {"gt": 0.95e-3, "le": None}, "tpanel": {"gt": 5.5e-3, "le": None}}
+    assert verify_rule("single-miura", stiff, "axialstiff60 < 6000", n=4).n_meeting == 0
+
+
+@pytest.mark.slow
+def test_demo_runs_end_to_end(tmp_path, capsys):
+    out = tmp_path / "demo"
+    assert main(["demo", "-o", str(out), "-n", "80", "--verify", "6", "--workers", "1"]) == 0
+    files = "1_fit/strip.fold 1_fit/strip.stl 2_database/database.parquet 3_rules/rules.json"
+    for f in (files + " 3_rules/rules.png 4_verify/verify.json summary.json").split():
+        assert (out / f).is_file(), f
+    summary = json.loads((out / "summary.json").read_text())
+    perf = summary["fitted_strip"]["performance"]
+    assert perf["Zstiff"] > 0 and perf["error"] == pytest.approx(0.0972, abs=1e-3)
+    assert summary["rules"] and summary["verification"][0]["simulated"] == 6
+    assert "done: best rule" in capsys.readouterr().out
+
+
+def test_verify_rejects_bad_rules_file(tmp_path):
+    bad = tmp_path / "rules.json"
+    bad.write_text("{not json")
+    assert main(["verify", "arch", "--rules", str(bad), "--target", "Zstiff > 1"]) == 2
+    bad.write_text(json.dumps([{"rule": "x"}]))
+    assert main(["verify", "arch", "--rules", str(bad), "--target", "Zstiff > 1"]) == 2
+    bad.write_text(json.dumps([{"bounds": {"m": {"in": [8]}}}]))
+    assert main(["verify", "arch", "--rules", str(bad), "--target", "Zsniff > 1"]) == 2
