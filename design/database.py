@@ -96,8 +96,9 @@ def read_table(path, columns=None) -> pd.DataFrame:
         ``.txt`` / ``.dat``.
     columns : sequence of str, optional
         Names of the columns of a headerless file. When omitted, a sibling
-        ``*_FeatureName.txt`` (whitespace-separated names) is used if present. For files with
-        a header, selects these columns.
+        ``*_FeatureName.txt`` (whitespace-separated names) is used if present; a file with
+        fewer columns than it names takes the first names (a table of design features only).
+        For files with a header, selects these columns.
 
     Returns
     -------
@@ -116,11 +117,18 @@ def read_table(path, columns=None) -> pd.DataFrame:
         raise FileNotFoundError(f"database {path} does not exist")
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        frame = pd.read_csv(path)
+        try:
+            frame = pd.read_csv(path)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+            raise ValueError(f"{path.name} is not a readable CSV table: {exc}") from None
     elif suffix in (".parquet", ".pq"):
-        frame = pd.read_parquet(path)
+        try:
+            frame = pd.read_parquet(path)
+        except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
+            raise ValueError(f"{path.name} is not a readable Parquet file: {exc}") from None
     elif suffix in (".txt", ".dat"):
         names = list(columns) if columns is not None else None
+        sibling_names = names is None
         if names is None:
             sib = feature_name_file(path)
             if sib is None:
@@ -133,6 +141,8 @@ def read_table(path, columns=None) -> pd.DataFrame:
             data = np.loadtxt(path, delimiter=",", ndmin=2)
         except ValueError as exc:
             raise ValueError(f"{path.name}: not a comma-separated numeric table ({exc})") from exc
+        if sibling_names and data.shape[1] < len(names):
+            names = names[: data.shape[1]]  # a table of the leading (feature) columns only
         if data.shape[1] != len(names):
             raise ValueError(
                 f"{path.name} has {data.shape[1]} columns but {len(names)} names were given: "

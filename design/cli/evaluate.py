@@ -15,7 +15,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from design.runner import evaluate_designs, validate_designs
@@ -75,48 +74,17 @@ def _epilog() -> str:
     return "\n".join(lines)
 
 
-def _feature_names_file(path: Path) -> Path:
-    prefix = path.stem.split("_", 1)[0]
-    return path.with_name(f"{prefix}_FeatureName.txt")
-
-
 def read_designs(path: Path) -> pd.DataFrame:
     """Read a design table (.csv, .parquet/.pq, or a published headerless .txt)."""
+    from design.database import read_table
+
     path = Path(path)
-    suffix = path.suffix.lower()
-    if not path.is_file():
-        raise OSError(f"design table {path} does not exist")
-    if suffix in _CSV:
-        try:
-            return pd.read_csv(path)
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{path} is not a readable CSV table: {exc}") from None
-    if suffix in _PARQUET:
-        try:
-            return pd.read_parquet(path)
-        except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
-            raise ValueError(f"{path} is not a readable Parquet file: {exc}") from None
-    if suffix in _TXT:
-        names_file = _feature_names_file(path)
-        if not names_file.is_file():
-            raise OSError(
-                f"{path} is a headerless .txt; its column names must be in {names_file}, "
-                "which does not exist"
-            )
-        names = names_file.read_text().split()
-        try:
-            arr = np.loadtxt(path, delimiter=",", ndmin=2)
-        except ValueError as exc:
-            raise ValueError(f"{path} is not a comma-separated numeric table: {exc}") from None
-        if arr.shape[1] > len(names):
-            raise ValueError(
-                f"{path} has {arr.shape[1]} columns but {names_file} names only {len(names)}"
-            )
-        return pd.DataFrame(arr, columns=names[: arr.shape[1]])
-    raise ValueError(
-        f"design table {path}: unknown extension {path.suffix!r}; allowed: .csv, .parquet, "
-        ".pq, .txt"
-    )
+    if path.suffix.lower() not in _CSV + _PARQUET + _TXT:
+        raise ValueError(
+            f"design table {path}: unknown extension {path.suffix!r}; allowed: .csv, .parquet, "
+            ".pq, .txt"
+        )
+    return read_table(path)
 
 
 def _check_output(path: Path) -> None:
