@@ -148,6 +148,7 @@ def evaluate_designs(
     workers: int = 1,
     progress: bool | None = None,
     limit_threads: bool = True,
+    log_warnings: bool = True,
 ) -> pd.DataFrame:
     """Simulate every row of ``table`` with ``scenario``.
 
@@ -165,6 +166,9 @@ def evaluate_designs(
     limit_threads : bool
         Limit BLAS to one thread per evaluation (the small dense solves are much slower
         when several threads contend for the cores).
+    log_warnings : bool
+        Log values outside the paper's sampling ranges (callers that report
+        ``validate_designs(...).warnings`` themselves pass False).
 
     Returns
     -------
@@ -177,7 +181,7 @@ def evaluate_designs(
     if workers == 0 or workers < -1:
         raise DesignTableError(f"workers = {workers} must be >= 1 or -1 (all cores)")
     checked = validate_designs(scenario, table)
-    for w in checked.warnings:
+    for w in checked.warnings if log_warnings else ():
         log.warning("outside the paper's sampling ranges: %s", w)
     if progress is None:
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import shutil
 
 import numpy as np
@@ -30,6 +31,8 @@ def test_csv_in_csv_out(tmp_path, data0, capsys):
     assert np.allclose(res[PERF].to_numpy(), data0[PERF].to_numpy(), rtol=1e-4)
     assert (res["status"] == "converged").all()
     assert "3 design(s) evaluated" in capsys.readouterr().out
+    # the command leaves the library's logging alone (in-process callers still get warnings)
+    assert logging.getLogger("design.runner").level == logging.NOTSET
 
 
 def test_parquet_in_parquet_out(tmp_path, data0):

@@ -9,7 +9,6 @@ columns and ``status`` (CSV or Parquet, by the output's extension).
 from __future__ import annotations
 
 import argparse
-import logging
 import os
 import sys
 import tempfile
@@ -124,12 +123,12 @@ def run(args) -> int:
     checked = validate_designs(scenario, table)  # raises before anything is simulated
     for w in checked.warnings:
         print(f"holofold evaluate: warning: {w}", file=sys.stderr)
-    logging.getLogger("design.runner").setLevel(logging.ERROR)  # warnings printed above
     res = evaluate_designs(
         scenario,
         table,
         workers=args.workers,
         progress=False if args.no_progress else None,
+        log_warnings=False,  # printed above
     )
     write_results(res, args.output)
     ok = (res["status"] == "converged").sum()
