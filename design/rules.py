@@ -430,6 +430,11 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         F-beta used for ranking (beta < 1 favours precision).
     n_rules : int, default=3
         How many rules to keep (the top k alternatives).
+    max_overlap : float in (0, 1] or None, default=None
+        Make the alternatives distinct: walking down the ranking, a rule is kept only if the
+        training rows it covers overlap those of every rule kept before it by at most this
+        Jaccard index (|A and B| / |A or B|). None keeps the plain top k, which are often
+        near-copies of one box.
     scoring : {"oob", "train"}, default="oob"
         Rows on which the precision used for *ranking* is estimated: the out-of-bag rows of
         the trees that found the rule (pooled over those trees; an honest estimate), or all
@@ -499,6 +504,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         "min_support": [Interval(Integral, 1, None, closed="left")],
         "beta": [Interval(Real, 0, None, closed="neither")],
         "n_rules": [Interval(Integral, 1, None, closed="left")],
+        "max_overlap": [Interval(Real, 0, 1, closed="right"), None],
         "scoring": [StrOptions({"train", "oob"})],
         "ranking": [StrOptions({"fbeta", "lcb"})],
         "categorical_features": ["array-like", None],
@@ -524,6 +530,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         min_support=10,
         beta=0.2,
         n_rules=3,
+        max_overlap=None,
         scoring="oob",
         ranking="lcb",
         categorical_features=None,
@@ -545,6 +552,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         self.min_support = min_support
         self.beta = beta
         self.n_rules = n_rules
+        self.max_overlap = max_overlap
         self.scoring = scoring
         self.ranking = ranking
         self.categorical_features = categorical_features
@@ -800,13 +808,14 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         }
         self._candidate_frame = None
         k = self.n_rules
+        pick = self._pick(Z32, k)
         self.rules_ = self._rules_frame(
-            self._all_lower[:k],
-            self._all_upper[:k],
-            {key: v[:k] for key, v in self._all_stats.items()},
+            self._all_lower[pick],
+            self._all_upper[pick],
+            {key: v[pick] for key, v in self._all_stats.items()},
         )
-        self._lower = self._all_lower[:k]
-        self._upper = self._all_upper[:k]
+        self._lower = self._all_lower[pick]
+        self._upper = self._all_upper[pick]
         if len(self.rules_) < k:
             msg = (
                 f"only {len(self.rules_)} of the {k} requested rules reach precision >= "
@@ -815,6 +824,29 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             )
             logger.info(msg)
             warnings.warn(msg, FewRulesWarning, stacklevel=3)
+
+    def _pick(self, Z32: np.ndarray, k: int) -> np.ndarray:
+        """Positions in the ranking of the rules to keep (the top k, or distinct ones)."""
+        n = len(self._all_lower)
+        if self.max_overlap is None or n <= 1:
+            return np.arange(min(k, n))
+        kept: list[int] = []
+        covered: list[np.ndarray] = []
+        for start in range(0, n, 256):  # rows covered, for a block of candidates at a time
+            block = boxes_contain(
+                self._all_lower[start : start + 256], self._all_upper[start : start + 256], Z32
+            )
+            for j, rows in enumerate(block):
+                inter = [np.count_nonzero(rows & c) for c in covered]
+                union = [np.count_nonzero(rows | c) for c in covered]
+                if all(
+                    i <= self.max_overlap * max(u, 1) for i, u in zip(inter, union, strict=True)
+                ):
+                    kept.append(start + j)
+                    covered.append(rows)
+                    if len(kept) == k:
+                        return np.asarray(kept)
+        return np.asarray(kept, dtype=np.intp)
 
     @property
     def candidate_rules_(self) -> pd.DataFrame:

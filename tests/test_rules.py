@@ -309,3 +309,22 @@ def test_feature_names_for_arrays():
     assert m.rules_.loc[0, "rule"].startswith("W > 0.69")
     assert m.rules_.loc[0, "W_gt"] == pytest.approx(0.7, abs=0.01)
     assert "W_gt" in m.rules_.columns
+
+
+def test_max_overlap_gives_distinct_alternatives(reference_data):
+    db = reference_data.load("data3_ShapeFit")
+    feats = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]
+    X, y = db[feats], (db["Zsnap"] == 1).to_numpy()
+    kw = dict(categorical_features=["m"], random_state=0, n_estimators=40, n_rules=3)
+    plain = ForestRuleMiner(**kw).fit(X, y)
+    distinct = ForestRuleMiner(**kw, max_overlap=0.5).fit(X, y)
+    assert distinct.rules_["rule"].iloc[0] == plain.rules_["rule"].iloc[0]  # same best rule
+    cover = distinct.rule_matches(X, which="top")
+    assert cover.shape[0] == len(distinct.rules_) >= 2
+    for i in range(len(cover)):
+        for j in range(i):
+            inter = np.count_nonzero(cover[i] & cover[j])
+            union = np.count_nonzero(cover[i] | cover[j])
+            assert inter <= 0.5 * union
+    # the candidates are the same; only which alternatives are shown changes
+    assert len(distinct.candidate_rules_) == len(plain.candidate_rules_)

@@ -89,7 +89,8 @@ def run(args) -> int:
     rules.mkdir(exist_ok=True)
     call(
         ["mine", str(db / "database.parquet"), "--target", args.target, "--seed", str(args.seed),
-         "--json", str(rules / "rules.json"), "--plot", str(rules / "rules.png")]
+         "--max-overlap", "0.5", "--json", str(rules / "rules.json"),
+         "--plot", str(rules / "rules.png")]
     )  # fmt: skip
     mined = json.loads((rules / "rules.json").read_text())
     summary["rules"] = mined

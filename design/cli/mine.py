@@ -65,6 +65,13 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--min-support", type=int, default=10, help="default 10")
     p.add_argument("--beta", type=float, default=0.2, help="F-beta for ranking (default 0.2)")
     p.add_argument(
+        "--max-overlap",
+        type=float,
+        default=None,
+        metavar="J",
+        help="keep only alternatives whose covered rows overlap earlier rules' by Jaccard <= J",
+    )
+    p.add_argument(
         "--scoring",
         choices=("oob", "train"),
         default="oob",
@@ -116,6 +123,8 @@ def run(args) -> int:
         raise ValueError(f"--min-support must be >= 1, got {args.min_support}")
     if args.beta <= 0:
         raise ValueError(f"--beta must be > 0, got {args.beta}")
+    if args.max_overlap is not None and not 0 < args.max_overlap <= 1:
+        raise ValueError(f"--max-overlap must be in (0, 1], got {args.max_overlap}")
     json_path = _check_output(args.json, "--json")
     plot_path = _check_output(args.plot, "--plot", _PLOT_SUFFIXES)
 
@@ -175,6 +184,7 @@ def run(args) -> int:
         min_support=args.min_support,
         beta=args.beta,
         n_rules=args.rules,
+        max_overlap=args.max_overlap,
         scoring=args.scoring,
         ranking=args.ranking,
         categorical_features=cats or None,
