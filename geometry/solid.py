@@ -9,10 +9,14 @@ fanned from their centre. Panels must be convex (every generator of holofold giv
 panels); a crease wider than a panel allows raises :class:`ParameterError`.
 
 The prisms are unioned with manifold3d into one watertight solid (disjoint pieces stay
-separate bodies of the same mesh), or returned one per panel.
+separate bodies of the same mesh), or returned one per panel. When panels overlap in the folded
+state (too thick for their hinge gaps at that fold angle) a :class:`SolidWarning` says by how
+much.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 import trimesh
@@ -20,7 +24,11 @@ import trimesh
 from geometry.errors import ParameterError
 from geometry.pattern import CreasePattern, newell_normals, orient_faces
 
-__all__ = ["shrunk_panels", "panel_solids", "thick_solid"]
+__all__ = ["shrunk_panels", "panel_solids", "thick_solid", "SolidWarning"]
+
+
+class SolidWarning(UserWarning):
+    """The thick panels of a folded state overlap (the part would not print as designed)."""
 
 
 def _edge_index(pattern: CreasePattern) -> dict[tuple[int, int], int]:
@@ -128,6 +136,15 @@ def thick_solid(
         for s in solids
     ]  # fmt: skip
     whole = m3d.Manifold.batch_boolean(parts, m3d.OpType.Add)
+    total = sum(p.volume() for p in parts)
+    lost = 1.0 - whole.volume() / total if total > 0 else 0.0
+    if lost > 1e-6:
+        warnings.warn(
+            f"thick panels intersect in this folded state ({100 * lost:.3g} % of their volume "
+            "overlaps): use thinner panels or wider creases for a printable part",
+            SolidWarning,
+            stacklevel=2,
+        )
     mesh = whole.to_mesh()
     return trimesh.Trimesh(
         vertices=np.asarray(mesh.vert_properties)[:, :3], faces=np.asarray(mesh.tri_verts)

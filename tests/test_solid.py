@@ -8,7 +8,7 @@ import pytest
 
 from geometry.errors import ParameterError
 from geometry.miura import miura_sheet
-from geometry.solid import panel_solids, shrunk_panels, thick_solid
+from geometry.solid import SolidWarning, panel_solids, shrunk_panels, thick_solid
 from geometry.tmp import tmp_sheet
 
 W, T = 2e-3, 0.5e-3
@@ -70,3 +70,14 @@ def test_crease_wider_than_panel_and_bad_thickness_raise():
         thick_solid(p, -1e-3, W)
     with pytest.raises(ParameterError, match="crease width"):
         shrunk_panels(p, -1.0)
+
+
+def test_overlapping_thick_panels_are_reported():
+    p = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
+    with pytest.warns(SolidWarning, match="panels intersect"):
+        thick_solid(p, 1e-3, W)  # 1 mm panels with 2 mm gaps collide at ext 0.6
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        thick_solid(p, T, W)  # 0.5 mm panels do not

@@ -16,7 +16,7 @@ import argparse
 
 TARGET = "Zstiff > 100 & error < 0.1"
 STRIP = {"m": 12, "offset": 0.2, "stripeWidth": 0.02, "extrude": 0.1}
-MATERIAL = {"tcrease": 0.8e-3, "tpanel": 3e-3, "W": 2e-3}
+MATERIAL = {"tcrease": 0.8e-3, "tpanel": 2e-3, "W": 3e-3}  # a printable strip: no panel overlap
 
 
 def register(subparsers) -> argparse.ArgumentParser:
