@@ -10,6 +10,7 @@ import trimesh
 
 from design.cli import main
 from fitting.error import paper_error
+from geometry.solid import SolidWarning
 
 BASE = ["fit", "--curve", "half-circle:radius=2"]
 DESIGN = ["--m", "12", "--offset", "0.2", "--strip-width", "0.02", "--extrude", "0.1"]
@@ -83,7 +84,8 @@ def test_fit_auto(tmp_path, capsys):
 def test_thick_solid(tmp_path, capsys):
     out = tmp_path / "solid"
     thick = ["--panel-thickness", "0.004", "--crease-width", "0.002"]
-    assert main([*BASE, *DESIGN, *thick, "-o", str(out)]) == 0
+    with pytest.warns(SolidWarning, match="panels intersect"):  # 4 mm panels, 2 mm gaps
+        assert main([*BASE, *DESIGN, *thick, "-o", str(out)]) == 0
     s = _summary(capsys)
     assert str(out / "strip_solid.stl") in s["files"]
     mesh = trimesh.load(out / "strip_solid.stl")
