@@ -588,7 +588,6 @@ class CreasePattern:
             asg = self.assignment.copy()
             mv = np.isin(asg, ("M", "V", "F"))
             asg[mv] = np.where(a[mv] > 0, "V", np.where(a[mv] < 0, "M", asg[mv]))
-            asg[mv & (a == 0) & (asg == "F")] = "F"
             new = replace(new, fold_angle=a, assignment=asg)
         return new
 
