@@ -21,7 +21,7 @@ import warnings
 import numpy as np
 import trimesh
 
-from geometry.errors import ParameterError
+from geometry.errors import DegenerateGeometryError, ParameterError
 from geometry.pattern import CreasePattern, newell_normals, orient_faces
 
 __all__ = ["shrunk_panels", "panel_solids", "thick_solid", "SolidWarning"]
@@ -146,6 +146,13 @@ def thick_solid(
             stacklevel=2,
         )
     mesh = whole.to_mesh()
-    return trimesh.Trimesh(
+    out = trimesh.Trimesh(
         vertices=np.asarray(mesh.vert_properties)[:, :3], faces=np.asarray(mesh.tri_verts)
     )
+    if not out.is_watertight:
+        raise DegenerateGeometryError(
+            "the thick panels of this folded state overlap so much that their union is not a "
+            f"watertight solid ({100 * lost:.3g} % of the volume overlaps); use thinner panels, "
+            "wider creases or a less folded state"
+        )
+    return out

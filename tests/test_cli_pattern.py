@@ -68,3 +68,22 @@ def test_bad_arguments_exit_nonzero_and_write_nothing(tmp_path, capsys, extra, m
     assert code == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_overlapping_thick_tmp_is_refused_and_mild_overlap_is_a_one_line_warning(tmp_path, capsys):
+    out = tmp_path / "tmp"
+    argv = ["pattern", "tmp", "--m", "6", "--n", "6", "--size", "0.2", "--ext", "0.6",
+            "--thickness", "0.5e-3", "-o", str(out)]  # fmt: skip
+    assert main(argv) == 2  # the folded tubes run through each other: no watertight solid
+    assert "not a watertight solid" in capsys.readouterr().err
+    assert not out.exists()
+    ok = tmp_path / "miura"
+    argv = ["pattern", "miura", "--m", "4", "--n", "4", "--gamma", "60", "--ext", "0.6",
+            "--size", "0.2", "--thickness", "2e-3", "--crease-width", "2e-3",
+            "-o", str(ok)]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("holofold pattern: warning: thick panels intersect") and err.count("\n") == 1
+    )
+    assert (ok / "thick.stl").is_file()

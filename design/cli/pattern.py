@@ -74,13 +74,15 @@ def _build(args):
 
 
 def run(args) -> int:
+    import sys
+    import warnings
     from pathlib import Path
 
     import numpy as np
 
     from geometry.errors import check_range
     from geometry.export import export
-    from geometry.solid import shrunk_panels, thick_solid
+    from geometry.solid import SolidWarning, shrunk_panels, thick_solid
 
     pattern = _build(args)
     W = check_range("--crease-width", args.crease_width, 0.0, None)
@@ -88,7 +90,11 @@ def run(args) -> int:
     if args.thickness is not None:
         t = check_range("--thickness", args.thickness, 0.0, None, low_open=True)
         shrunk_panels(pattern, W)  # a crease wider than a panel fails here, before any output
-        solid = thick_solid(pattern, t, W)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SolidWarning)
+            solid = thick_solid(pattern, t, W)
+        for w in caught:
+            print(f"holofold pattern: warning: {w.message}", file=sys.stderr)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     written = [
