@@ -28,6 +28,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from design.database import read_table  # noqa: E402
 from design.runner import evaluate_designs  # noqa: E402
 from design.scenarios import get_scenario  # noqa: E402
 
@@ -53,9 +54,8 @@ def reference_folder(arg: str | None) -> Path:
 
 
 def load(folder: Path, stem: str) -> pd.DataFrame:
-    names = (folder / f"{stem.split('_')[0]}_FeatureName.txt").read_text().split()
-    arr = np.loadtxt(folder / f"{stem}.txt", delimiter=",", ndmin=2)
-    return pd.DataFrame(arr, columns=names)
+    """A published file with its column names (from the sibling *_FeatureName.txt)."""
+    return read_table(folder / f"{stem}.txt")
 
 
 def rel_err(ours, ref) -> np.ndarray:

@@ -22,7 +22,6 @@ next to the repository, ``$HOLOFOLD_REFERENCE_DATA`` or ``--data``.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -38,6 +37,7 @@ from design.scenarios.gripper import (  # noqa: E402
     decode_closing_step,
     simulate,
 )
+from validation.reproduce import load, reference_folder  # noqa: E402
 
 STEMS = {1: "data2_MiuraBased_sample", 2: "data2_SplittedMiura_sample", 3: "data2_TwoPanel_sample"}
 NAMES = {1: "Miura-based", 2: "splitted Miura", 3: "two-panel"}
@@ -48,19 +48,6 @@ OUTPUTS = ["freqFinal", "finalQ", "Tmax", "stiff"]
 def emit(text: str = "") -> None:
     sys.stdout.write(text + "\n")
     sys.stdout.flush()
-
-
-def reference_folder(arg: str | None) -> Path:
-    default = ROOT.parent / "shared" / "reference-data"
-    for c in (arg, os.environ.get("HOLOFOLD_REFERENCE_DATA"), default):
-        if c and (Path(c) / "README.md").is_file():
-            return Path(c)
-    raise SystemExit("reference data not found: pass --data or set HOLOFOLD_REFERENCE_DATA")
-
-
-def load(folder: Path, stem: str) -> pd.DataFrame:
-    names = (folder / "data2_FeatureName.txt").read_text().split()
-    return pd.DataFrame(np.loadtxt(folder / f"{stem}.txt", delimiter=",", ndmin=2), columns=names)
 
 
 def _run(row: dict, perturb: float = 0.0) -> dict:
