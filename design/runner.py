@@ -3,8 +3,9 @@
 :func:`evaluate_designs` checks every row before anything is simulated (missing columns,
 non-numeric or physically invalid values are reported together, with their 1-based row numbers,
 as one :class:`DesignTableError`), warns about values outside the paper's sampling ranges, then
-evaluates the rows (optionally on several worker processes with joblib) and returns the rows in
-the same order with the performance columns and ``status``. A row whose simulation raises gets
+evaluates the rows (optionally on several worker processes with joblib, or on a Dask cluster
+given its scheduler address) and returns the rows in the same order with the performance columns
+and ``status``. A row whose simulation raises (or whose Dask worker dies) gets
 ``status = "failed: <reason>"`` and empty (NaN) outputs; the batch goes on.
 """
 
@@ -12,8 +13,12 @@ from __future__ import annotations
 
 import logging
 import math
+import os
+import re
 import sys
 from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,11 +27,20 @@ import pandas as pd
 from design.scenarios import Scenario, get_scenario
 from design.scenarios.base import single_thread
 
-__all__ = ["DesignTableError", "ValidatedTable", "validate_designs", "evaluate_designs"]
+__all__ = [
+    "DesignTableError",
+    "ValidatedTable",
+    "validate_designs",
+    "evaluate_designs",
+    "check_scheduler",
+    "dask_scheduler",
+]
 
 log = logging.getLogger(__name__)
 
 _MAX_LISTED = 20
+# scheme://host:port, host a name, an IPv4 address or a bracketed IPv6 address
+_ADDRESS = re.compile(r"[a-z][a-z0-9+.-]*://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):[0-9]{1,5}")
 
 
 class DesignTableError(ValueError):
@@ -126,19 +140,152 @@ def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
     return ValidatedTable(rows=rows, warnings=warnings)
 
 
+def _failed(scenario: Scenario, exc: BaseException) -> dict:
+    """NaN outputs and ``status = "failed: <ExceptionName>: <first line of the message>"``."""
+    reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    out = {c: float("nan") for c in scenario.performance_names}
+    out["status"] = f"failed: {type(exc).__name__}: {reason}"
+    return out
+
+
 def _evaluate_one(scenario: Scenario, row: dict, limit_threads: bool) -> dict:
     """Evaluate one row; any exception becomes a ``failed: ...`` status."""
     try:
         if limit_threads:
             with single_thread():
-                out = scenario.evaluate(row)
-        else:
-            out = scenario.evaluate(row)
+                return scenario.evaluate(row)
+        return scenario.evaluate(row)
     except Exception as exc:  # noqa: BLE001 - a failed row must not stop the batch
-        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        out = {c: float("nan") for c in scenario.performance_names}
-        out["status"] = f"failed: {type(exc).__name__}: {reason}"
-    return out
+        return _failed(scenario, exc)
+
+
+def check_scheduler(scheduler: str) -> str:
+    """Check a Dask scheduler address before anything is done with it.
+
+    Parameters
+    ----------
+    scheduler : str
+        ``"local"`` (a local Dask cluster) or an address ``scheme://host:port`` such as
+        ``tcp://10.0.0.5:8786``.
+
+    Returns
+    -------
+    str
+        The address without surrounding blanks (``"local"`` in lower case).
+
+    Raises
+    ------
+    ValueError
+        The address does not look like one, or the optional package ``distributed`` is
+        missing.
+    """
+    address = str(scheduler).strip()
+    if address.lower() == "local":
+        address = "local"
+    elif not _ADDRESS.fullmatch(address) or int(address.rsplit(":", 1)[1]) > 65535:
+        raise ValueError(
+            f"Dask scheduler {scheduler!r} is not an address: expected 'local' or "
+            "scheme://host:port, e.g. tcp://10.0.0.5:8786"
+        )
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        raise ValueError(
+            f"running on a Dask cluster (scheduler {address!r}) needs the optional package "
+            'distributed: pip install "holofold[cluster]"'
+        ) from None
+    return address
+
+
+@contextmanager
+def dask_scheduler(scheduler: str, workers: int = 1) -> Iterator[str]:
+    """Context manager giving the address of a running Dask scheduler.
+
+    Parameters
+    ----------
+    scheduler : str
+        An address (checked by :func:`check_scheduler`, used as is) or ``"local"``: a
+        ``distributed.LocalCluster`` runs for the duration of the block with ``workers``
+        single-threaded worker processes (every core when ``workers`` is 1 or -1).
+    workers : int
+        Worker processes of the local cluster; ignored for a remote scheduler.
+
+    Yields
+    ------
+    str
+        The scheduler address.
+    """
+    address = check_scheduler(scheduler)
+    workers = int(workers)
+    if workers == 0 or workers < -1:
+        raise ValueError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    if address != "local":
+        if workers != 1:
+            log.info("workers = %s ignored: the Dask cluster at %s has its own", workers, address)
+        yield address
+        return
+    from distributed import LocalCluster
+
+    n = (os.cpu_count() or 1) if workers in (1, -1) else workers
+    log.info("starting a local Dask cluster with %d worker process(es)", n)
+    # LocalCluster quietens only distributed's own handler; its INFO records would still reach
+    # the root logger's handlers (as in the CLI), so quieten the logger for the block
+    quiet = logging.getLogger("distributed")
+    level = quiet.level
+    quiet.setLevel(max(level, logging.WARNING))
+    try:
+        with LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster:
+            yield cluster.scheduler_address
+    finally:
+        quiet.setLevel(level)
+
+
+def _worker_ready(scenario: Scenario) -> str:
+    """Run on every Dask worker before a batch: unpickling ``scenario`` imports holofold."""
+    return scenario.name
+
+
+def _evaluate_on_dask(
+    scenario: Scenario, rows: list, limit_threads: bool, address: str, progress: bool
+) -> list:
+    """Evaluate ``rows`` on the Dask scheduler at ``address``; results in input order.
+
+    A task that errs outside :func:`_evaluate_one` (its worker died: ``KilledWorker``)
+    becomes a failed row. Workers that cannot import holofold, or a lost scheduler (cancelled
+    futures), raise: nothing of the batch is kept.
+    """
+    from distributed import Client, as_completed
+
+    n = len(rows)
+    outs: list = [None] * n
+    with Client(address, set_as_default=False) as client:
+        # a worker that cannot unpickle a task drops out of the cluster and the batch would wait
+        # forever; client.run reports the same failure instead
+        try:
+            ready = client.run(_worker_ready, scenario)
+        except Exception as exc:  # noqa: BLE001 - whatever the workers raised
+            raise ValueError(
+                f"the Dask workers of {address} cannot run holofold ({exc}); install it on "
+                'every worker: pip install "holofold[cluster]"'
+            ) from None
+        if not ready:
+            log.warning("no Dask workers at %s yet: the designs wait for some to join", address)
+        futures = client.map(_evaluate_one, [scenario] * n, rows, [limit_threads] * n, pure=False)
+        where = {f.key: i for i, f in enumerate(futures)}
+        done = as_completed(futures, loop=client.loop)
+        if progress:
+            from tqdm import tqdm
+
+            done = tqdm(done, total=n, desc=scenario.name, unit="design", file=sys.stderr)
+        for f in done:
+            if f.status == "error":
+                outs[where[f.key]] = _failed(scenario, f.exception())
+            else:
+                outs[where[f.key]] = f.result()
+            f.release()
+    return outs
 
 
 def evaluate_designs(
@@ -149,6 +296,7 @@ def evaluate_designs(
     progress: bool | None = None,
     limit_threads: bool = True,
     log_warnings: bool = True,
+    scheduler: str | None = None,
 ) -> pd.DataFrame:
     """Simulate every row of ``table`` with ``scenario``.
 
@@ -160,7 +308,9 @@ def evaluate_designs(
         Feature columns in SI units (names as in the published files); other columns are
         kept. Input columns named like a performance column are replaced.
     workers : int
-        Worker processes (joblib); 1 runs in this process. -1 uses every core.
+        Worker processes (joblib); 1 runs in this process. -1 uses every core. With
+        ``scheduler="local"``: the local Dask cluster's worker processes (1 or -1: every
+        core); ignored for a remote scheduler.
     progress : bool, optional
         Show a tqdm progress bar; default only when stderr is a terminal.
     limit_threads : bool
@@ -169,6 +319,10 @@ def evaluate_designs(
     log_warnings : bool
         Log values outside the paper's sampling ranges (callers that report
         ``validate_designs(...).warnings`` themselves pass False).
+    scheduler : str, optional
+        Run on a Dask cluster instead of joblib: its scheduler address
+        (``tcp://host:8786``), or ``"local"`` for a local cluster started for this call (see
+        :func:`dask_scheduler`). Needs the ``cluster`` extra.
 
     Returns
     -------
@@ -180,12 +334,18 @@ def evaluate_designs(
     workers = int(workers)
     if workers == 0 or workers < -1:
         raise DesignTableError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    if scheduler is not None:
+        scheduler = check_scheduler(scheduler)
     checked = validate_designs(scenario, table)
     for w in checked.warnings if log_warnings else ():
         log.warning("outside the paper's sampling ranges: %s", w)
     if progress is None:
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
     n = len(checked.rows)
+    if scheduler is not None and n:
+        with dask_scheduler(scheduler, workers) as address:
+            outs = _evaluate_on_dask(scenario, checked.rows, limit_threads, address, progress)
+        return _assemble(scenario, table, outs)
     if workers == 1 or n <= 1:
         results = (_evaluate_one(scenario, r, limit_threads) for r in checked.rows)
     else:
@@ -197,7 +357,11 @@ def evaluate_designs(
         from tqdm import tqdm
 
         results = tqdm(results, total=n, desc=scenario.name, unit="design", file=sys.stderr)
-    outs = list(results)
+    return _assemble(scenario, table, list(results))
+
+
+def _assemble(scenario: Scenario, table: pd.DataFrame, outs: list) -> pd.DataFrame:
+    """The input rows (index kept), then the performance columns and ``status``."""
     perf = scenario.performance_names
     keep = [c for c in table.columns if c not in perf and c != "status"]
     replaced = [c for c in table.columns if c in perf or c == "status"]

@@ -18,12 +18,13 @@ import json
 import logging
 import os
 import sys
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from design.runner import evaluate_designs, validate_designs
+from design.runner import check_scheduler, dask_scheduler, evaluate_designs, validate_designs
 from design.scenarios import Scenario, get_scenario
 
 __all__ = ["build_database", "load_database"]
@@ -55,6 +56,7 @@ def build_database(
     workers: int = 1,
     progress: bool | None = None,
     meta: dict | None = None,
+    scheduler: str | None = None,
 ) -> pd.DataFrame:
     """Simulate ``designs`` into ``folder``, resuming whatever an earlier run left there.
 
@@ -68,11 +70,15 @@ def build_database(
     chunk_size : int
         Rows per result chunk: the unit of work lost at most when a run is interrupted.
     workers : int
-        Worker processes per chunk (joblib).
+        Worker processes per chunk (joblib), or of the local Dask cluster with
+        ``scheduler="local"``.
     progress : bool, optional
         Progress bar on stderr (default: only on a terminal).
     meta : dict, optional
         Extra metadata stored in ``meta.json`` (seed, sampling method, ...).
+    scheduler : str, optional
+        Simulate on a Dask cluster: a scheduler address (``tcp://host:8786``) or ``"local"``
+        (one local cluster for the whole run); see :func:`design.runner.evaluate_designs`.
 
     Returns
     -------
@@ -85,6 +91,10 @@ def build_database(
     chunk_size = int(chunk_size)
     if chunk_size < 1:
         raise ValueError(f"chunk_size = {chunk_size} must be >= 1")
+    if int(workers) == 0 or int(workers) < -1:
+        raise ValueError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    if scheduler is not None:
+        scheduler = check_scheduler(scheduler)
     validate_designs(scenario, designs)  # every row checked before anything is simulated
     folder = Path(folder)
     chunks = folder / "chunks"
@@ -136,13 +146,22 @@ def build_database(
             unit="design",
             file=sys.stderr,
         )
+    # a local Dask cluster is started once for all chunks, not once per chunk
+    cluster = dask_scheduler(scheduler, workers) if scheduler and todo else nullcontext()
     try:
-        for k in todo:
-            part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
-            res = evaluate_designs(scenario, part, workers=workers, progress=False)
-            _write_atomic(res, chunks / f"part-{k:05d}.parquet")
-            if bar is not None:
-                bar.update(len(part))
+        with cluster as address:
+            for k in todo:
+                part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
+                res = evaluate_designs(
+                    scenario,
+                    part,
+                    workers=1 if address else workers,
+                    progress=False,
+                    scheduler=address,
+                )
+                _write_atomic(res, chunks / f"part-{k:05d}.parquet")
+                if bar is not None:
+                    bar.update(len(part))
     finally:
         if bar is not None:
             bar.close()

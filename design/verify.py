@@ -94,13 +94,20 @@ def verify_rule(
     seed: int = 0,
     workers: int = 1,
     progress: bool | None = None,
+    scheduler: str | None = None,
 ) -> Verification:
-    """Simulate ``n`` fresh designs inside a rule and count those meeting ``target``."""
+    """Simulate ``n`` fresh designs inside a rule and count those meeting ``target``.
+
+    ``workers``, ``progress`` and ``scheduler`` (a Dask scheduler address or ``"local"``) are
+    passed to :func:`design.runner.evaluate_designs`.
+    """
     if isinstance(scenario, str):
         scenario = get_scenario(scenario)
     tgt = parse_target(target, scenario.performance_names)
     designs = sample_designs(scenario, n, seed=seed, ranges=rule_ranges(scenario, bounds))
-    res = evaluate_designs(scenario, designs, workers=workers, progress=progress)
+    res = evaluate_designs(
+        scenario, designs, workers=workers, progress=progress, scheduler=scheduler
+    )
     failed = res["status"].str.startswith("failed")
     meets = pd.Series(False, index=res.index)
     ok = res.loc[~failed]

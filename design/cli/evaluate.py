@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from design.runner import evaluate_designs, validate_designs
+from design.runner import check_scheduler, evaluate_designs, validate_designs
 from design.scenarios import SCENARIO_NAMES, get_scenario
 
 __all__ = ["register", "run", "read_designs", "write_results"]
@@ -48,7 +48,19 @@ def register(subparsers) -> argparse.ArgumentParser:
         "--workers",
         type=int,
         default=1,
-        help="worker processes (default 1; -1 = every core)",
+        help=(
+            "worker processes (default 1; -1 = every core); with --scheduler local the local "
+            "cluster's processes (1 = every core), ignored with a remote --scheduler"
+        ),
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help=(
+            "run on a Dask cluster at ADDRESS (e.g. tcp://host:8786), or 'local' for a local "
+            "Dask cluster with --workers processes; needs the cluster extra "
+            '(pip install "holofold[cluster]")'
+        ),
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     return p
@@ -70,6 +82,9 @@ def _epilog() -> str:
         lines.append(f"    -> {', '.join(sc.performance_names)}, status")
     lines.append("  (? = optional, default 2e9 Pa)")
     lines.append("example: holofold evaluate arch designs.csv -o results.parquet --workers 4")
+    lines.append(
+        "         holofold evaluate arch designs.csv -o out.csv --scheduler tcp://host:8786"
+    )
     return "\n".join(lines)
 
 
@@ -117,6 +132,8 @@ def run(args) -> int:
     _check_output(args.output)
     if args.workers == 0 or args.workers < -1:
         raise ValueError(f"--workers {args.workers}: must be >= 1 or -1 (every core)")
+    if args.scheduler is not None:
+        check_scheduler(args.scheduler)
     table = read_designs(args.designs)
     if len(table) == 0:
         raise ValueError(f"{args.designs} has no rows")
@@ -129,6 +146,7 @@ def run(args) -> int:
         workers=args.workers,
         progress=False if args.no_progress else None,
         log_warnings=False,  # printed above
+        scheduler=args.scheduler,
     )
     write_results(res, args.output)
     ok = (res["status"] == "converged").sum()

@@ -27,7 +27,24 @@ def register(subparsers) -> argparse.ArgumentParser:
         metavar="NAME=LOW:HIGH",
         help="override a feature's range (SI units), or NAME=A,B,C for categorical choices",
     )
-    p.add_argument("--workers", type=int, default=1, help="worker processes (-1: all cores)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help=(
+            "worker processes (-1: all cores); with --scheduler local the local cluster's "
+            "processes (1 = every core), ignored with a remote --scheduler"
+        ),
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help=(
+            "run on a Dask cluster at ADDRESS (e.g. tcp://host:8786), or 'local' for a local "
+            "Dask cluster with --workers processes; needs the cluster extra "
+            '(pip install "holofold[cluster]")'
+        ),
+    )
     p.add_argument("--chunk-size", type=int, default=100, help="rows per result chunk")
     p.add_argument("--csv", action="store_true", help="also write database.csv")
     return p
@@ -53,6 +70,7 @@ def _parse_ranges(items):
 def run(args) -> int:
     from pathlib import Path
 
+    from design.runner import check_scheduler
     from design.sampling import sample_designs
     from design.scenarios import get_scenario
     from design.store import build_database
@@ -60,6 +78,8 @@ def run(args) -> int:
     scenario = get_scenario(args.scenario)
     if args.samples < 1:
         raise ValueError(f"--samples = {args.samples} must be >= 1")
+    if args.scheduler is not None:
+        check_scheduler(args.scheduler)
     designs = sample_designs(
         scenario, args.samples, seed=args.seed, method=args.method, ranges=_parse_ranges(args.range)
     )
@@ -70,6 +90,7 @@ def run(args) -> int:
         chunk_size=args.chunk_size,
         workers=args.workers,
         meta={"seed": args.seed, "method": args.method, "ranges": args.range},
+        scheduler=args.scheduler,
     )
     if args.csv:
         db.to_csv(Path(args.output) / "database.csv", index=False)

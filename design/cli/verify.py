@@ -21,15 +21,34 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("-n", "--samples", type=int, default=50, help="designs per rule (default 50)")
     p.add_argument("--top", type=int, default=None, help="verify only the first K rules")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--workers", type=int, default=1)
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help=(
+            "worker processes (-1: all cores); with --scheduler local the local cluster's "
+            "processes (1 = every core), ignored with a remote --scheduler"
+        ),
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help=(
+            "run on a Dask cluster at ADDRESS (e.g. tcp://host:8786), or 'local' for a local "
+            "Dask cluster with --workers processes; needs the cluster extra "
+            '(pip install "holofold[cluster]")'
+        ),
+    )
     p.add_argument("-o", "--output", help="folder for verify.json and the simulated designs")
     return p
 
 
 def run(args) -> int:
     import json
+    from contextlib import nullcontext
     from pathlib import Path
 
+    from design.runner import check_scheduler, dask_scheduler
     from design.scenarios import get_scenario
     from design.targets import parse_target
     from design.verify import rule_ranges, verify_rule
@@ -38,6 +57,8 @@ def run(args) -> int:
     parse_target(args.target, scenario.performance_names)
     if args.samples < 1:
         raise ValueError(f"--samples = {args.samples} must be >= 1")
+    if args.scheduler is not None:
+        check_scheduler(args.scheduler)
     try:
         rules = json.loads(Path(args.rules).read_text())
     except json.JSONDecodeError as exc:
@@ -49,26 +70,30 @@ def run(args) -> int:
         rule_ranges(scenario, r["bounds"])  # all rules checked before simulating
     out = Path(args.output) if args.output else None
     report = []
-    for i, r in enumerate(rules, start=1):
-        v = verify_rule(
-            scenario,
-            r["bounds"],
-            args.target,
-            args.samples,
-            seed=args.seed + i,
-            workers=args.workers,
-        )
-        s = v.summary()
-        lo, hi = s["precision_95ci"]
-        print(
-            f"rule {i}: {r.get('rule', '')}\n  fresh designs meeting the target: "
-            f"{s['meeting_target']}/{s['simulated']} = {s['precision']:.3f} "
-            f"(95 % CI {lo:.3f}-{hi:.3f}; {s['failed']} failed)"
-        )
-        report.append({"rank": i, "rule": r.get("rule"), "bounds": r["bounds"], **s})
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-            v.designs.to_csv(out / f"verify_rule{i}.csv", index=False)
+    # a local Dask cluster is started once for all rules
+    cluster = dask_scheduler(args.scheduler, args.workers) if args.scheduler else nullcontext()
+    with cluster as address:
+        for i, r in enumerate(rules, start=1):
+            v = verify_rule(
+                scenario,
+                r["bounds"],
+                args.target,
+                args.samples,
+                seed=args.seed + i,
+                workers=1 if address else args.workers,
+                scheduler=address,
+            )
+            s = v.summary()
+            lo, hi = s["precision_95ci"]
+            print(
+                f"rule {i}: {r.get('rule', '')}\n  fresh designs meeting the target: "
+                f"{s['meeting_target']}/{s['simulated']} = {s['precision']:.3f} "
+                f"(95 % CI {lo:.3f}-{hi:.3f}; {s['failed']} failed)"
+            )
+            report.append({"rank": i, "rule": r.get("rule"), "bounds": r["bounds"], **s})
+            if out is not None:
+                out.mkdir(parents=True, exist_ok=True)
+                v.designs.to_csv(out / f"verify_rule{i}.csv", index=False)
     if out is not None:
         (out / "verify.json").write_text(json.dumps(report, indent=2))
     print(json.dumps([{k: d[k] for k in ("rank", "precision", "simulated")} for d in report]))

@@ -1,0 +1,207 @@
+"""Design evaluation on a Dask cluster: same numbers and order as joblib, failures, addresses."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from contextlib import contextmanager
+
+import numpy as np
+import pandas as pd
+import pytest
+
+distributed = pytest.importorskip("distributed")
+
+import dask  # noqa: E402
+
+import design.runner as runner  # noqa: E402
+import design.store as store  # noqa: E402
+from design.cli import main  # noqa: E402
+from design.runner import check_scheduler, evaluate_designs  # noqa: E402
+from design.sampling import sample_designs  # noqa: E402
+from design.scenarios import Column, Scenario, get_scenario  # noqa: E402
+
+
+def _toy_evaluate(row):
+    if row["a"] == 1:
+        time.sleep(0.2)  # the first row finishes last
+    if row["a"] == 13:
+        raise RuntimeError("unlucky design\nsecond line")
+    if row["a"] == 7:
+        os._exit(3)  # the worker process dies (never called on the in-process cluster)
+    return {"double": 2 * row["a"], "status": "converged"}
+
+
+TOY = Scenario(
+    name="toy",
+    description="doubles a",
+    features=(Column("a", "m", "a length", 1.0, 10.0),),
+    performance=(Column("double", "m", "2 a"),),
+    check=lambda row: [],
+    evaluate=_toy_evaluate,
+)
+
+
+@pytest.fixture(scope="module")
+def address():
+    """An in-process cluster (threads, no processes) reached over TCP like a remote one."""
+    with distributed.LocalCluster(
+        processes=False,
+        n_workers=1,
+        threads_per_worker=2,
+        protocol="tcp://",
+        dashboard_address=":0",
+    ) as cluster:
+        yield cluster.scheduler_address
+
+
+@pytest.fixture(scope="module")
+def miura():
+    sc = get_scenario("single-miura")
+    d = sample_designs(sc, 6, seed=5).iloc[[3, 0, 5, 1, 4, 2]]
+    d.index = [60, 10, 50, 20, 40, 30]
+    return sc, d
+
+
+def test_same_numbers_and_order_as_joblib(address, miura):
+    sc, d = miura
+    assert address.startswith("tcp://")
+    ref = evaluate_designs(sc, d, workers=1)
+    res = evaluate_designs(sc, d, scheduler=address, progress=True)
+    assert list(res["sample"]) == [3, 0, 5, 1, 4, 2]
+    assert list(res.index) == [60, 10, 50, 20, 40, 30]
+    assert (res["status"] == "converged").all()
+    pd.testing.assert_frame_equal(res, ref, check_exact=True)
+
+
+def test_failed_row_on_dask(address):
+    df = pd.DataFrame({"id": ["p", "q", "r", "s"], "a": [1.0, 13.0, 3.0, 4.0]})
+    res = evaluate_designs(TOY, df, scheduler=address)
+    assert res["id"].tolist() == ["p", "q", "r", "s"]
+    assert res["double"].iloc[[0, 2, 3]].tolist() == [2.0, 6.0, 8.0]
+    assert np.isnan(res["double"].iloc[1])
+    failed = "failed: RuntimeError: unlucky design"
+    assert res["status"].tolist() == ["converged", failed, "converged", "converged"]
+
+
+def test_dead_worker_fails_its_row_only():
+    """A local cluster of real processes; the worker running a=7 exits (os._exit)."""
+    df = pd.DataFrame({"a": [1.0, 7.0, 3.0, 4.0, 5.0]})
+    cfg = {
+        "distributed.scheduler.allowed-failures": 0,  # KilledWorker at the first death
+        "distributed.scheduler.worker-saturation": 1.0,  # one task per worker at a time
+    }
+    with dask.config.set(cfg):
+        res = evaluate_designs(TOY, df, scheduler="local", workers=2)
+    assert res["status"].iloc[1].startswith("failed: KilledWorker: ")
+    assert np.isnan(res["double"].iloc[1])
+    assert res["double"].iloc[[0, 2, 3, 4]].tolist() == [2.0, 6.0, 8.0, 10.0]
+    assert (res["status"].iloc[[0, 2, 3, 4]] == "converged").all()
+
+
+@pytest.mark.parametrize(
+    "bad", ["10.0.0.5:8786", "tcp://host", "tcp//host:8786", "tcp://host:99999", "", "loc"]
+)
+def test_bad_address_is_refused_before_anything(bad):
+    calls = []
+    sc = Scenario(**{**TOY.__dict__, "evaluate": lambda r: calls.append(r) or {}})
+    with pytest.raises(ValueError, match=f"Dask scheduler {bad!r} is not an address"):
+        evaluate_designs(sc, pd.DataFrame({"a": [1.0, 2.0]}), scheduler=bad)
+    assert calls == []
+
+
+def test_bad_worker_count_with_local_cluster(tmp_path):
+    designs = pd.DataFrame({"a": [1.0, 2.0]})
+    with pytest.raises(ValueError, match="workers = 0 must be >= 1"):
+        store.build_database(TOY, designs, tmp_path / "db", scheduler="local", workers=0)
+    assert not (tmp_path / "db").exists()
+
+
+def test_good_addresses_and_missing_package(monkeypatch):
+    assert check_scheduler(" LOCAL ") == "local"
+    assert check_scheduler("tcp://10.0.0.5:8786") == "tcp://10.0.0.5:8786"
+    assert check_scheduler("tls://[::1]:8786") == "tls://[::1]:8786"
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    with pytest.raises(ValueError, match=r'pip install "holofold\[cluster\]"'):
+        check_scheduler("tcp://10.0.0.5:8786")
+
+
+def test_workers_without_holofold_are_reported(address, monkeypatch):
+    def cannot_import(scenario):
+        raise ModuleNotFoundError("No module named 'design'")
+
+    monkeypatch.setattr(runner, "_worker_ready", cannot_import)
+    with pytest.raises(ValueError, match=f"workers of {address} cannot run holofold.*'design'"):
+        evaluate_designs(TOY, pd.DataFrame({"a": [1.0]}), scheduler=address)
+
+
+def test_unreachable_scheduler_names_it():
+    df = pd.DataFrame({"a": [1.0]})
+    with dask.config.set({"distributed.comm.timeouts.connect": "0.5s"}):
+        with pytest.raises(OSError, match="tcp://127.0.0.1:1"):
+            evaluate_designs(TOY, df, scheduler="tcp://127.0.0.1:1")
+
+
+def test_interrupted_dask_build_resumes_without_duplicates(address, miura, tmp_path, monkeypatch):
+    sc, _ = miura
+    designs = sample_designs(sc, 7, seed=1)
+    calls, started = [], []
+    real = store.evaluate_designs
+
+    def counting(scenario, part, **kw):
+        calls.append((list(part["sample"]), kw["scheduler"], kw["workers"]))
+        if len(calls) == 2 and not hasattr(counting, "interrupted"):
+            counting.interrupted = True
+            raise KeyboardInterrupt
+        return real(scenario, part, **kw)
+
+    @contextmanager
+    def fake_local(scheduler, workers):  # stands in for starting a LocalCluster
+        started.append((scheduler, workers))
+        yield address
+
+    monkeypatch.setattr(store, "evaluate_designs", counting)
+    monkeypatch.setattr(store, "dask_scheduler", fake_local)
+    db_dir = tmp_path / "db"
+    with pytest.raises(KeyboardInterrupt):
+        store.build_database(sc, designs, db_dir, chunk_size=3, scheduler="local", workers=3)
+    assert len(list((db_dir / "chunks").glob("*.parquet"))) == 1
+    calls.clear()
+    db = store.build_database(sc, designs, db_dir, chunk_size=3, scheduler="local", workers=3)
+    assert started == [("local", 3), ("local", 3)]  # one cluster per run, not per chunk
+    assert calls == [([3, 4, 5], address, 1), ([6], address, 1)]  # only the missing chunks
+    assert list(db["sample"]) == list(range(7))
+    ref = evaluate_designs(sc, designs)
+    pd.testing.assert_frame_equal(db, ref, check_exact=True)
+
+
+def test_cli_scheduler_flag(address, miura, tmp_path, capsys):
+    sc, d = miura
+    src, out = tmp_path / "designs.csv", tmp_path / "out.csv"
+    d.to_csv(src, index=False)
+    assert main(["evaluate", "single-miura", str(src), "-o", str(out), "--scheduler", address]) == 0
+    res = pd.read_csv(out)
+    ref = evaluate_designs(sc, d).reset_index(drop=True)
+    assert list(res["sample"]) == [3, 0, 5, 1, 4, 2]
+    assert np.allclose(res["axialstiff60"], ref["axialstiff60"], rtol=1e-11, atol=0)
+    assert "6 converged" in capsys.readouterr().out
+    gen = tmp_path / "gen"
+    argv = ["generate", "single-miura", "-n", "4", "-o", str(gen), "--chunk-size", "3"]
+    assert main([*argv, "--scheduler", address]) == 0
+    db = pd.read_parquet(gen / "database.parquet")
+    assert list(db["sample"]) == [0, 1, 2, 3] and (db["status"] == "converged").all()
+    bad = tmp_path / "bad"
+    assert main(["generate", "single-miura", "-n", "4", "-o", str(bad), "--scheduler", "x"]) == 2
+    assert "Dask scheduler 'x' is not an address" in capsys.readouterr().err
+    assert not bad.exists()
+    rules = tmp_path / "rules.json"
+    box = {"tcrease": {"gt": None, "le": 0.6e-3}, "tpanel": {"gt": None, "le": 1.2e-3}}
+    rules.write_text(json.dumps([{"rule": "soft", "bounds": box}]))
+    argv = ["verify", "single-miura", "--rules", str(rules), "--target", "axialstiff60 < 6000"]
+    for extra, folder in (([], "v1"), (["--scheduler", address], "v2")):
+        assert main([*argv, "-n", "4", "-o", str(tmp_path / folder), *extra]) == 0
+    v1, v2 = (pd.read_csv(tmp_path / f / "verify_rule1.csv") for f in ("v1", "v2"))
+    pd.testing.assert_frame_equal(v1, v2)
+    assert (v2["status"] == "converged").all()
