@@ -80,6 +80,32 @@ def test_two_panel_stiffness_is_robust_on_a_stable_row(reference_data):
     assert a.Tmax == pytest.approx(df["Tmax"].iloc[11], rel=1e-9)
 
 
+def test_converged_mode_is_repeatable(reference_data):
+    """Two-panel row 4: with the scripts' loose tolerances its prying stiffness is one of the
+    round-off-sensitive ones (module docstring); with ``converged=True`` a 1e-15 change of L1
+    moves the stiffness by < 1e-9 and the tip path by < 1 nm, and the closing step, Tmax and
+    frequency are still the published ones."""
+    df = reference_data.load("data2_TwoPanel_sample")
+    row = _row(df, 3)
+    opt = GripperOptions(converged=True, keep_history=True)
+    a = simulate(row, opt)
+    b = simulate(row | {"L1": row["L1"] * (1 + 1e-15)}, opt)
+    assert a.status == b.status == "converged"
+    assert a.closing_step == b.closing_step == 80
+    assert b.stiff == pytest.approx(a.stiff, rel=1e-9)
+    np.testing.assert_allclose(b.tip_distance, a.tip_distance, rtol=0, atol=1e-9)  # 1 nm
+    assert a.Tmax == pytest.approx(df["Tmax"].iloc[3], rel=1e-6)
+    assert a.freqFinal == pytest.approx(df["freqFinal"].iloc[3], rel=1e-6)
+    # every prying increment met the tight tolerance
+    (run,) = a.stiffness_runs
+    assert run.ok and run.converged.all()
+    assert GripperOptions(converged=True).tolerance(5e-6, "displacement") == {
+        "tol": 1e-12,
+        "max_iter": 60,
+    }
+    assert GripperOptions().tolerance(5e-6, "force") == {"tol": 5e-6}
+
+
 @pytest.mark.slow
 def test_physical_polarity_gives_the_same_folding(reference_data):
     """Normalised springs with the pattern's fold_sign fold exactly like the reference's raw

@@ -34,7 +34,7 @@ def _evaluate(name, df):
 
 
 def test_registry():
-    assert SCENARIO_NAMES == ("single-miura", "canopy", "arch", "gripper")
+    assert SCENARIO_NAMES == ("single-miura", "canopy", "arch", "gripper", "gripper-converged")
     for n in SCENARIO_NAMES:
         sc = get_scenario(n)
         assert sc.name == n and sc.performance_names and sc.feature_names

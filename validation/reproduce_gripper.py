@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -43,6 +44,7 @@ STEMS = {1: "data2_MiuraBased_sample", 2: "data2_SplittedMiura_sample", 3: "data
 NAMES = {1: "Miura-based", 2: "splitted Miura", 3: "two-panel"}
 FEATURES = ["Pattern", "L1", "L2", "t1", "t2", "tpanel", "rate", "W"]
 OUTPUTS = ["freqFinal", "finalQ", "Tmax", "stiff"]
+DEFAULT = GripperOptions()
 
 
 def emit(text: str = "") -> None:
@@ -50,12 +52,12 @@ def emit(text: str = "") -> None:
     sys.stdout.flush()
 
 
-def _run(row: dict, perturb: float = 0.0) -> dict:
+def _run(row: dict, perturb: float = 0.0, options: GripperOptions = DEFAULT) -> dict:
     t = time.perf_counter()
     if perturb:
         row = row | {"L1": row["L1"] * (1.0 + perturb)}
     try:
-        r = simulate(row, GripperOptions())
+        r = simulate(row, options)
         out = r.as_row() | {"step": r.closing_step or np.nan}
     except Exception as exc:  # noqa: BLE001 - report and go on
         out = {c: np.nan for c in OUTPUTS} | {"status": f"failed: {exc}", "step": np.nan}
@@ -63,12 +65,110 @@ def _run(row: dict, perturb: float = 0.0) -> dict:
     return out
 
 
-def run_rows(rows: list[dict], workers: int, perturb: float = 0.0) -> list[dict]:
+def run_rows(rows: list[dict], workers: int, perturb=0.0, options=DEFAULT) -> list[dict]:
+    """Simulate ``rows``; ``perturb`` (relative L1 change) and ``options`` are one for all
+    rows or a sequence with one per row."""
+    n = len(rows)
+    perturb = np.broadcast_to(np.asarray(perturb, float), (n,))
+    options = [options] * n if isinstance(options, GripperOptions) else list(options)
+    jobs = list(zip(rows, perturb, options, strict=True))
     if workers == 1:
-        return [_run(r, perturb) for r in rows]
+        return [_run(*job) for job in jobs]
     from joblib import Parallel, delayed
 
-    return list(Parallel(n_jobs=workers, batch_size=1)(delayed(_run)(r, perturb) for r in rows))
+    return list(Parallel(n_jobs=workers, batch_size=1)(delayed(_run)(*job) for job in jobs))
+
+
+def run_ensemble(rows: list[dict], members, workers: int) -> list[pd.DataFrame]:
+    """One run of every row per member ``(relative L1 shift, options)`` (all in one pool)."""
+    members = list(members)
+    n = len(rows)
+    out = pd.DataFrame(
+        run_rows(
+            [r for _ in members for r in rows],
+            workers,
+            np.repeat([m[0] for m in members], n),
+            [m[1] for m in members for _ in rows],
+        )
+    )
+    return [out.iloc[k * n : (k + 1) * n].reset_index(drop=True) for k in range(len(members))]
+
+
+def exchangeability(values: np.ndarray, published: np.ndarray, rtol: float, seed: int = 0) -> dict:
+    """Is the published value statistically just one more member of our ensemble?
+
+    ``values`` (n, K): K runs of each of n rows that differ only by round-off of the input;
+    ``published`` (n,). Two values *agree* when they are within ``rtol`` (relative). If the
+    published numbers come from the same algorithm and only round-off differs, the published
+    value is exchangeable with the members, so (a) it agrees with a member as often as two
+    members agree with each other, and (b) its rank among the K + 1 values (ties broken at
+    random) is uniform on 0..K -- checked with a chi-square test (``p_rank``). Rows where all
+    K members agree are the *stable* rows; on them the published value should agree too.
+    """
+    from scipy.stats import chi2
+
+    v = np.asarray(values, float)
+    p = np.asarray(published, float)
+    ok = np.isfinite(v).all(axis=1) & np.isfinite(p)
+    v, p = v[ok], p[ok]
+    n, K = v.shape
+
+    def agree(a, b):
+        return np.abs(a - b) <= rtol * np.abs(b)
+
+    pub = np.mean([agree(v[:, k], p).mean() for k in range(K)])
+    mem = np.mean([agree(v[:, i], v[:, j]).mean() for i in range(K) for j in range(K) if i != j])
+    ties = agree(v, p[:, None])
+    below = (v < p[:, None]) & ~ties
+    rng = np.random.default_rng(seed)
+    rank = below.sum(1) + rng.integers(0, ties.sum(1) + 1)
+    hist = np.bincount(rank, minlength=K + 1)
+    expect = n / (K + 1)
+    p_rank = float(chi2.sf(((hist - expect) ** 2 / expect).sum(), K))
+    stable = agree(v, v[:, :1]).all(axis=1)
+    inside = (ties.any(1)) | ((v.min(1) < p) & (p < v.max(1)))
+    return dict(
+        n=n,
+        members=K,
+        agree_published=pub,
+        agree_members=mem,
+        rank_hist=hist,
+        p_rank=p_rank,
+        stable=int(stable.sum()),
+        stable_agree=float(agree(v[stable, 0], p[stable]).mean()) if stable.any() else np.nan,
+        inside=float(inside.mean()),
+    )
+
+
+def ensemble_report(P: int, ref: pd.DataFrame, members: list[pd.DataFrame], how: str) -> None:
+    """Published values against an ensemble of round-off-perturbed runs of the same rows."""
+    K = len(members)
+    emit(f"  ensemble: {K} runs per row, {how}")
+    pub_step = decode_closing_step(P, ref["L1"].to_numpy(), ref["L2"].to_numpy(), ref["finalQ"])
+    steps = np.column_stack([m["step"].to_numpy(float) for m in members])
+    stiff = np.column_stack([m["stiff"].to_numpy(float) for m in members])
+    for label, vals, pub, rtol in (
+        ("closing step", steps, np.rint(pub_step), 0.0),
+        ("stiff (1e-3)", stiff, ref["stiff"].to_numpy(float), 1e-3),
+        ("stiff (1e-2)", stiff, ref["stiff"].to_numpy(float), 1e-2),
+    ):
+        x = exchangeability(vals, pub, rtol)
+        emit(
+            f"    {label:<13} agreement published-member {x['agree_published']:.3f} vs "
+            f"member-member {x['agree_members']:.3f};  published inside the ensemble on "
+            f"{100 * x['inside']:.1f} % of rows"
+        )
+        emit(
+            f"    {'':<13} rank of published among {K + 1}: {x['rank_hist'].tolist()} "
+            f"(uniform if exchangeable: chi-square p = {x['p_rank']:.2f});  rows where all runs "
+            f"agree: {x['stable']} / {x['n']}, published agrees there on "
+            f"{100 * x['stable_agree']:.1f} %"
+        )
+    med = np.nanmedian(stiff, axis=1)
+    e = np.abs(med - ref["stiff"].to_numpy()) / ref["stiff"].to_numpy()
+    spread = (np.nanmax(stiff, 1) - np.nanmin(stiff, 1)) / np.abs(med)
+    emit(stats_line("stiff, ens. median", e))
+    emit(stats_line("stiff, ens. spread", spread))
 
 
 def sensitivity(P: int, ref: pd.DataFrame, ours: pd.DataFrame, other: pd.DataFrame) -> None:
@@ -216,13 +316,32 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--compare", default=None, help="per-row CSV of an earlier --save run to compare with"
     )
+    ap.add_argument(
+        "--ensemble",
+        type=int,
+        default=0,
+        metavar="K",
+        help="also run every row K times with L1 x (1 + k 1e-15) and test whether the published "
+        "values are exchangeable with these round-off-level variants",
+    )
+    ap.add_argument(
+        "--ensemble-arccos",
+        action="store_true",
+        help="odd ensemble members also use the reference's arccos dihedral angle",
+    )
+    ap.add_argument(
+        "--converged",
+        action="store_true",
+        help="run every Newton solve to a tight tolerance (GripperOptions(converged=True))",
+    )
     args = ap.parse_args(argv)
+    options = GripperOptions(converged=args.converged)
     frames = []
     if args.random:
         rng = np.random.default_rng(args.seed)
         for P in args.patterns:
             rows = random_designs(P, args.random, rng)
-            res = pd.DataFrame(run_rows(rows, args.workers))
+            res = pd.DataFrame(run_rows(rows, args.workers, 0.0, options))
             fail = (res["status"] == "failed: no closure").sum()
             other = res["status"].str.startswith("failed").sum() - fail
             emit(
@@ -240,7 +359,7 @@ def main(argv=None) -> int:
                 ref = ref.iloc[: args.rows]
             rows = ref[FEATURES].to_dict("records")
             t = time.perf_counter()
-            ours = pd.DataFrame(run_rows(rows, args.workers, args.perturb))
+            ours = pd.DataFrame(run_rows(rows, args.workers, args.perturb, options))
             emit(f"(pattern {P}: {time.perf_counter() - t:.0f} s wall)")
             report(P, ref.reset_index(drop=True), ours)
             if args.compare:
@@ -250,9 +369,29 @@ def main(argv=None) -> int:
                     sensitivity(P, ref.reset_index(drop=True), ours, old)
                 else:
                     emit(f"  --compare: {len(old)} rows of pattern {P} there, not {len(ours)}")
+            extra = []
+            if args.ensemble > 1:
+                t = time.perf_counter()
+                k = np.arange(1, args.ensemble)
+                angle = args.ensemble_arccos & (k % 2 == 1)
+                spec = [
+                    (args.perturb + 1e-15 * kk, replace(options, arccos_angle=bool(a)))
+                    for kk, a in zip(k, angle, strict=True)
+                ]
+                members = [ours, *run_ensemble(rows, spec, args.workers)]
+                emit(f"(ensemble: {time.perf_counter() - t:.0f} s wall)")
+                how = f"member k: L1 x (1 + k 1e-15), k = 0..{args.ensemble - 1}" + (
+                    ", arccos dihedral angle on odd k" if args.ensemble_arccos else ""
+                )
+                ensemble_report(P, ref.reset_index(drop=True), members, how)
+                extra = [
+                    m[["step", "stiff"]].add_suffix(f"_m{j}") for j, m in enumerate(members[1:], 1)
+                ]
             pub = ref.add_suffix("_published")
             frames.append(
-                pd.concat([ref[FEATURES], ours, pub[[o + "_published" for o in OUTPUTS]]], axis=1)
+                pd.concat(
+                    [ref[FEATURES], ours, *extra, pub[[o + "_published" for o in OUTPUTS]]], axis=1
+                )
             )
     if args.save and frames:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)

@@ -11,12 +11,13 @@ from design.scenarios.base import STATUS_OK, Column, Scenario
 
 __all__ = ["Column", "Scenario", "STATUS_OK", "SCENARIO_NAMES", "get_scenario"]
 
-#: command-line name -> module
+#: command-line name -> module (its ``SCENARIO``) or ``module:ATTRIBUTE``
 _MODULES = {
     "single-miura": "design.scenarios.single_miura",
     "canopy": "design.scenarios.canopy",
     "arch": "design.scenarios.arch",
     "gripper": "design.scenarios.gripper",
+    "gripper-converged": "design.scenarios.gripper:SCENARIO_CONVERGED",
 }
 SCENARIO_NAMES = tuple(_MODULES)
 
@@ -28,4 +29,5 @@ def get_scenario(name: str) -> Scenario:
     key = str(name).strip().lower().replace("_", "-")
     if key not in _MODULES:
         raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIO_NAMES)}")
-    return importlib.import_module(_MODULES[key]).SCENARIO
+    module, _, attr = _MODULES[key].partition(":")
+    return getattr(importlib.import_module(module), attr or "SCENARIO")
