@@ -17,9 +17,11 @@ def _ensembles(n=2000, K=7, seed=1):
     rng = np.random.default_rng(seed)
     centre = rng.uniform(1e-5, 1e-3, n)
     stable = rng.random(n) < 0.4
-    draw = lambda: centre * np.where(  # noqa: E731
-        stable, 1.0, rng.choice([0.9, 1.0, 1.0, 1.03, 1.2], n)
-    )
+
+    def draw():
+        factor = rng.choice([0.9, 1.0, 1.0, 1.03, 1.2], n)
+        return centre * np.where(stable, 1.0, factor)
+
     return np.column_stack([draw() for _ in range(K)]), draw(), stable
 
 
