@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from design.cli._parallel import add_parallel_arguments
 from design.runner import check_scheduler, evaluate_designs, validate_designs
 from design.scenarios import SCENARIO_NAMES, get_scenario
 
@@ -44,24 +45,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "-o", "--output", type=Path, required=True, help="result table (.csv or .parquet)"
     )
-    p.add_argument(
-        "--workers",
-        type=int,
-        default=1,
-        help=(
-            "worker processes (default 1; -1 = every core); with --scheduler local the local "
-            "cluster's processes (1 = every core), ignored with a remote --scheduler"
-        ),
-    )
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help=(
-            "run on a Dask cluster at ADDRESS (e.g. tcp://host:8786), or 'local' for a local "
-            "Dask cluster with --workers processes; needs the cluster extra "
-            '(pip install "holofold[cluster]")'
-        ),
-    )
+    add_parallel_arguments(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     return p
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from design.cli._parallel import add_parallel_arguments
+
 
 def register(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
@@ -27,24 +29,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         metavar="NAME=LOW:HIGH",
         help="override a feature's range (SI units), or NAME=A,B,C for categorical choices",
     )
-    p.add_argument(
-        "--workers",
-        type=int,
-        default=1,
-        help=(
-            "worker processes (-1: all cores); with --scheduler local the local cluster's "
-            "processes (1 = every core), ignored with a remote --scheduler"
-        ),
-    )
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help=(
-            "run on a Dask cluster at ADDRESS (e.g. tcp://host:8786), or 'local' for a local "
-            "Dask cluster with --workers processes; needs the cluster extra "
-            '(pip install "holofold[cluster]")'
-        ),
-    )
+    add_parallel_arguments(p)
     p.add_argument("--chunk-size", type=int, default=100, help="rows per result chunk")
     p.add_argument("--csv", action="store_true", help="also write database.csv")
     return p

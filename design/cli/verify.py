@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from design.cli._parallel import add_parallel_arguments
+
 
 def register(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
@@ -21,24 +23,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("-n", "--samples", type=int, default=50, help="designs per rule (default 50)")
     p.add_argument("--top", type=int, default=None, help="verify only the first K rules")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument(
-        "--workers",
-        type=int,
-        default=1,
-        help=(
-            "worker processes (-1: all cores); with --scheduler local the local cluster's "
-            "processes (1 = every core), ignored with a remote --scheduler"
-        ),
-    )
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help=(
-            "run on a Dask cluster at ADDRESS (e.g. tcp://host:8786), or 'local' for a local "
-            "Dask cluster with --workers processes; needs the cluster extra "
-            '(pip install "holofold[cluster]")'
-        ),
-    )
+    add_parallel_arguments(p)
     p.add_argument("-o", "--output", help="folder for verify.json and the simulated designs")
     return p
 
