@@ -288,9 +288,11 @@ class GripperOptions:
 class GripperResult:
     """Outputs of one gripper simulation (units: rad/s, W, °C, N/m).
 
-    ``tip_distance`` (m) and ``Tmax_history`` (°C) per heating step and ``stiffness_runs``
-    (the prying Newton :class:`~mechanics.solvers.SolveResult` s) are kept only with
-    ``GripperOptions(keep_history=True)``.
+    Kept only with ``GripperOptions(keep_history=True)``: ``tip_distance`` (m) and
+    ``Tmax_history`` (°C) per heating step, ``stiffness_runs`` (the prying Newton
+    :class:`~mechanics.solvers.SolveResult` s), and the meshed shape at the last heating step
+    (the closing one, or the cap): flat ``nodes`` (nn, 3) m, ``triangles`` (nt, 3) node ids,
+    ``displacement`` (nn, 3) m and nodal ``temperature`` (nn,) °C.
     """
 
     freqFinal: float
@@ -303,6 +305,10 @@ class GripperResult:
     Tmax_history: np.ndarray = field(default_factory=lambda: np.zeros(0))
     unconverged_steps: int = 0
     stiffness_runs: tuple = ()
+    nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    triangles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.intp))
+    displacement: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    temperature: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def as_row(self) -> dict:
         return {
@@ -552,7 +558,14 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
             break
     hist = {}
     if options.keep_history:
-        hist = dict(tip_distance=np.array(dist_hist), Tmax_history=np.array(tmax_hist))
+        hist = dict(
+            tip_distance=np.array(dist_hist),
+            Tmax_history=np.array(tmax_hist),
+            nodes=st.nodes.copy(),
+            triangles=np.asarray(st.triangles, np.intp).copy(),
+            displacement=state.U.copy(),
+            temperature=np.asarray(state.T, float).copy(),
+        )
     if closing is None:
         nan = float("nan")
         return GripperResult(
