@@ -63,3 +63,19 @@ def test_integer_steps_with_ties(rtol):
     x = exchangeability(v, pub, rtol)
     assert x["p_rank"] > 1e-3
     assert x["inside"] > 0.9
+
+
+def test_ensemble_picture(tmp_path):
+    import pandas as pd
+
+    plot = runpy.run_path(str(ROOT / "validation" / "reproduce_gripper.py"))["plot_ensemble"]
+    v, pub, _ = _ensembles(n=40, K=4)
+    table = pd.DataFrame(
+        {"Pattern": np.repeat([2.0, 3.0], 20), "stiff": v[:, 0], "stiff_published": pub}
+        | {f"stiff_m{k}": v[:, k] for k in range(1, 4)}
+    )
+    png = tmp_path / "ens.png"
+    assert plot(table, png) == [2, 3]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(ValueError, match="ensemble columns"):
+        plot(table[["Pattern", "stiff", "stiff_published"]], tmp_path / "no.png")

@@ -298,6 +298,50 @@ def random_designs(P: int, n: int, rng: np.random.Generator) -> list[dict]:
     return rows
 
 
+def plot_ensemble(table: pd.DataFrame, path) -> list[int]:
+    """Picture of the published values against the ensemble, one panel per pattern.
+
+    ``table``: a ``--save`` CSV of an ``--ensemble`` run (columns ``stiff``, ``stiff_m1``, ...,
+    ``stiff_published``). Rows are sorted by the ensemble's spread; each row is a grey bar from
+    the smallest to the largest ensemble member and a dot for the published value, all relative
+    to the ensemble median. Returns the patterns drawn.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    members = sorted(c for c in table.columns if c.startswith("stiff_m"))
+    if not members:
+        raise ValueError("no ensemble columns (stiff_m1, ...): save a run made with --ensemble")
+    patterns = [int(P) for P in sorted(table["Pattern"].unique())]
+    fig, axes = plt.subplots(len(patterns), 1, figsize=(11, 3.6 * len(patterns)), squeeze=False)
+    for ax, P in zip(axes[:, 0], patterns, strict=True):
+        d = table[table["Pattern"] == P]
+        v = d[["stiff", *members]].to_numpy(float)
+        med = np.median(v, axis=1, keepdims=True)
+        rel = v / med - 1
+        pub = d["stiff_published"].to_numpy(float) / med[:, 0] - 1
+        order = np.argsort(rel.max(1) - rel.min(1), kind="stable")
+        x = np.arange(len(order))
+        ax.vlines(x, rel[order].min(1), rel[order].max(1), color="0.6", lw=2.5, label="ensemble")
+        ax.plot(x, pub[order], "o", ms=3.5, color="C3", label="published")
+        ax.set_yscale("symlog", linthresh=1e-4)
+        ax.axhspan(-1e-3, 1e-3, color="C2", alpha=0.12, lw=0, label="within 1e-3")
+        ax.set_xlim(-1, len(order))
+        ax.set_ylabel("stiff / ensemble median - 1")
+        ax.set_title(
+            f"{NAMES[P]}: prying stiffness of {len(d)} published rows, {v.shape[1]} runs each "
+            "differing only by round-off"
+        )
+        ax.legend(loc="upper left", fontsize=8, ncol=3)
+    axes[-1, 0].set_xlabel("rows, sorted by the spread of the ensemble")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return patterns
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--patterns", nargs="*", type=int, default=[1, 2, 3], choices=[1, 2, 3])
@@ -334,7 +378,21 @@ def main(argv=None) -> int:
         action="store_true",
         help="run every Newton solve to a tight tolerance (GripperOptions(converged=True))",
     )
+    ap.add_argument(
+        "--plot",
+        default=None,
+        metavar="PNG",
+        help="with --ensemble: draw the published values against the ensemble (or redraw a "
+        "saved run: --plot PNG --replot CSV)",
+    )
+    ap.add_argument("--replot", default=None, metavar="CSV", help="a --save CSV to plot")
     args = ap.parse_args(argv)
+    if args.replot:
+        if not args.plot:
+            ap.error("--replot needs --plot PNG")
+        plot_ensemble(pd.read_csv(args.replot), args.plot)
+        emit(f"picture written to {args.plot}")
+        return 0
     options = GripperOptions(converged=args.converged)
     frames = []
     if args.random:
@@ -397,6 +455,9 @@ def main(argv=None) -> int:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         pd.concat(frames, ignore_index=True).to_csv(args.save, index=False)
         emit(f"per-row results written to {args.save}")
+    if args.plot and frames and args.ensemble > 1:
+        plot_ensemble(pd.concat(frames, ignore_index=True), args.plot)
+        emit(f"picture written to {args.plot}")
     return 0
 
 
