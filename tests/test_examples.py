@@ -4,6 +4,7 @@ import runpy
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -21,3 +22,33 @@ def test_render_miura_writes_a_png(tmp_path, monkeypatch):
     width = int.from_bytes(data[16:20], "big")
     height = int.from_bytes(data[20:24], "big")
     assert (width, height) == (1400, 600)
+
+
+@pytest.mark.slow
+def test_gripper_closing_example(tmp_path, monkeypatch):
+    from design.scenarios.gripper import CLOSURE_PAIR, published_q
+
+    png = tmp_path / "gripper.png"
+    monkeypatch.setattr(sys, "argv", ["gripper_closing.py", str(png)])
+    ns = runpy.run_path(str(ROOT / "examples" / "gripper_closing.py"), run_name="__main__")
+    res = ns["RESULT"]
+    data = png.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    width = int.from_bytes(data[16:20], "big")
+    height = int.from_bytes(data[20:24], "big")
+    assert (width, height) == (1400, 900)
+    assert sorted(k for k in res) == [2, 3]
+    for pattern, row in res.items():
+        sim, d = row["result"], row["design"]
+        step = row["closing_step"]
+        assert row["png"] == png and d["Pattern"] == pattern
+        assert step is not None and step == sim.closing_step == len(sim.tip_distance)
+        assert sim.tip_distance[step - 1] < 1e-3 < sim.tip_distance[step - 2]
+        assert row["Tmax"] == sim.temperature.max() == sim.Tmax_history[-1]
+        assert row["finalQ"] == float(published_q(pattern, d["L1"], d["L2"], step))
+        assert 0 < row["stiff"] < 1
+        # the drawn shape is the closed one: arms lifted off the plane, tips within 1 mm
+        x = sim.nodes + sim.displacement
+        a, b = (i - 1 for i in CLOSURE_PAIR[pattern])
+        assert np.linalg.norm(x[a] - x[b]) == pytest.approx(sim.tip_distance[-1], rel=1e-12)
+        assert sim.triangles.max() < len(x) and x[:, 2].max() > 1e-3

@@ -101,6 +101,7 @@ __all__ = [
     "build_model",
     "natural_frequency",
     "STATUS_NO_CLOSURE",
+    "CLOSURE_PAIR",
     "ArccosAssembler",
     "arccos_dihedral",
 ]
@@ -170,6 +171,7 @@ STIFF_LOADS = {
     2: [((31, 32), 1, 1.0), ((53, 54), 1, -1.0)],
     3: [((17, 18), 1, -1.0), ((11, 12), 1, 1.0)],
 }
+#: 1-based meshed node ids of the two arm tips whose distance decides closure (scenarios.md 4.7)
 CLOSURE_PAIR = {1: (59, 71), 2: (32, 53), 3: (12, 17)}
 
 
