@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import logging
 import math
-import os
 import re
 import sys
 from collections import Counter
@@ -33,6 +32,7 @@ __all__ = [
     "validate_designs",
     "evaluate_designs",
     "check_scheduler",
+    "check_workers",
     "dask_scheduler",
 ]
 
@@ -159,6 +159,14 @@ def _evaluate_one(scenario: Scenario, row: dict, limit_threads: bool) -> dict:
         return _failed(scenario, exc)
 
 
+def check_workers(workers) -> int:
+    """``workers`` as an int: >= 1 processes, or -1 for every core (else ``ValueError``)."""
+    w = int(workers)
+    if w == 0 or w < -1:
+        raise ValueError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    return w
+
+
 def check_scheduler(scheduler: str) -> str:
     """Check a Dask scheduler address before anything is done with it.
 
@@ -206,7 +214,7 @@ def dask_scheduler(scheduler: str, workers: int = 1) -> Iterator[str]:
     scheduler : str
         An address (checked by :func:`check_scheduler`, used as is) or ``"local"``: a
         ``distributed.LocalCluster`` runs for the duration of the block with ``workers``
-        single-threaded worker processes (every core when ``workers`` is 1 or -1).
+        single-threaded worker processes (-1: one per core).
     workers : int
         Worker processes of the local cluster; ignored for a remote scheduler.
 
@@ -216,17 +224,16 @@ def dask_scheduler(scheduler: str, workers: int = 1) -> Iterator[str]:
         The scheduler address.
     """
     address = check_scheduler(scheduler)
-    workers = int(workers)
-    if workers == 0 or workers < -1:
-        raise ValueError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    workers = check_workers(workers)
     if address != "local":
         if workers != 1:
             log.info("workers = %s ignored: the Dask cluster at %s has its own", workers, address)
         yield address
         return
     from distributed import LocalCluster
+    from joblib import cpu_count
 
-    n = (os.cpu_count() or 1) if workers in (1, -1) else workers
+    n = cpu_count() if workers == -1 else workers
     log.info("starting a local Dask cluster with %d worker process(es)", n)
     # LocalCluster quietens only distributed's own handler; its INFO records would still reach
     # the root logger's handlers (as in the CLI), so quieten the logger for the block
@@ -303,14 +310,14 @@ def evaluate_designs(
     Parameters
     ----------
     scenario : Scenario or str
-        The scenario or its name (``single-miura``, ``canopy``, ``arch``).
+        The scenario or its name (:data:`design.scenarios.SCENARIO_NAMES`).
     table : DataFrame
         Feature columns in SI units (names as in the published files); other columns are
         kept. Input columns named like a performance column are replaced.
     workers : int
         Worker processes (joblib); 1 runs in this process. -1 uses every core. With
-        ``scheduler="local"``: the local Dask cluster's worker processes (1 or -1: every
-        core); ignored for a remote scheduler.
+        ``scheduler="local"``: the local Dask cluster's worker processes (-1: one per core);
+        ignored for a remote scheduler.
     progress : bool, optional
         Show a tqdm progress bar; default only when stderr is a terminal.
     limit_threads : bool
@@ -331,9 +338,7 @@ def evaluate_designs(
     """
     if isinstance(scenario, str):
         scenario = get_scenario(scenario)
-    workers = int(workers)
-    if workers == 0 or workers < -1:
-        raise DesignTableError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    workers = check_workers(workers)
     if scheduler is not None:
         scheduler = check_scheduler(scheduler)
     checked = validate_designs(scenario, table)

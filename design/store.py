@@ -24,7 +24,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from design.runner import check_scheduler, dask_scheduler, evaluate_designs, validate_designs
+from design.runner import (
+    check_scheduler,
+    check_workers,
+    dask_scheduler,
+    evaluate_designs,
+    validate_designs,
+)
 from design.scenarios import Scenario, get_scenario
 
 __all__ = ["build_database", "load_database"]
@@ -91,8 +97,7 @@ def build_database(
     chunk_size = int(chunk_size)
     if chunk_size < 1:
         raise ValueError(f"chunk_size = {chunk_size} must be >= 1")
-    if int(workers) == 0 or int(workers) < -1:
-        raise ValueError(f"workers = {workers} must be >= 1 or -1 (all cores)")
+    workers = check_workers(workers)
     if scheduler is not None:
         scheduler = check_scheduler(scheduler)
     validate_designs(scenario, designs)  # every row checked before anything is simulated

@@ -205,3 +205,53 @@ def test_cli_scheduler_flag(address, miura, tmp_path, capsys):
     v1, v2 = (pd.read_csv(tmp_path / f / "verify_rule1.csv") for f in ("v1", "v2"))
     pd.testing.assert_frame_equal(v1, v2)
     assert (v2["status"] == "converged").all()
+
+
+def test_worker_settings_of_the_commands(monkeypatch):
+    from argparse import Namespace
+
+    from design.cli._parallel import parallel_settings
+
+    def ps(workers, scheduler):
+        return parallel_settings(Namespace(workers=workers, scheduler=scheduler))
+
+    assert ps(None, None) == (1, None)
+    assert ps(3, None) == (3, None)
+    assert ps(None, "local") == (-1, "local")  # a local cluster: one process per core
+    assert ps(1, " LOCAL ") == (1, "local")  # exactly one when asked
+    assert ps(None, "tcp://10.0.0.5:8786") == (1, "tcp://10.0.0.5:8786")
+    with pytest.raises(ValueError, match="--workers 4: the Dask cluster at tcp://10.0.0.5:8786"):
+        ps(4, "tcp://10.0.0.5:8786")
+    with pytest.raises(ValueError, match="--workers 0: must be >= 1"):
+        ps(0, None)
+    # the local cluster gets that many processes
+    seen = {}
+
+    class FakeCluster:
+        scheduler_address = "tcp://127.0.0.1:1"
+
+        def __init__(self, n_workers, **kw):
+            seen["n"] = n_workers
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+    import distributed
+    import joblib
+
+    monkeypatch.setattr(distributed, "LocalCluster", FakeCluster)
+    for workers, n in ((1, 1), (3, 3), (-1, joblib.cpu_count())):
+        with runner.dask_scheduler("local", workers) as address:
+            assert address == "tcp://127.0.0.1:1" and seen["n"] == n
+
+
+def test_cli_refuses_workers_with_a_remote_scheduler(miura, tmp_path, capsys):
+    designs = tmp_path / "d.csv"
+    miura[1].to_csv(designs, index=False)
+    argv = ["evaluate", "single-miura", str(designs), "-o", str(tmp_path / "r.csv")]
+    assert main([*argv, "--workers", "2", "--scheduler", "tcp://127.0.0.1:8786"]) == 2
+    assert "has its own workers" in capsys.readouterr().err
+    assert not (tmp_path / "r.csv").exists()

@@ -84,7 +84,7 @@ def test_performance_columns_in_input_are_replaced():
 
 
 def test_bad_workers():
-    with pytest.raises(DesignTableError, match="workers"):
+    with pytest.raises(ValueError, match="workers"):
         evaluate_designs(TOY, pd.DataFrame({"a": [1.0]}), workers=0)
 
 

@@ -8,6 +8,10 @@ Usage (from the repository root)::
     PYTHONPATH=. python validation/reproduce_gripper.py --random 50       # fresh designs
     PYTHONPATH=. python validation/reproduce_gripper.py --patterns 3 --perturb 1e-15 \
         --compare out/gripper.csv          # round-off sensitivity of each row vs an earlier run
+    PYTHONPATH=. python validation/reproduce_gripper.py --patterns 3 --ensemble 8 \
+        --ensemble-arccos --save out/ens.csv --plot out/ens.png   # published vs 8 variants
+    PYTHONPATH=. python validation/reproduce_gripper.py --from-csv out/ens.csv  # report again
+    PYTHONPATH=. python validation/reproduce_gripper.py --converged      # tight Newton solves
 
 For each pattern and performance column it prints the median, 90th and 99th percentile and
 maximum of |ours - published| / |published|, the closure-step agreement (the published finalQ
@@ -97,13 +101,16 @@ def run_ensemble(rows: list[dict], members, workers: int) -> list[pd.DataFrame]:
 def exchangeability(values: np.ndarray, published: np.ndarray, rtol: float, seed: int = 0) -> dict:
     """Is the published value statistically just one more member of our ensemble?
 
-    ``values`` (n, K): K runs of each of n rows that differ only by round-off of the input;
+    ``values`` (n, K): K runs of each of n rows that differ only by round-off-level details;
     ``published`` (n,). Two values *agree* when they are within ``rtol`` (relative). If the
-    published numbers come from the same algorithm and only round-off differs, the published
+    published numbers come from the same algorithm and only such details differ, the published
     value is exchangeable with the members, so (a) it agrees with a member as often as two
-    members agree with each other, and (b) its rank among the K + 1 values (ties broken at
-    random) is uniform on 0..K -- checked with a chi-square test (``p_rank``). Rows where all
-    K members agree are the *stable* rows; on them the published value should agree too.
+    members agree with each other, and (b) its rank among the K + 1 values (exact ties broken
+    at random; a tolerance would make ties intransitive and the rank non-uniform) is uniform on
+    0..K -- checked with a chi-square test (``p_rank``). Rows where all K members agree are the
+    *stable* rows; on them the published value should agree too. ``pair_median`` and
+    ``pair_p90`` are the median and 90th percentile of |a - b| / |b| over rows and pairs of
+    members: the agreement a run can expect with another run.
     """
     from scipy.stats import chi2
 
@@ -118,15 +125,17 @@ def exchangeability(values: np.ndarray, published: np.ndarray, rtol: float, seed
 
     pub = np.mean([agree(v[:, k], p).mean() for k in range(K)])
     mem = np.mean([agree(v[:, i], v[:, j]).mean() for i in range(K) for j in range(K) if i != j])
-    ties = agree(v, p[:, None])
-    below = (v < p[:, None]) & ~ties
+    ties = v == p[:, None]
+    below = v < p[:, None]
     rng = np.random.default_rng(seed)
     rank = below.sum(1) + rng.integers(0, ties.sum(1) + 1)
     hist = np.bincount(rank, minlength=K + 1)
     expect = n / (K + 1)
     p_rank = float(chi2.sf(((hist - expect) ** 2 / expect).sum(), K))
     stable = agree(v, v[:, :1]).all(axis=1)
-    inside = (ties.any(1)) | ((v.min(1) < p) & (p < v.max(1)))
+    inside = agree(v, p[:, None]).any(1) | ((v.min(1) < p) & (p < v.max(1)))
+    pairs = [np.abs(v[:, i] - v[:, j]) / np.abs(v[:, j]) for i in range(K) for j in range(K)]
+    pairs = np.concatenate([d for k, d in enumerate(pairs) if k // K != k % K] or [np.nan])
     return dict(
         n=n,
         members=K,
@@ -137,38 +146,63 @@ def exchangeability(values: np.ndarray, published: np.ndarray, rtol: float, seed
         stable=int(stable.sum()),
         stable_agree=float(agree(v[stable, 0], p[stable]).mean()) if stable.any() else np.nan,
         inside=float(inside.mean()),
+        pair_median=float(np.median(pairs)),
+        pair_p90=float(np.percentile(pairs, 90)),
     )
 
 
-def ensemble_report(P: int, ref: pd.DataFrame, members: list[pd.DataFrame], how: str) -> None:
-    """Published values against an ensemble of round-off-perturbed runs of the same rows."""
-    K = len(members)
-    emit(f"  ensemble: {K} runs per row, {how}")
-    pub_step = decode_closing_step(P, ref["L1"].to_numpy(), ref["L2"].to_numpy(), ref["finalQ"])
-    steps = np.column_stack([m["step"].to_numpy(float) for m in members])
-    stiff = np.column_stack([m["stiff"].to_numpy(float) for m in members])
-    for label, vals, pub, rtol in (
-        ("closing step", steps, np.rint(pub_step), 0.0),
-        ("stiff (1e-3)", stiff, ref["stiff"].to_numpy(float), 1e-3),
-        ("stiff (1e-2)", stiff, ref["stiff"].to_numpy(float), 1e-2),
-    ):
-        x = exchangeability(vals, pub, rtol)
+def ensemble_report(
+    P: int, ref: pd.DataFrame, steps: np.ndarray, stiff: np.ndarray, groups: dict
+) -> None:
+    """Published values against an ensemble: ``steps``, ``stiff`` (n, K) member results of the
+    n rows of ``ref``; ``groups`` maps a label to the member columns to test together."""
+    pub_step = np.rint(
+        decode_closing_step(P, ref["L1"].to_numpy(), ref["L2"].to_numpy(), ref["finalQ"])
+    )
+    pub_stiff = ref["stiff"].to_numpy(float)
+    for name, cols in groups.items():
+        emit(f"  members {name} ({len(cols)} runs per row):")
+        for label, vals, pub, rtol in (
+            ("closing step", steps[:, cols], pub_step, 0.0),
+            ("stiff (1e-3)", stiff[:, cols], pub_stiff, 1e-3),
+            ("stiff (1e-2)", stiff[:, cols], pub_stiff, 1e-2),
+        ):
+            x = exchangeability(vals, pub, rtol)
+            emit(
+                f"    {label:<13} agreement published-member {x['agree_published']:.3f} vs "
+                f"member-member {x['agree_members']:.3f};  published inside the ensemble on "
+                f"{100 * x['inside']:.1f} % of {x['n']} rows"
+            )
+            emit(
+                f"    {'':<13} rank of published among {len(cols) + 1}: "
+                f"{x['rank_hist'].tolist()} (chi-square p = {x['p_rank']:.2g});  rows where all "
+                f"runs agree: {x['stable']}, published agrees there on "
+                f"{100 * x['stable_agree']:.1f} %"
+            )
+        x = exchangeability(stiff[:, cols], pub_stiff, 1e-3)
+        e = np.abs(stiff[:, cols] - pub_stiff[:, None]) / pub_stiff[:, None]
+        e = e[np.isfinite(e).all(axis=1)]
         emit(
-            f"    {label:<13} agreement published-member {x['agree_published']:.3f} vs "
-            f"member-member {x['agree_members']:.3f};  published inside the ensemble on "
-            f"{100 * x['inside']:.1f} % of rows"
+            f"    stiff, |a - b| / |b|: member vs member median {x['pair_median']:.2e}, p90 "
+            f"{x['pair_p90']:.2e};  member vs published median {np.median(e):.2e}, p90 "
+            f"{np.percentile(e, 90):.2e}"
         )
-        emit(
-            f"    {'':<13} rank of published among {K + 1}: {x['rank_hist'].tolist()} "
-            f"(uniform if exchangeable: chi-square p = {x['p_rank']:.2f});  rows where all runs "
-            f"agree: {x['stable']} / {x['n']}, published agrees there on "
-            f"{100 * x['stable_agree']:.1f} %"
-        )
-    med = np.nanmedian(stiff, axis=1)
-    e = np.abs(med - ref["stiff"].to_numpy()) / ref["stiff"].to_numpy()
-    spread = (np.nanmax(stiff, 1) - np.nanmin(stiff, 1)) / np.abs(med)
-    emit(stats_line("stiff, ens. median", e))
-    emit(stats_line("stiff, ens. spread", spread))
+
+
+def ensemble_arrays(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(steps, stiff, groups) of a saved ``--ensemble`` run (columns ``step``, ``stiff``,
+    ``step_m1``, ``stiff_m1``, ``angle_m1``, ...; member 0 is the plain run)."""
+    ks = sorted(int(c[7:]) for c in table.columns if c.startswith("stiff_m"))
+    if not ks:
+        raise ValueError("no ensemble columns (stiff_m1, ...): save a run made with --ensemble")
+    steps = table[["step"] + [f"step_m{k}" for k in ks]].to_numpy(float)
+    stiff = table[["stiff"] + [f"stiff_m{k}" for k in ks]].to_numpy(float)
+    angle = ["atan2"] + [str(table[f"angle_m{k}"].iloc[0]) for k in ks]
+    groups = {"all": list(range(len(angle)))}
+    if len(set(angle)) > 1:
+        for a in sorted(set(angle)):
+            groups[f"with the {a} angle"] = [i for i, b in enumerate(angle) if b == a]
+    return steps, stiff, groups
 
 
 def sensitivity(P: int, ref: pd.DataFrame, ours: pd.DataFrame, other: pd.DataFrame) -> None:
@@ -299,47 +333,56 @@ def random_designs(P: int, n: int, rng: np.random.Generator) -> list[dict]:
 
 
 def plot_ensemble(table: pd.DataFrame, path) -> list[int]:
-    """Picture of the published values against the ensemble, one panel per pattern.
+    """Picture of the published stiffness against the ensemble, one panel per pattern.
 
-    ``table``: a ``--save`` CSV of an ``--ensemble`` run (columns ``stiff``, ``stiff_m1``, ...,
-    ``stiff_published``). Rows are sorted by the ensemble's spread; each row is a grey bar from
-    the smallest to the largest ensemble member and a dot for the published value, all relative
-    to the ensemble median. Returns the patterns drawn.
+    ``table``: a ``--save`` CSV of an ``--ensemble`` run. Rows are sorted by the ensemble's
+    spread; each row is a grey bar from the smallest to the largest member and a dot for the
+    published value, all relative to the ensemble median (rows with a member that did not close
+    are left out). Returns the patterns drawn.
     """
-    import matplotlib
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    members = sorted(c for c in table.columns if c.startswith("stiff_m"))
-    if not members:
-        raise ValueError("no ensemble columns (stiff_m1, ...): save a run made with --ensemble")
-    patterns = [int(P) for P in sorted(table["Pattern"].unique())]
-    fig, axes = plt.subplots(len(patterns), 1, figsize=(11, 3.6 * len(patterns)), squeeze=False)
-    for ax, P in zip(axes[:, 0], patterns, strict=True):
+    missing = {"Pattern", "stiff_published"} - set(table.columns)
+    if missing:
+        raise ValueError(f"not a --save CSV of reproduce_gripper.py: no {sorted(missing)}")
+    arrays = {int(P): ensemble_arrays(d) for P, d in table.groupby("Pattern")}
+    angles = {len(g) for _, _, g in arrays.values()}
+    what = "; half with the reference's arccos angle" if angles != {1} else ""
+    fig = Figure(figsize=(11, 3.6 * len(arrays)))
+    axes = fig.subplots(len(arrays), 1, squeeze=False)[:, 0]
+    for ax, (P, (_, v, _)) in zip(axes, arrays.items(), strict=True):
         d = table[table["Pattern"] == P]
-        v = d[["stiff", *members]].to_numpy(float)
-        med = np.median(v, axis=1, keepdims=True)
-        rel = v / med - 1
-        pub = d["stiff_published"].to_numpy(float) / med[:, 0] - 1
+        pub = d["stiff_published"].to_numpy(float)
+        ok = np.isfinite(v).all(axis=1) & np.isfinite(pub)
+        v, pub = v[ok], pub[ok]
+        med = np.median(v, axis=1)
+        rel = v / med[:, None] - 1
         order = np.argsort(rel.max(1) - rel.min(1), kind="stable")
         x = np.arange(len(order))
         ax.vlines(x, rel[order].min(1), rel[order].max(1), color="0.6", lw=2.5, label="ensemble")
-        ax.plot(x, pub[order], "o", ms=3.5, color="C3", label="published")
+        ax.plot(x, (pub / med - 1)[order], "o", ms=3.5, color="C3", label="published")
         ax.set_yscale("symlog", linthresh=1e-4)
         ax.axhspan(-1e-3, 1e-3, color="C2", alpha=0.12, lw=0, label="within 1e-3")
         ax.set_xlim(-1, len(order))
         ax.set_ylabel("stiff / ensemble median - 1")
         ax.set_title(
-            f"{NAMES[P]}: prying stiffness of {len(d)} published rows, {v.shape[1]} runs each "
-            "differing only by round-off"
+            f"{NAMES[P]}: prying stiffness of {len(order)} published rows against "
+            f"{v.shape[1]} holofold runs each (L1 x (1 + k 1e-15){what})"
         )
         ax.legend(loc="upper left", fontsize=8, ncol=3)
-    axes[-1, 0].set_xlabel("rows, sorted by the spread of the ensemble")
+    axes[-1].set_xlabel("rows, sorted by the spread of the ensemble")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return patterns
+    return list(arrays)
+
+
+def analyse_saved(table: pd.DataFrame) -> None:
+    """Print the ensemble report of a saved ``--ensemble`` run (``--from-csv``)."""
+    for P, d in table.groupby("Pattern"):
+        ref = d.rename(columns={"finalQ_published": "finalQ_pub", "stiff_published": "stiff_pub"})
+        ref = ref.assign(finalQ=ref["finalQ_pub"], stiff=ref["stiff_pub"]).reset_index(drop=True)
+        emit(f"== pattern {int(P)} ({NAMES[int(P)]}): {len(d)} rows (saved run)")
+        ensemble_report(int(P), ref, *ensemble_arrays(d))
 
 
 def main(argv=None) -> int:
@@ -365,8 +408,8 @@ def main(argv=None) -> int:
         type=int,
         default=0,
         metavar="K",
-        help="also run every row K times with L1 x (1 + k 1e-15) and test whether the published "
-        "values are exchangeable with these round-off-level variants",
+        help="run every row K times in all, run k with L1 x (1 + k 1e-15), and test whether "
+        "the published values are exchangeable with these round-off-level variants",
     )
     ap.add_argument(
         "--ensemble-arccos",
@@ -382,16 +425,32 @@ def main(argv=None) -> int:
         "--plot",
         default=None,
         metavar="PNG",
-        help="with --ensemble: draw the published values against the ensemble (or redraw a "
-        "saved run: --plot PNG --replot CSV)",
+        help="with --ensemble or --from-csv: draw the published stiffness against the ensemble",
     )
-    ap.add_argument("--replot", default=None, metavar="CSV", help="a --save CSV to plot")
+    ap.add_argument(
+        "--from-csv",
+        default=None,
+        metavar="CSV",
+        help="report (and --plot) a saved --ensemble run instead of simulating",
+    )
     args = ap.parse_args(argv)
-    if args.replot:
-        if not args.plot:
-            ap.error("--replot needs --plot PNG")
-        plot_ensemble(pd.read_csv(args.replot), args.plot)
-        emit(f"picture written to {args.plot}")
+    if args.ensemble < 0 or args.ensemble == 1:
+        ap.error(f"--ensemble {args.ensemble}: needs K >= 2 runs per row")
+    if args.random and (args.ensemble or args.plot):
+        ap.error("--ensemble and --plot apply to the published rows, not to --random designs")
+    if args.plot and not (args.ensemble or args.from_csv):
+        ap.error("--plot needs --ensemble K (or --from-csv CSV)")
+    if args.ensemble_arccos and not args.ensemble:
+        ap.error("--ensemble-arccos needs --ensemble K")
+    if args.from_csv:
+        try:
+            table = pd.read_csv(args.from_csv)
+            analyse_saved(table)
+            if args.plot:
+                plot_ensemble(table, args.plot)
+                emit(f"picture written to {args.plot}")
+        except (OSError, ValueError, KeyError) as exc:
+            ap.error(f"--from-csv {args.from_csv}: {exc}")
         return 0
     options = GripperOptions(converged=args.converged)
     frames = []
@@ -431,20 +490,25 @@ def main(argv=None) -> int:
             if args.ensemble > 1:
                 t = time.perf_counter()
                 k = np.arange(1, args.ensemble)
-                angle = args.ensemble_arccos & (k % 2 == 1)
+                arccos = args.ensemble_arccos & (k % 2 == 1)
                 spec = [
                     (args.perturb + 1e-15 * kk, replace(options, arccos_angle=bool(a)))
-                    for kk, a in zip(k, angle, strict=True)
+                    for kk, a in zip(k, arccos, strict=True)
                 ]
-                members = [ours, *run_ensemble(rows, spec, args.workers)]
+                members = run_ensemble(rows, spec, args.workers)
                 emit(f"(ensemble: {time.perf_counter() - t:.0f} s wall)")
-                how = f"member k: L1 x (1 + k 1e-15), k = 0..{args.ensemble - 1}" + (
-                    ", arccos dihedral angle on odd k" if args.ensemble_arccos else ""
-                )
-                ensemble_report(P, ref.reset_index(drop=True), members, how)
                 extra = [
-                    m[["step", "stiff"]].add_suffix(f"_m{j}") for j, m in enumerate(members[1:], 1)
+                    m[["step", "stiff"]]
+                    .add_suffix(f"_m{kk}")
+                    .assign(**{f"angle_m{kk}": "arccos" if a else "atan2"})
+                    for kk, a, m in zip(k, arccos, members, strict=True)
                 ]
+                emit(
+                    f"  ensemble: member k = 0..{args.ensemble - 1} with L1 x (1 + k 1e-15)"
+                    + (", odd k with the reference's arccos angle" if args.ensemble_arccos else "")
+                )
+                saved = pd.concat([ours, *extra], axis=1)
+                ensemble_report(P, ref.reset_index(drop=True), *ensemble_arrays(saved))
             pub = ref.add_suffix("_published")
             frames.append(
                 pd.concat(

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from design.cli._parallel import add_parallel_arguments
-from design.runner import check_scheduler, evaluate_designs, validate_designs
+from design.cli._parallel import add_parallel_arguments, parallel_settings
+from design.runner import evaluate_designs, validate_designs
 from design.scenarios import SCENARIO_NAMES, get_scenario
 
 __all__ = ["register", "run", "read_designs", "write_results"]
@@ -114,10 +114,7 @@ def write_results(df: pd.DataFrame, path: Path) -> None:
 def run(args) -> int:
     scenario = get_scenario(args.scenario)
     _check_output(args.output)
-    if args.workers == 0 or args.workers < -1:
-        raise ValueError(f"--workers {args.workers}: must be >= 1 or -1 (every core)")
-    if args.scheduler is not None:
-        check_scheduler(args.scheduler)
+    workers, scheduler = parallel_settings(args)
     table = read_designs(args.designs)
     if len(table) == 0:
         raise ValueError(f"{args.designs} has no rows")
@@ -127,10 +124,10 @@ def run(args) -> int:
     res = evaluate_designs(
         scenario,
         table,
-        workers=args.workers,
+        workers=workers,
         progress=False if args.no_progress else None,
         log_warnings=False,  # printed above
-        scheduler=args.scheduler,
+        scheduler=scheduler,
     )
     write_results(res, args.output)
     ok = (res["status"] == "converged").sum()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from design.cli._parallel import add_parallel_arguments
+from design.cli._parallel import add_parallel_arguments, parallel_settings
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -55,7 +55,6 @@ def _parse_ranges(items):
 def run(args) -> int:
     from pathlib import Path
 
-    from design.runner import check_scheduler
     from design.sampling import sample_designs
     from design.scenarios import get_scenario
     from design.store import build_database
@@ -63,8 +62,7 @@ def run(args) -> int:
     scenario = get_scenario(args.scenario)
     if args.samples < 1:
         raise ValueError(f"--samples = {args.samples} must be >= 1")
-    if args.scheduler is not None:
-        check_scheduler(args.scheduler)
+    workers, scheduler = parallel_settings(args)
     designs = sample_designs(
         scenario, args.samples, seed=args.seed, method=args.method, ranges=_parse_ranges(args.range)
     )
@@ -73,9 +71,9 @@ def run(args) -> int:
         designs,
         args.output,
         chunk_size=args.chunk_size,
-        workers=args.workers,
+        workers=workers,
         meta={"seed": args.seed, "method": args.method, "ranges": args.range},
-        scheduler=args.scheduler,
+        scheduler=scheduler,
     )
     if args.csv:
         db.to_csv(Path(args.output) / "database.csv", index=False)

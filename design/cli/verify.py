@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from design.cli._parallel import add_parallel_arguments
+from design.cli._parallel import add_parallel_arguments, parallel_settings
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -33,7 +33,7 @@ def run(args) -> int:
     from contextlib import nullcontext
     from pathlib import Path
 
-    from design.runner import check_scheduler, dask_scheduler
+    from design.runner import dask_scheduler
     from design.scenarios import get_scenario
     from design.targets import parse_target
     from design.verify import rule_ranges, verify_rule
@@ -42,8 +42,7 @@ def run(args) -> int:
     parse_target(args.target, scenario.performance_names)
     if args.samples < 1:
         raise ValueError(f"--samples = {args.samples} must be >= 1")
-    if args.scheduler is not None:
-        check_scheduler(args.scheduler)
+    workers, scheduler = parallel_settings(args)
     try:
         rules = json.loads(Path(args.rules).read_text())
     except json.JSONDecodeError as exc:
@@ -56,7 +55,7 @@ def run(args) -> int:
     out = Path(args.output) if args.output else None
     report = []
     # a local Dask cluster is started once for all rules
-    cluster = dask_scheduler(args.scheduler, args.workers) if args.scheduler else nullcontext()
+    cluster = dask_scheduler(scheduler, workers) if scheduler else nullcontext()
     with cluster as address:
         for i, r in enumerate(rules, start=1):
             v = verify_rule(
@@ -65,7 +64,7 @@ def run(args) -> int:
                 args.target,
                 args.samples,
                 seed=args.seed + i,
-                workers=1 if address else args.workers,
+                workers=1 if address else workers,
                 scheduler=address,
             )
             s = v.summary()
