@@ -286,12 +286,17 @@ def _evaluate_on_dask(
             from tqdm import tqdm
 
             done = tqdm(done, total=n, desc=scenario.name, unit="design", file=sys.stderr)
-        for f in done:
-            if f.status == "error":
-                outs[where[f.key]] = _failed(scenario, f.exception())
-            else:
-                outs[where[f.key]] = f.result()
-            f.release()
+        try:
+            for f in done:
+                if f.status == "error":
+                    outs[where[f.key]] = _failed(scenario, f.exception())
+                else:
+                    outs[where[f.key]] = f.result()
+                f.release()
+        finally:  # interrupted (Ctrl-C, lost scheduler): leave nothing running on the cluster
+            client.cancel([f for f in futures if not f.done()])
+            if progress:
+                done.close()
     return outs
 
 

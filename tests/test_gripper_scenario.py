@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from design.scenarios import get_scenario
 from design.scenarios.gripper import (
     SCENARIO,
     STATUS_NO_CLOSURE,
@@ -99,11 +100,32 @@ def test_converged_mode_is_repeatable(reference_data):
     # every prying increment met the tight tolerance
     (run,) = a.stiffness_runs
     assert run.ok and run.converged.all()
+    # the scenario object runs the converged mode
+    conv = get_scenario("gripper-converged").evaluate(row)
+    assert conv["stiff"] == pytest.approx(a.stiff, rel=1e-9) and conv["status"] == "converged"
     assert GripperOptions(converged=True).tolerance(5e-6, "displacement") == {
         "tol": 1e-12,
         "max_iter": 200,
     }
     assert GripperOptions().tolerance(5e-6, "force") == {"tol": 5e-6}
+
+
+@pytest.mark.slow
+def test_converged_mode_splitted_row(reference_data):
+    """Splitted row 1 in converged mode (pre-bias and both prying runs with the tight
+    tolerance): repeatable, every solve converged, the published closing step and Tmax, and the
+    published stiffness to 1e-4 (this row's loosely converged solves end near equilibrium)."""
+    df = reference_data.load("data2_SplittedMiura_sample")
+    row = _row(df, 0)
+    opt = GripperOptions(converged=True, keep_history=True)
+    a = simulate(row, opt)
+    b = simulate(row | {"L1": row["L1"] * (1 + 1e-15)}, opt)
+    assert a.status == b.status == "converged" and a.closing_step == b.closing_step == 117
+    assert b.stiff == pytest.approx(a.stiff, rel=1e-9)
+    r1, r2 = a.stiffness_runs
+    assert r1.converged.all() and r2.converged.all()
+    assert a.Tmax == pytest.approx(df["Tmax"].iloc[0], rel=1e-6)
+    assert a.stiff == pytest.approx(df["stiff"].iloc[0], rel=1e-4)
 
 
 @pytest.mark.slow

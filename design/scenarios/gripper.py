@@ -705,10 +705,12 @@ CONVERGED = GripperOptions(converged=True)
 SCENARIO_CONVERGED = replace(
     SCENARIO,
     name="gripper-converged",
-    description=SCENARIO.description.replace(
-        " (Zhu & Filipov 2022, data2).",
-        "; every Newton solve converged to a tight tolerance, so the outputs are repeatable"
-        " (the published data2 stiffness is not: it comes from loosely converged solves).",
+    description=(
+        "Electro-thermal gripper, three patterns (1 Miura-based, 2 splitted Miura, 3 two-panel):"
+        " angular natural frequency (rad/s), heating power and maximum temperature at closure,"
+        " prying stiffness; every Newton solve converged to a tight tolerance, so the outputs"
+        " are repeatable (the published data2 stiffness is not: it comes from loosely"
+        " converged solves)."
     ),
     evaluate=evaluate_converged,
     reference_files=(),
