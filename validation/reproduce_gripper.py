@@ -69,7 +69,9 @@ def _run(row: dict, perturb: float = 0.0, options: GripperOptions = DEFAULT) -> 
     return out
 
 
-def run_rows(rows: list[dict], workers: int, perturb=0.0, options=DEFAULT) -> list[dict]:
+def run_rows(
+    rows: list[dict], workers: int, perturb: float | np.ndarray = 0.0, options=DEFAULT
+) -> list[dict]:
     """Simulate ``rows``; ``perturb`` (relative L1 change) and ``options`` are one for all
     rows or a sequence with one per row."""
     n = len(rows)
