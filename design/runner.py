@@ -17,7 +17,7 @@ import re
 import sys
 from collections import Counter
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -254,19 +254,21 @@ def _worker_ready(scenario: Scenario) -> str:
     return scenario.name
 
 
-def _evaluate_on_dask(
-    scenario: Scenario, rows: list, limit_threads: bool, address: str, progress: bool
-) -> list:
-    """Evaluate ``rows`` on the Dask scheduler at ``address``; results in input order.
+def _iter_on_dask(
+    scenario: Scenario, rows: list, limit_threads: bool, address: str
+) -> Iterator[tuple[int, dict]]:
+    """Evaluate ``rows`` on the Dask scheduler at ``address``, yielding results as they finish.
 
-    A task that errs outside :func:`_evaluate_one` (its worker died: ``KilledWorker``)
-    becomes a failed row. Workers that cannot import holofold, or a lost scheduler (cancelled
-    futures), raise: nothing of the batch is kept.
+    Every row is submitted at once; ``(i, result)`` pairs (``i`` the 0-based position in
+    ``rows``) come in order of completion. A task that errs outside :func:`_evaluate_one` (its
+    worker died: ``KilledWorker``) yields a failed row. Workers that cannot import holofold
+    raise ``ValueError`` before anything is submitted; a lost scheduler (cancelled futures)
+    raises. When the generator ends early (an exception, or ``close()``: wrap it in
+    :func:`contextlib.closing`), the tasks still pending are cancelled.
     """
     from distributed import Client, as_completed
 
     n = len(rows)
-    outs: list = [None] * n
     with Client(address, set_as_default=False) as client:
         # a worker that cannot unpickle a task drops out of the cluster and the batch would wait
         # forever; client.run reports the same failure instead
@@ -281,22 +283,37 @@ def _evaluate_on_dask(
             log.warning("no Dask workers at %s yet: the designs wait for some to join", address)
         futures = client.map(_evaluate_one, [scenario] * n, rows, [limit_threads] * n, pure=False)
         where = {f.key: i for i, f in enumerate(futures)}
-        done = as_completed(futures, loop=client.loop)
-        if progress:
-            from tqdm import tqdm
-
-            done = tqdm(done, total=n, desc=scenario.name, unit="design", file=sys.stderr)
         try:
-            for f in done:
-                if f.status == "error":
-                    outs[where[f.key]] = _failed(scenario, f.exception())
-                else:
-                    outs[where[f.key]] = f.result()
-                f.release()
+            for f in as_completed(futures, loop=client.loop):
+                out = _failed(scenario, f.exception()) if f.status == "error" else f.result()
+                f.release()  # the cluster forgets the result; the caller holds the only copy
+                yield where[f.key], out
         finally:  # interrupted (Ctrl-C, lost scheduler): leave nothing running on the cluster
             client.cancel([f for f in futures if not f.done()])
-            if progress:
-                done.close()
+
+
+def _evaluate_on_dask(
+    scenario: Scenario, rows: list, limit_threads: bool, address: str, progress: bool
+) -> list:
+    """Evaluate ``rows`` on the Dask scheduler at ``address``; results in input order.
+
+    See :func:`_iter_on_dask` (failed rows, workers without holofold, cancellation).
+    """
+    outs: list = [None] * len(rows)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(rows), desc=scenario.name, unit="design", file=sys.stderr)
+    try:
+        with closing(_iter_on_dask(scenario, rows, limit_threads, address)) as results:
+            for i, out in results:
+                outs[i] = out
+                if bar is not None:
+                    bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
     return outs
 
 

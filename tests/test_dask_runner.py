@@ -144,37 +144,109 @@ def test_unreachable_scheduler_names_it():
             evaluate_designs(TOY, df, scheduler="tcp://127.0.0.1:1")
 
 
+def _slow_first(row):
+    if row["a"] == 1:
+        time.sleep(0.3)  # the first chunk finishes after all the others
+    if row["a"] == 5:
+        raise RuntimeError("unlucky design")
+    return {"double": 2 * row["a"], "status": "converged"}
+
+
+SLOW_FIRST = Scenario(**{**TOY.__dict__, "name": "slow-first", "evaluate": _slow_first})
+EVALUATED = []  # rows run by _recording_evaluate_one (the in-process workers share it)
+_EVALUATE_ONE = runner._evaluate_one
+
+
+def _recording_evaluate_one(scenario, row, limit_threads):
+    EVALUATED.append(tuple(sorted(row.items())))
+    return _EVALUATE_ONE(scenario, row, limit_threads)
+
+
+def _chunk_files(folder):
+    return {p.name: pd.read_parquet(p) for p in sorted((folder / "chunks").glob("*"))}
+
+
+def _record_writes(monkeypatch, fail_at=None):
+    """Record the chunk files ``store._write_atomic`` writes; Ctrl-C instead of write fail_at."""
+    written, real = [], store._write_atomic
+
+    def recording(df, path):
+        if path.parent.name == "chunks":
+            if len(written) + 1 == fail_at:
+                raise KeyboardInterrupt
+            written.append(path.name)
+        real(df, path)
+
+    monkeypatch.setattr(store, "_write_atomic", recording)
+    return written
+
+
+def test_dask_build_writes_each_chunk_when_its_rows_are_done(
+    address, tmp_path, monkeypatch, capsys
+):
+    designs = pd.DataFrame({"id": list("pqrstuv"), "a": np.arange(1.0, 8.0)}, index=range(10, 17))
+    serial = store.build_database(SLOW_FIRST, designs, tmp_path / "serial", chunk_size=2)
+    written = _record_writes(monkeypatch)
+    db = store.build_database(
+        SLOW_FIRST, designs, tmp_path / "dask", chunk_size=2, scheduler=address, progress=True
+    )
+    # every row was submitted at once: the three later chunks were written while the first
+    # chunk's slow row was still running
+    assert sorted(written[:3]) == ["part-00001.parquet", "part-00002.parquet", "part-00003.parquet"]
+    assert written[3:] == ["part-00000.parquet"]
+    assert "7/7" in capsys.readouterr().err  # the bar counted every row
+    assert db["status"].tolist()[4] == "failed: RuntimeError: unlucky design"
+    assert db["double"].tolist()[:4] == [2.0, 4.0, 6.0, 8.0]
+    pd.testing.assert_frame_equal(db, serial, check_exact=True)
+    a, b = _chunk_files(tmp_path / "dask"), _chunk_files(tmp_path / "serial")
+    assert list(a) == list(b) == [f"part-0000{k}.parquet" for k in range(4)]
+    for name in a:
+        pd.testing.assert_frame_equal(a[name], b[name], check_exact=True)
+
+
 def test_interrupted_dask_build_resumes_without_duplicates(address, miura, tmp_path, monkeypatch):
     sc, _ = miura
     designs = sample_designs(sc, 7, seed=1)
-    calls, started = [], []
-    real = store.evaluate_designs
-
-    def counting(scenario, part, **kw):
-        calls.append((list(part["sample"]), kw["scheduler"], kw["workers"]))
-        if len(calls) == 2 and not hasattr(counting, "interrupted"):
-            counting.interrupted = True
-            raise KeyboardInterrupt
-        return real(scenario, part, **kw)
+    serial = store.build_database(sc, designs, tmp_path / "serial", chunk_size=2)
+    started = []
 
     @contextmanager
     def fake_local(scheduler, workers):  # stands in for starting a LocalCluster
         started.append((scheduler, workers))
         yield address
 
-    monkeypatch.setattr(store, "evaluate_designs", counting)
     monkeypatch.setattr(store, "dask_scheduler", fake_local)
+    monkeypatch.setattr(runner, "_evaluate_one", _recording_evaluate_one)
+    EVALUATED.clear()
     db_dir = tmp_path / "db"
+    written = _record_writes(monkeypatch, fail_at=3)  # Ctrl-C when a third chunk is complete
     with pytest.raises(KeyboardInterrupt):
-        store.build_database(sc, designs, db_dir, chunk_size=3, scheduler="local", workers=3)
-    assert len(list((db_dir / "chunks").glob("*.parquet"))) == 1
-    calls.clear()
-    db = store.build_database(sc, designs, db_dir, chunk_size=3, scheduler="local", workers=3)
+        store.build_database(sc, designs, db_dir, chunk_size=2, scheduler="local", workers=3)
+    assert len(written) == 2
+    assert sorted(p.name for p in (db_dir / "chunks").iterdir()) == sorted(written)
+    assert not (db_dir / "database.parquet").exists()
+    assert len(EVALUATED) <= 7  # every row submitted once
+    first_run = set(written)
+    with distributed.Client(address, set_as_default=False) as client:  # nothing left running
+        for _ in range(50):
+            if not client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)):
+                break
+            time.sleep(0.1)
+        assert not client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks))
+    EVALUATED.clear()
+    written.clear()
+    db = store.build_database(sc, designs, db_dir, chunk_size=2, scheduler="local", workers=3)
     assert started == [("local", 3), ("local", 3)]  # one cluster per run, not per chunk
-    assert calls == [([3, 4, 5], address, 1), ([6], address, 1)]  # only the missing chunks
+    assert sorted(_chunk_files(db_dir)) == [f"part-0000{k}.parquet" for k in range(4)]
+    rest = [k for k in range(4) if f"part-0000{k}.parquet" not in first_run]
+    assert sorted(written) == [f"part-0000{k}.parquet" for k in rest]  # only the missing ones
+    rows = runner.validate_designs(sc, designs).rows
+    want = [tuple(sorted(rows[i].items())) for k in rest for i in range(2 * k, min(7, 2 * k + 2))]
+    assert sorted(EVALUATED) == sorted(want)  # only the missing chunks' rows, each once
     assert list(db["sample"]) == list(range(7))
-    ref = evaluate_designs(sc, designs)
-    pd.testing.assert_frame_equal(db, ref, check_exact=True)
+    pd.testing.assert_frame_equal(db, serial, check_exact=True)
+    for name, part in _chunk_files(tmp_path / "serial").items():
+        pd.testing.assert_frame_equal(pd.read_parquet(db_dir / "chunks" / name), part)
 
 
 def test_cli_scheduler_flag(address, miura, tmp_path, capsys):
