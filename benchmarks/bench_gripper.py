@@ -6,7 +6,7 @@ prying stiffness -- with its closing heating step, the time per heating step, th
 simulator's Octave figures of the issue and the target of 2 s per sample; the last column is the
 same run with every Newton solve converged tightly (``GripperOptions(converged=True)``).
 
-    PYTHONPATH=. python benchmarks/bench_gripper.py [--repeat 3]
+    python benchmarks/bench_gripper.py [--repeat 3]
 """
 
 from __future__ import annotations
@@ -19,13 +19,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
+
+from holofold.design.scenarios.gripper import GripperOptions, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from threadpoolctl import threadpool_limits  # noqa: E402
-
-from design.scenarios.gripper import GripperOptions, simulate  # noqa: E402
 
 #: (file, 0-based row): published rows closing at heating steps 145, 117 and 88
 SAMPLES = {

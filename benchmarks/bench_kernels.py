@@ -2,7 +2,7 @@
 
 Run from the repository root::
 
-    OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/bench_kernels.py [--repeat 7]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_kernels.py [--repeat 7]
 
 Models: concentrated-hinge Miura sheets (``geometry.miura.miura_sheet`` +
 ``mechanics.hinges.build_concentrated``) when those modules are importable, and synthetic
@@ -21,10 +21,10 @@ import time
 
 import numpy as np
 
-from mechanics.assembly import BANDED_MAX_WORK, DENSE_MAX_DOF, Assembler
-from mechanics.solvers import solve_newton
-from mechanics.springs import dihedral_angle
-from mechanics.structure import Structure
+from holofold.mechanics.assembly import BANDED_MAX_WORK, DENSE_MAX_DOF, Assembler
+from holofold.mechanics.solvers import solve_newton
+from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.structure import Structure
 
 
 def synthetic_sheet(nx: int, ny: int, *, seed: int = 0) -> Structure:
@@ -61,8 +61,8 @@ def synthetic_sheet(nx: int, ny: int, *, seed: int = 0) -> Structure:
 
 def miura_model(m: int, n: int) -> Structure | None:
     try:
-        from geometry.miura import miura_sheet
-        from mechanics.hinges import build_concentrated
+        from holofold.geometry.miura import miura_sheet
+        from holofold.mechanics.hinges import build_concentrated
     except ImportError:
         return None
     p = miura_sheet(m, n, 0.01, 0.01, np.deg2rad(60.0), 0.6)

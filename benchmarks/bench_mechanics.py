@@ -6,7 +6,7 @@ thread) for one arch sample at m = 8, 12, 16, 24 (both load cases), one single M
 reference simulator's Octave figures of the issue and the speed-up. ``build`` is the part spent
 building the models (geometry + bar-and-hinge model), the rest is the nonlinear solves.
 
-    PYTHONPATH=. python benchmarks/bench_mechanics.py [--repeat 7]
+    python benchmarks/bench_mechanics.py [--repeat 7]
 """
 
 from __future__ import annotations
@@ -15,13 +15,10 @@ import argparse
 import statistics
 import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from threadpoolctl import threadpool_limits
 
-from threadpoolctl import threadpool_limits  # noqa: E402
-
-from design.scenarios import arch, canopy, single_miura  # noqa: E402
+from holofold.design.scenarios import arch, canopy, single_miura
 
 # a design in the middle of the paper's sampling ranges (SI units)
 MID = dict(tcrease=0.75e-3, tpanel=3.5e-3, W=2.5e-3)

@@ -11,7 +11,7 @@ the targets, and the speed-up (reference / holofold):
 * a whole run on data3 (fit + test scoring of the rules) on 2 threads;
 * the 7 x 5 x 5 grid of Fig. S8 (depth 8..32 x 20..200 trees x 5 splits) on 2 processes.
 
-    PYTHONPATH=. python benchmarks/bench_rules.py [--repeat 5] [--data DIR] [--no-grid]
+    python benchmarks/bench_rules.py [--repeat 5] [--data DIR] [--no-grid]
 """
 
 from __future__ import annotations
@@ -27,12 +27,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from design.database import read_table  # noqa: E402
-from design.evaluation import grid_search, rule_scores, split_indices  # noqa: E402
-from design.rules import FewRulesWarning, ForestRuleMiner  # noqa: E402
-from design.targets import parse_target  # noqa: E402
+from holofold.design.database import read_table
+from holofold.design.evaluation import grid_search, rule_scores, split_indices
+from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.targets import parse_target
 
 FEATURES = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]
 TARGET = "Zstiff > 800 & Xstiff > 600 & error < 0.1"

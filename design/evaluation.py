@@ -23,7 +23,7 @@ from sklearn.neighbors import KNeighborsClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.rules import FewRulesWarning, ForestRuleMiner
 
 __all__ = [
     "HoldoutResult",

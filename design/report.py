@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from design.rules import ForestRuleMiner, format_rule
+from holofold.design.rules import ForestRuleMiner, format_rule
 
 __all__ = [
     "rules_frame",

@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from design.scenarios import Scenario, get_scenario
-from design.scenarios.base import single_thread
+from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.scenarios.base import single_thread
 
 __all__ = [
     "DesignTableError",

@@ -16,7 +16,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from design.scenarios.base import Scenario
+from holofold.design.scenarios.base import Scenario
 
 __all__ = ["sample_designs", "METHODS"]
 

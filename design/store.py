@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from design.runner import (
+from holofold.design.runner import (
     _assemble,
     _iter_on_dask,
     check_scheduler,
@@ -34,7 +34,7 @@ from design.runner import (
     evaluate_designs,
     validate_designs,
 )
-from design.scenarios import Scenario, get_scenario
+from holofold.design.scenarios import Scenario, get_scenario
 
 __all__ = ["build_database", "load_database"]
 

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from design.runner import evaluate_designs
-from design.sampling import sample_designs
-from design.scenarios import Scenario, get_scenario
-from design.targets import parse_target
+from holofold.design.runner import evaluate_designs
+from holofold.design.sampling import sample_designs
+from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.targets import parse_target
 
 __all__ = ["rule_ranges", "verify_rule", "Verification"]
 

@@ -2,7 +2,7 @@
 
 Usage::
 
-    PYTHONPATH=. python examples/fit_curves.py [output-folder]    # default: docs/
+    python examples/fit_curves.py [output-folder]    # default: docs/
 
 1. the paper's half circle of radius 2 m (paper sampling, m = 12, l_o = 0.2 m),
 2. a catenary arch (span 4 m, height 2 m) with m and offset chosen by ``fit_auto`` for a
@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fitting import PlanarCurve, fit_strip, parse_curve_spec
-from fitting.auto import fit_auto
+from holofold.fitting import PlanarCurve, fit_strip, parse_curve_spec
+from holofold.fitting.auto import fit_auto
 
 #: filled by :func:`main`: {"backend": ..., "png": ..., "strips": [dict per strip]}
 RESULT: dict = {}

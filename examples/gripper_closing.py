@@ -1,6 +1,6 @@
 """Heat two electro-thermal origami grippers until they close and draw how they close.
 
-    PYTHONPATH=. python examples/gripper_closing.py [output.png]     # default: docs/gripper.png
+    python examples/gripper_closing.py [output.png]     # default: docs/gripper.png
 
 Simulates one two-panel gripper (pattern 3) and one splitted-Miura gripper (pattern 2) of the
 paper's scenario 3 (``design.scenarios.gripper``, repeatable ``converged=True`` solves): every
@@ -27,7 +27,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from shapely.geometry import Polygon  # noqa: E402
 from shapely.ops import unary_union  # noqa: E402
 
-from design.scenarios.gripper import (  # noqa: E402
+from holofold.design.scenarios.gripper import (  # noqa: E402
     CLOSURE,
     CLOSURE_PAIR,
     ROOM_T,

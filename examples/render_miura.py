@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pyvista as pv
 
-from geometry.mesh import folded_mesh
-from geometry.miura import miura_sheet
-from geometry.solid import thick_solid
+from holofold.geometry.mesh import folded_mesh
+from holofold.geometry.miura import miura_sheet
+from holofold.geometry.solid import thick_solid
 
 pv.OFF_SCREEN = True
 DEFAULT = Path(__file__).resolve().parents[1] / "docs" / "miura.png"

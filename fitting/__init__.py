@@ -6,8 +6,8 @@ Modules: :mod:`fitting.curves` (curve types, parsing, lengths, distances),
 :mod:`fitting.auto` (choosing m and offset for a tolerance).
 """
 
-from fitting.auto import AutoFit, FitNotFoundError, fit_auto
-from fitting.curves import (
+from holofold.fitting.auto import AutoFit, FitNotFoundError, fit_auto
+from holofold.fitting.curves import (
     BUILTIN_CURVES,
     CurveError,
     PlanarCurve,
@@ -17,8 +17,13 @@ from fitting.curves import (
     read_points_csv,
     read_svg_curve,
 )
-from fitting.error import ClosestPointError, closest_point_error, index_matched_error, paper_error
-from fitting.strip import SAMPLINGS, StripFit, fit_strip
+from holofold.fitting.error import (
+    ClosestPointError,
+    closest_point_error,
+    index_matched_error,
+    paper_error,
+)
+from holofold.fitting.strip import SAMPLINGS, StripFit, fit_strip
 
 __all__ = [
     "BUILTIN_CURVES",

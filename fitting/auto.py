@@ -18,9 +18,9 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from fitting.curves import load_curve
-from fitting.error import closest_point_error, index_matched_error
-from fitting.strip import (
+from holofold.fitting.curves import load_curve
+from holofold.fitting.error import closest_point_error, index_matched_error
+from holofold.fitting.strip import (
     StripFit,
     _check_m,
     _check_sampling,
@@ -29,7 +29,7 @@ from fitting.strip import (
     strip_samples,
     zigzag_centre_line,
 )
-from geometry.errors import DegenerateGeometryError, ParameterError, check_range
+from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 
 __all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"]
 

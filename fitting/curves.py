@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from geometry.errors import DegenerateGeometryError, FormatError, ParameterError
+from holofold.geometry.errors import DegenerateGeometryError, FormatError, ParameterError
 
 __all__ = [
     "CurveError",
@@ -211,7 +211,7 @@ class PlanarCurve:
 
     def scaled(self, factor: float) -> PlanarCurve:
         """The curve scaled about the origin by ``factor`` > 0 (e.g. SVG units -> metres)."""
-        from geometry.errors import check_range
+        from holofold.geometry.errors import check_range
 
         k = check_range("scale", factor, 0.0, None, low_open=True)
         if k == 1.0:
@@ -405,7 +405,7 @@ class PlanarCurve:
 
 # ---------------------------------------------------------------------- built-ins
 def _positive(name: str, value: float) -> float:
-    from geometry.errors import check_range
+    from holofold.geometry.errors import check_range
 
     return check_range(name, value, 0.0, None, low_open=True)
 
@@ -423,7 +423,7 @@ def _half_circle(radius: float = 2.0) -> PlanarCurve:
 
 
 def _arc(radius: float = 2.0, angle: float = 120.0) -> PlanarCurve:
-    from geometry.errors import check_range
+    from holofold.geometry.errors import check_range
 
     R = _positive("radius", radius)
     a_deg = check_range("angle", angle, 0.0, 360.0, low_open=True, high_open=True)

@@ -19,8 +19,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from fitting.curves import PlanarCurve
-from geometry.errors import ParameterError
+from holofold.fitting.curves import PlanarCurve
+from holofold.geometry.errors import ParameterError
 
 __all__ = [
     "ClosestPointError",
@@ -70,8 +70,8 @@ def paper_error(curve, m, offset, seg: int = SEG):
         e in metres, the shape of the broadcast inputs. Vectorised: one evaluation of the
         curve per distinct m.
     """
-    from fitting.curves import load_curve
-    from fitting.strip import _odd_normals
+    from holofold.fitting.curves import load_curve
+    from holofold.fitting.strip import _odd_normals
 
     curve = load_curve(curve)
     m_arr, off_arr = np.broadcast_arrays(np.asarray(m), np.asarray(offset, dtype=float))

@@ -48,15 +48,15 @@ from typing import Any
 
 import numpy as np
 
-from fitting.curves import PlanarCurve, load_curve
-from fitting.error import ClosestPointError, closest_point_error, index_matched_error
-from geometry.errors import (
+from holofold.fitting.curves import PlanarCurve, load_curve
+from holofold.fitting.error import ClosestPointError, closest_point_error, index_matched_error
+from holofold.geometry.errors import (
     DegenerateGeometryError,
     InvalidPatternError,
     ParameterError,
     check_range,
 )
-from geometry.pattern import CreasePattern
+from holofold.geometry.pattern import CreasePattern
 
 __all__ = [
     "StripFit",
@@ -374,7 +374,7 @@ def fit_strip(
         "sampling": sampling,
         "curve": curve.name,
         "curve_params": dict(curve.params),
-        "generator": "fitting.strip.fit_strip (specs/scenarios.md 5.3-5.4)",
+        "generator": "holofold.fitting.strip.fit_strip (specs/scenarios.md 5.3-5.4)",
     }
     try:
         pattern = CreasePattern.from_faces(X, list(faces), flat=None, meta=meta)

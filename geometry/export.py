@@ -12,10 +12,10 @@ from pathlib import Path
 
 import trimesh
 
-from geometry.fold_io import export_fold
-from geometry.mesh import MESH_TYPES, export_mesh, folded_mesh
-from geometry.pattern import CreasePattern
-from geometry.svg import export_svg
+from holofold.geometry.fold_io import export_fold
+from holofold.geometry.mesh import MESH_TYPES, export_mesh, folded_mesh
+from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.svg import export_svg
 
 __all__ = ["export", "EXPORT_TYPES"]
 

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from geometry.errors import FormatError
-from geometry.pattern import ASSIGNMENTS, CreasePattern
+from holofold.geometry.errors import FormatError
+from holofold.geometry.pattern import ASSIGNMENTS, CreasePattern
 
 __all__ = ["fold_dict", "export_fold", "load_fold", "FoldWarning"]
 

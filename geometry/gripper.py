@@ -34,8 +34,8 @@ import math
 
 import numpy as np
 
-from geometry.errors import ParameterError, check_range
-from geometry.pattern import CreasePattern
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.pattern import CreasePattern
 
 __all__ = [
     "miura_based_gripper",

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from geometry.pattern import CreasePattern, orient_faces
+from holofold.geometry.pattern import CreasePattern, orient_faces
 
 __all__ = ["fan_triangulation", "folded_mesh", "flat_mesh", "export_mesh", "MESH_TYPES"]
 

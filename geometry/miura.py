@@ -24,8 +24,8 @@ import numbers
 
 import numpy as np
 
-from geometry.errors import ParameterError, check_range
-from geometry.pattern import CreasePattern, measure_fold_angles, reference_edges
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.pattern import CreasePattern, measure_fold_angles, reference_edges
 
 __all__ = ["miura_cell", "miura_sheet", "miura_sheet_paper", "miura_nodes", "miura_faces"]
 

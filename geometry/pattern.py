@@ -29,7 +29,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from geometry.errors import DegenerateGeometryError, InvalidPatternError
+from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError
 
 __all__ = [
     "ASSIGNMENTS",

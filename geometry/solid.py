@@ -21,8 +21,8 @@ import warnings
 import numpy as np
 import trimesh
 
-from geometry.errors import DegenerateGeometryError, ParameterError
-from geometry.pattern import CreasePattern, newell_normals, orient_faces
+from holofold.geometry.errors import DegenerateGeometryError, ParameterError
+from holofold.geometry.pattern import CreasePattern, newell_normals, orient_faces
 
 __all__ = ["shrunk_panels", "panel_solids", "thick_solid", "SolidWarning"]
 

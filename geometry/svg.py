@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geometry.errors import FormatError
-from geometry.pattern import CreasePattern
+from holofold.geometry.errors import FormatError
+from holofold.geometry.pattern import CreasePattern
 
 __all__ = ["COLOURS", "export_svg", "load_svg", "SvgLines"]
 

@@ -32,9 +32,9 @@ import math
 
 import numpy as np
 
-from geometry.errors import ParameterError, check_range
-from geometry.miura import check_count, rigid_fold_pattern
-from geometry.pattern import CreasePattern
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.miura import check_count, rigid_fold_pattern
+from holofold.geometry.pattern import CreasePattern
 
 __all__ = ["tmp_sheet", "tmp_nodes", "tmp_faces", "tmp_node_count"]
 

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geometry.errors import ParameterError
-from mechanics.solvers import solve_mgdcm, solve_newton
-from mechanics.solvers.result import SolveResult
-from mechanics.structure import Structure
+from holofold.geometry.errors import ParameterError
+from holofold.mechanics.solvers import solve_mgdcm, solve_newton
+from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.structure import Structure
 
 __all__ = [
     "LoadGroup",

@@ -35,9 +35,9 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from mechanics.bars import bar_kernel
-from mechanics.springs import SPRING_BLOCKS, spring_kernel
-from mechanics.structure import Structure
+from holofold.mechanics.bars import bar_kernel
+from holofold.mechanics.springs import SPRING_BLOCKS, spring_kernel
+from holofold.mechanics.structure import Structure
 
 __all__ = [
     "AssemblyPattern",

@@ -23,11 +23,11 @@ import weakref
 
 import numpy as np
 
-from geometry.errors import ParameterError, check_range
-from geometry.pattern import CreasePattern
-from mechanics.compat import PAPER, Profile
-from mechanics.springs import dihedral_angle
-from mechanics.structure import BarType, SpringRole, Structure
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.compat import PAPER, Profile
+from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.structure import BarType, SpringRole, Structure
 
 __all__ = [
     "build_concentrated",

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechanics.bars import ElementResponse
+from holofold.mechanics.bars import ElementResponse
 
 __all__ = [
     "dihedral_angle",

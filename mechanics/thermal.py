@@ -29,9 +29,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from mechanics.compat import PAPER
-from mechanics.hinges import crease_rest_targets
-from mechanics.solvers import solve_selffold
+from holofold.mechanics.compat import PAPER
+from holofold.mechanics.hinges import crease_rest_targets
+from holofold.mechanics.solvers import solve_selffold
 
 __all__ = [
     "ThermalModel",

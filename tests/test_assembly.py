@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from mechanics.assembly import Assembler, assembly_pattern
-from mechanics.bars import bar_forces
-from mechanics.springs import dihedral_angle, spring_forces
-from mechanics.structure import Structure
+from holofold.mechanics.assembly import Assembler, assembly_pattern
+from holofold.mechanics.bars import bar_forces
+from holofold.mechanics.springs import dihedral_angle, spring_forces
+from holofold.mechanics.structure import Structure
 
 
 def grid_structure(nx=4, ny=3, *, amp=0.15, seed=0, k=0.5, supports=None):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from mechanics.bars import bar_forces, bar_strain
+from holofold.mechanics.bars import bar_forces, bar_strain
 
 
 def _random_bars(rng, nn=6, nb=9):

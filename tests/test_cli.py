@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from design.cli import _command_modules, build_parser, main
+from holofold.cli import _command_modules, build_parser, main
 
 
 def test_subcommands_are_discovered():
@@ -25,7 +25,7 @@ def test_each_subcommand_has_help(name, capsys):
 
 def test_unknown_subcommand_exits_nonzero():
     proc = subprocess.run(
-        [sys.executable, "-m", "design.cli", "no-such-command"], capture_output=True, text=True
+        [sys.executable, "-m", "holofold.cli", "no-such-command"], capture_output=True, text=True
     )
     assert proc.returncode == 2
     assert "invalid choice" in proc.stderr

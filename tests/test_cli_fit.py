@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from design.cli import main
-from fitting.error import paper_error
-from geometry.solid import SolidWarning
+from holofold.cli import main
+from holofold.fitting.error import paper_error
+from holofold.geometry.solid import SolidWarning
 
 BASE = ["fit", "--curve", "half-circle:radius=2"]
 DESIGN = ["--m", "12", "--offset", "0.2", "--strip-width", "0.02", "--extrude", "0.1"]
@@ -104,8 +104,8 @@ def test_thick_solid(tmp_path, capsys):
 
 
 def test_plan_view_svg_without_layout():
-    from design.cli.fit import _plan_view_svg
-    from fitting.strip import fit_strip
+    from holofold.cli.fit import _plan_view_svg
+    from holofold.fitting.strip import fit_strip
 
     fit = fit_strip("half-circle", 8, 0.2, 0.02, 0.1)
     svg = _plan_view_svg(fit)

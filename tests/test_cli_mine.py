@@ -6,10 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from design.cli import main
-from design.evaluation import holdout
-from design.rules import ForestRuleMiner
-from design.targets import parse_target
+from holofold.cli import main
+from holofold.design.evaluation import holdout
+from holofold.design.rules import ForestRuleMiner
+from holofold.design.targets import parse_target
 
 
 def test_mine_published_txt_matches_holdout(reference_data, tmp_path, capsys):

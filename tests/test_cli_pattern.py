@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from design.cli import main
-from geometry.fold_io import load_fold
+from holofold.cli import main
+from holofold.geometry.fold_io import load_fold
 
 
 def test_miura_writes_all_files(tmp_path, capsys):

@@ -7,9 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from design.scenarios.single_miura import EXTENSIONS, cell_models
-from mechanics.analyses import secant_stiffness
-from mechanics.compat import PAPER, PHYSICAL, Profile
+from holofold.design.scenarios.single_miura import EXTENSIONS, cell_models
+from holofold.mechanics.analyses import secant_stiffness
+from holofold.mechanics.compat import PAPER, PHYSICAL, Profile
 
 FIELDS = {
     "edge_bar_area_last_panel",

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from fitting.curves import (
+from holofold.fitting.curves import (
     CurveError,
     PlanarCurve,
     builtin_curve,
@@ -16,7 +16,7 @@ from fitting.curves import (
     read_points_csv,
     read_svg_curve,
 )
-from geometry.errors import FormatError, ParameterError
+from holofold.geometry.errors import FormatError, ParameterError
 
 T = np.linspace(0.0, 1.0, 7)
 

@@ -16,12 +16,12 @@ distributed = pytest.importorskip("distributed")
 
 import dask  # noqa: E402
 
-import design.runner as runner  # noqa: E402
-import design.store as store  # noqa: E402
-from design.cli import main  # noqa: E402
-from design.runner import check_scheduler, evaluate_designs  # noqa: E402
-from design.sampling import sample_designs  # noqa: E402
-from design.scenarios import Column, Scenario, get_scenario  # noqa: E402
+import holofold.design.runner as runner  # noqa: E402
+import holofold.design.store as store  # noqa: E402
+from holofold.cli import main  # noqa: E402
+from holofold.design.runner import check_scheduler, evaluate_designs  # noqa: E402
+from holofold.design.sampling import sample_designs  # noqa: E402
+from holofold.design.scenarios import Column, Scenario, get_scenario  # noqa: E402
 
 
 def _toy_evaluate(row):
@@ -282,7 +282,7 @@ def test_cli_scheduler_flag(address, miura, tmp_path, capsys):
 def test_worker_settings_of_the_commands(monkeypatch):
     from argparse import Namespace
 
-    from design.cli._parallel import parallel_settings
+    from holofold.cli._parallel import parallel_settings
 
     def ps(workers, scheduler):
         return parallel_settings(Namespace(workers=workers, scheduler=scheduler))

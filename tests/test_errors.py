@@ -2,7 +2,7 @@ import math
 
 import pytest
 
-from geometry.errors import ParameterError, check_range
+from holofold.geometry.errors import ParameterError, check_range
 
 
 def test_check_range_accepts_and_returns_float():

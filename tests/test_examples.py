@@ -31,7 +31,7 @@ RECORDED_GRIPPERS = {3: (155, 2.0807132979735573e-04, 337.41693604377355),
 
 @pytest.mark.slow
 def test_gripper_closing_example(tmp_path, monkeypatch):
-    from design.scenarios.gripper import CLOSURE_PAIR, published_q
+    from holofold.design.scenarios.gripper import CLOSURE_PAIR, published_q
 
     png = tmp_path / "gripper.png"
     monkeypatch.setattr(sys, "argv", ["gripper_closing.py", str(png)])

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting.auto import FitNotFoundError, fit_auto
-from fitting.curves import parse_curve_spec
-from fitting.strip import fit_strip
-from geometry.errors import ParameterError
+from holofold.fitting.auto import FitNotFoundError, fit_auto
+from holofold.fitting.curves import parse_curve_spec
+from holofold.fitting.strip import fit_strip
+from holofold.geometry.errors import ParameterError
 
 HALF = parse_curve_spec("half-circle:radius=2")
 

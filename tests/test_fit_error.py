@@ -7,10 +7,15 @@ import time
 import numpy as np
 import pytest
 
-from fitting.curves import PlanarCurve, parse_curve_spec
-from fitting.error import closest_point_error, index_matched_error, paper_error, polyline_distance
-from fitting.strip import fit_strip
-from geometry.errors import ParameterError
+from holofold.fitting.curves import PlanarCurve, parse_curve_spec
+from holofold.fitting.error import (
+    closest_point_error,
+    index_matched_error,
+    paper_error,
+    polyline_distance,
+)
+from holofold.fitting.strip import fit_strip
+from holofold.geometry.errors import ParameterError
 
 HALF = parse_curve_spec("half-circle:radius=2")
 

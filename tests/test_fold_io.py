@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from geometry.errors import FormatError
-from geometry.fold_io import FoldWarning, export_fold, fold_dict, load_fold
-from geometry.miura import miura_sheet
-from geometry.pattern import CreasePattern
-from geometry.tmp import tmp_sheet
+from holofold.geometry.errors import FormatError
+from holofold.geometry.fold_io import FoldWarning, export_fold, fold_dict, load_fold
+from holofold.geometry.miura import miura_sheet
+from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.tmp import tmp_sheet
 
 
 @pytest.fixture(scope="module")

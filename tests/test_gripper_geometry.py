@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geometry.errors import ParameterError
-from geometry.gripper import (
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.gripper import (
     gripper_pattern,
     miura_based_gripper,
     splitted_miura_gripper,
     two_panel_gripper,
 )
-from mechanics.hinges import build_compliant
+from holofold.mechanics.hinges import build_compliant
 
 L1, L2, RATE, W = 5.2e-3, 2.9e-3, 0.37, 180e-6
 

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from design.scenarios import get_scenario
-from design.scenarios.gripper import (
+from holofold.design.scenarios import get_scenario
+from holofold.design.scenarios.gripper import (
     SCENARIO,
     STATUS_NO_CLOSURE,
     GripperOptions,
@@ -176,10 +176,10 @@ def test_scenario_columns():
 
 
 def test_arccos_dihedral_matches_exact_angle_and_rounds_near_flat():
-    from design.scenarios.gripper import ArccosAssembler, arccos_dihedral
-    from mechanics.assembly import Assembler
-    from mechanics.springs import dihedral_angle
-    from mechanics.structure import Structure
+    from holofold.design.scenarios.gripper import ArccosAssembler, arccos_dihedral
+    from holofold.mechanics.assembly import Assembler
+    from holofold.mechanics.springs import dihedral_angle
+    from holofold.mechanics.structure import Structure
 
     # hinge j-k on the x axis, wing i in the xy plane, wing l rotated by phi about the hinge
     def quad(phi):

@@ -7,20 +7,20 @@ import math
 import numpy as np
 import pytest
 
-from geometry.errors import ParameterError
-from geometry.miura import miura_sheet_paper
-from geometry.pattern import CreasePattern
-from mechanics.assembly import Assembler
-from mechanics.compat import PAPER, PHYSICAL
-from mechanics.hinges import (
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.miura import miura_sheet_paper
+from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.compat import PAPER, PHYSICAL
+from holofold.mechanics.hinges import (
     build_compliant,
     build_concentrated,
     crease_rest_targets,
     orient_springs,
 )
-from mechanics.solvers import solve_newton
-from mechanics.springs import dihedral_angle
-from mechanics.structure import SpringRole
+from holofold.mechanics.solvers import solve_newton
+from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.structure import SpringRole
 
 MAT = dict(E_panel=2e9, E_crease=2e9, nu_panel=0.3, nu_crease=0.3)
 
@@ -298,7 +298,7 @@ def test_bad_parameters_raise():
 
 def test_compliant_gripper_numbering_matches_the_reference_scripts():
     """Node ids the gripper scripts use (specs/scenarios.md 4.2-4.3), 1-based."""
-    gripper = pytest.importorskip("geometry.gripper")
+    gripper = pytest.importorskip("holofold.geometry.gripper")
     kw = dict(crease_width=2e-4, crease_thickness=1e-6, panel_thickness=1e-5, **MAT)
     s = build_compliant(gripper.miura_based_gripper(5e-3, 4e-3, 0.4), **kw)
     assert (s.n_nodes, len(s.bars)) == (83, 198)

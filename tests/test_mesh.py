@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from geometry.export import export
-from geometry.mesh import export_mesh, fan_triangulation, flat_mesh, folded_mesh
-from geometry.miura import miura_sheet
+from holofold.geometry.export import export
+from holofold.geometry.mesh import export_mesh, fan_triangulation, flat_mesh, folded_mesh
+from holofold.geometry.miura import miura_sheet
 
 
 @pytest.fixture(scope="module")

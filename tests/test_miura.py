@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from _rigidity import panel_errors
 
-from geometry.errors import ParameterError
-from geometry.miura import miura_cell, miura_sheet, miura_sheet_paper
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.miura import miura_cell, miura_sheet, miura_sheet_paper
 
 EXTS = (0.3, 0.6, 0.9, 1.0)
 GAMMA70 = math.radians(70.0)

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from design.scenarios.gripper import build_model, natural_frequency
-from geometry.gripper import two_panel_gripper
-from mechanics.assembly import Assembler
-from mechanics.hinges import build_compliant
-from mechanics.modal import eigenvalues, lumped_mass, natural_frequencies
-from mechanics.structure import Structure
+from holofold.design.scenarios.gripper import build_model, natural_frequency
+from holofold.geometry.gripper import two_panel_gripper
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.hinges import build_compliant
+from holofold.mechanics.modal import eigenvalues, lumped_mass, natural_frequencies
+from holofold.mechanics.structure import Structure
 
 
 def test_cantilever_bar_chain_first_axial_frequency():

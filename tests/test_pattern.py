@@ -8,8 +8,8 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from geometry.errors import DegenerateGeometryError, InvalidPatternError
-from geometry.pattern import (
+from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError
+from holofold.geometry.pattern import (
     CreasePattern,
     measure_fold_angles,
     newell_normals,
@@ -256,7 +256,7 @@ def test_networkx_round_trip():
 
 
 def test_networkx_round_trip_generated_sheet():
-    from geometry.miura import miura_sheet
+    from holofold.geometry.miura import miura_sheet
 
     p = miura_sheet(4, 3, 0.01, 0.02, math.radians(65), 0.7)
     q = CreasePattern.from_networkx(p.to_networkx())

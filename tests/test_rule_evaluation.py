@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 from sklearn.model_selection import train_test_split
 
-from design.database import PUBLISHED, column_roles, read_table
-from design.evaluation import (
+from holofold.design.database import PUBLISHED, column_roles, read_table
+from holofold.design.evaluation import (
     baselines,
     grid_search,
     holdout,
@@ -19,15 +19,15 @@ from design.evaluation import (
     split_indices,
     summarize,
 )
-from design.report import (
+from holofold.design.report import (
     plot_feature_importance,
     plot_rule_boxes,
     plot_rule_scatter,
     rules_to_json,
     rules_to_text,
 )
-from design.rules import FewRulesWarning, ForestRuleMiner
-from design.targets import parse_target
+from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.targets import parse_target
 
 D0_FEATURES = ["tcrease", "tpanel", "W", "gama"]
 D3_FEATURES = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]

@@ -8,7 +8,7 @@ import pytest
 from sklearn.base import clone
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
-from design.rules import FewRulesWarning, ForestRuleMiner, forest_boxes, stack_trees
+from holofold.design.rules import FewRulesWarning, ForestRuleMiner, forest_boxes, stack_trees
 
 # ---------------------------------------------------------------------------------------------
 # scikit-learn API compliance

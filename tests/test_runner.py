@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from design.runner import DesignTableError, evaluate_designs, validate_designs
-from design.scenarios import Column, Scenario, get_scenario
+from holofold.design.runner import DesignTableError, evaluate_designs, validate_designs
+from holofold.design.scenarios import Column, Scenario, get_scenario
 
 
 def _toy_check(row):

@@ -11,8 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from design.scenarios import SCENARIO_NAMES, get_scenario
-from design.scenarios.arch import arch_model
+from holofold.design.scenarios import SCENARIO_NAMES, get_scenario
+from holofold.design.scenarios.arch import arch_model
 
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
 
@@ -77,7 +77,7 @@ def test_canopy_subset(reference_data, stem):
 def test_canopy_material_columns_matter():
     sc = get_scenario("canopy")
     base = dict(pattern=2, m=24, n=6, tcrease=7e-4, tpanel=3e-3, W=2e-3)
-    from design.scenarios.canopy import sheet_models
+    from holofold.design.scenarios.canopy import sheet_models
 
     s0 = sheet_models(sc.complete(base), extensions=(0.6,))[0][0]
     s1 = sheet_models(sc.complete({**base, "creaseE": 4e9, "panelE": 1e9}), extensions=(0.6,))[0][0]
@@ -157,7 +157,7 @@ def test_checks_accept_paper_rows():
 
 # ----------------------------------------------------------------------------- analyses
 def _shallow_truss(h=0.1, EA=1e4):
-    from mechanics.structure import Structure
+    from holofold.mechanics.structure import Structure
 
     nodes = np.array([[-1.0, 0, 0], [0, 0, h], [1.0, 0, 0]])
     sup = np.ones((3, 3), bool)
@@ -169,7 +169,7 @@ def _shallow_truss(h=0.1, EA=1e4):
 
 
 def test_secant_stiffness_of_shallow_truss():
-    from mechanics.analyses import load_group, secant_stiffness
+    from holofold.mechanics.analyses import load_group, secant_stiffness
 
     s, pmax = _shallow_truss()
     P = 0.1 * pmax
@@ -184,7 +184,7 @@ def test_secant_stiffness_of_shallow_truss():
 
 
 def test_snap_check_mgdcm_finds_the_analytic_limit_load():
-    from mechanics.analyses import load_group, snap_check_mgdcm
+    from holofold.mechanics.analyses import load_group, snap_check_mgdcm
 
     s, pmax = _shallow_truss()
     snap = snap_check_mgdcm(s, load_group([1], "-z"), 1.25 * pmax, initial_step=0.02)

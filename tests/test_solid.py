@@ -6,10 +6,10 @@ import manifold3d as m3d
 import numpy as np
 import pytest
 
-from geometry.errors import ParameterError
-from geometry.miura import miura_sheet
-from geometry.solid import SolidWarning, panel_solids, shrunk_panels, thick_solid
-from geometry.tmp import tmp_sheet
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.miura import miura_sheet
+from holofold.geometry.solid import SolidWarning, panel_solids, shrunk_panels, thick_solid
+from holofold.geometry.tmp import tmp_sheet
 
 W, T = 2e-3, 0.5e-3
 

@@ -4,17 +4,17 @@ self-folding, on problems with analytic answers."""
 import numpy as np
 import pytest
 
-from geometry.errors import ParameterError
-from mechanics.assembly import Assembler
-from mechanics.solvers import (
+from holofold.geometry.errors import ParameterError
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.solvers import (
     SolveResult,
     solve_displacement,
     solve_mgdcm,
     solve_newton,
     solve_selffold,
 )
-from mechanics.springs import dihedral_angle
-from mechanics.structure import Structure
+from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.structure import Structure
 
 NO_SPRINGS = dict(springs=np.zeros((0, 4), int), spring_k=[], spring_rest=[])
 

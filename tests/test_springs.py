@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from mechanics.springs import (
+from holofold.mechanics.springs import (
     dihedral_angle,
     dihedral_derivatives,
     dihedral_gradient,

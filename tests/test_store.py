@@ -4,10 +4,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import design.store as store
-from design.cli import main
-from design.sampling import sample_designs
-from design.scenarios import get_scenario
+import holofold.design.store as store
+from holofold.cli import main
+from holofold.design.sampling import sample_designs
+from holofold.design.scenarios import get_scenario
 
 
 @pytest.fixture(scope="module")

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting.curves import PlanarCurve, parse_curve_spec
-from fitting.strip import (
+from holofold.fitting.curves import PlanarCurve, parse_curve_spec
+from holofold.fitting.strip import (
     StripFit,
     fit_strip,
     quad_warp,
@@ -14,7 +14,7 @@ from fitting.strip import (
     strip_faces,
     zigzag_centre_line,
 )
-from geometry.errors import DegenerateGeometryError, ParameterError
+from holofold.geometry.errors import DegenerateGeometryError, ParameterError
 
 HALF = parse_curve_spec("half-circle:radius=2")
 

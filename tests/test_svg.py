@@ -6,9 +6,9 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from geometry.errors import FormatError
-from geometry.miura import miura_sheet
-from geometry.svg import COLOURS, export_svg, load_svg
+from holofold.geometry.errors import FormatError
+from holofold.geometry.miura import miura_sheet
+from holofold.geometry.svg import COLOURS, export_svg, load_svg
 
 
 @pytest.fixture(scope="module")

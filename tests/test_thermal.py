@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geometry.gripper import two_panel_gripper
-from mechanics.hinges import build_compliant
-from mechanics.structure import Structure
-from mechanics.thermal import (
+from holofold.geometry.gripper import two_panel_gripper
+from holofold.mechanics.hinges import build_compliant
+from holofold.mechanics.structure import Structure
+from holofold.mechanics.thermal import (
     Bimorph,
     ThermalModel,
     chain_conductance,

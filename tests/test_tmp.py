@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from _rigidity import panel_errors
 
-from geometry.errors import ParameterError
-from geometry.tmp import tmp_node_count, tmp_sheet
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.tmp import tmp_node_count, tmp_sheet
 
 EXTS = (0.3, 0.6, 0.9, 1.0)
 L = 0.2
@@ -200,12 +200,12 @@ def test_invalid_parameters(args, name):
 
 def test_overlap_warning(caplog):
     # 2 b sqrt(1 - ext^2) > a: the tubes pass 2 theta = 90 deg; still rigid, but warned about
-    with caplog.at_level("WARNING", logger="geometry.tmp"):
+    with caplog.at_level("WARNING", logger="holofold.geometry.tmp"):
         p = tmp_sheet(2, 3, L, 0.5)
     assert "overlap" in caplog.text
     assert p.meta["delta"] * 2 > p.meta["a"]
     assert max(panel_errors(p)) <= 1e-12
     caplog.clear()
-    with caplog.at_level("WARNING", logger="geometry.tmp"):
+    with caplog.at_level("WARNING", logger="holofold.geometry.tmp"):
         tmp_sheet(24, 6, L, 0.3)
     assert caplog.text == ""

@@ -7,9 +7,17 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-exchangeability = runpy.run_path(str(ROOT / "validation" / "reproduce_gripper.py"))[
-    "exchangeability"
-]
+
+
+def _run_script(name: str) -> dict:
+    """The namespace of a validation script (its sibling imports need validation/ on the path)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.syspath_prepend(str(ROOT / "validation"))
+        return runpy.run_path(str(ROOT / "validation" / name))
+
+
+NS = _run_script("reproduce_gripper.py")
+exchangeability = NS["exchangeability"]
 
 
 def _ensembles(n=2000, K=7, seed=1):
@@ -113,7 +121,7 @@ def _saved_run(n=40, K=4, arccos=True):
 
 
 def test_ensemble_arrays_and_groups():
-    ns = runpy.run_path(str(ROOT / "validation" / "reproduce_gripper.py"))
+    ns = NS
     table = _saved_run()
     steps, stiff, groups = ns["ensemble_arrays"](table)
     assert steps.shape == stiff.shape == (40, 4)
@@ -127,7 +135,7 @@ def test_ensemble_arrays_and_groups():
 
 
 def test_ensemble_picture(tmp_path):
-    plot = runpy.run_path(str(ROOT / "validation" / "reproduce_gripper.py"))["plot_ensemble"]
+    plot = NS["plot_ensemble"]
     table = _saved_run()
     png = tmp_path / "ens.png"
     assert plot(table, png) == [2, 3]
@@ -140,7 +148,7 @@ def test_ensemble_picture(tmp_path):
 
 
 def test_command_line_rejects_meaningless_combinations(capsys):
-    main = runpy.run_path(str(ROOT / "validation" / "reproduce_gripper.py"))["main"]
+    main = NS["main"]
     for argv in (
         ["--ensemble", "1"],
         ["--random", "3", "--ensemble", "4"],
@@ -155,7 +163,7 @@ def test_command_line_rejects_meaningless_combinations(capsys):
 
 
 def test_report_of_a_saved_run(tmp_path, capsys):
-    main = runpy.run_path(str(ROOT / "validation" / "reproduce_gripper.py"))["main"]
+    main = NS["main"]
     csv = tmp_path / "ens.csv"
     _saved_run().to_csv(csv, index=False)
     assert main(["--from-csv", str(csv), "--plot", str(tmp_path / "ens.png")]) == 0

@@ -4,9 +4,9 @@ import json
 
 import pytest
 
-from design.cli import main
-from design.scenarios import get_scenario
-from design.verify import rule_ranges, verify_rule
+from holofold.cli import main
+from holofold.design.scenarios import get_scenario
+from holofold.design.verify import rule_ranges, verify_rule
 
 
 def test_rule_ranges_intersect_the_scenario_box():

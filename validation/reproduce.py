@@ -2,9 +2,9 @@
 
 Usage (from the repository root)::
 
-    PYTHONPATH=. python validation/reproduce.py                      # every file, all rows
-    PYTHONPATH=. python validation/reproduce.py --files data0 --rows 100 --workers 2
-    PYTHONPATH=. python validation/reproduce.py --save out/            # per-row CSVs too
+    python validation/reproduce.py                      # every file, all rows
+    python validation/reproduce.py --files data0 --rows 100 --workers 2
+    python validation/reproduce.py --save out/            # per-row CSVs too
 
 Files: data0_SingleMiura (1000 rows), data1_{Miura,TMP}Sheet_sample (2 x 200),
 data4_{Miura,TMP}SheetMat_sample (2 x 200), data3_ShapeFit (3000). The reference folder is
@@ -25,12 +25,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from holofold.design.database import read_table
+from holofold.design.runner import evaluate_designs
+from holofold.design.scenarios import get_scenario
 
-from design.database import read_table  # noqa: E402
-from design.runner import evaluate_designs  # noqa: E402
-from design.scenarios import get_scenario  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 FILES = {
     "data0": [("data0_SingleMiura", "single-miura")],

@@ -2,16 +2,16 @@
 
 Usage (from the repository root)::
 
-    PYTHONPATH=. python validation/reproduce_gripper.py                    # all 600 rows
-    PYTHONPATH=. python validation/reproduce_gripper.py --rows 20 --workers 2
-    PYTHONPATH=. python validation/reproduce_gripper.py --save out/gripper.csv
-    PYTHONPATH=. python validation/reproduce_gripper.py --random 50       # fresh designs
-    PYTHONPATH=. python validation/reproduce_gripper.py --patterns 3 --perturb 1e-15 \
+    python validation/reproduce_gripper.py                    # all 600 rows
+    python validation/reproduce_gripper.py --rows 20 --workers 2
+    python validation/reproduce_gripper.py --save out/gripper.csv
+    python validation/reproduce_gripper.py --random 50       # fresh designs
+    python validation/reproduce_gripper.py --patterns 3 --perturb 1e-15 \
         --compare out/gripper.csv          # round-off sensitivity of each row vs an earlier run
-    PYTHONPATH=. python validation/reproduce_gripper.py --patterns 3 --ensemble 8 \
+    python validation/reproduce_gripper.py --patterns 3 --ensemble 8 \
         --ensemble-arccos --save out/ens.csv --plot out/ens.png   # published vs 8 variants
-    PYTHONPATH=. python validation/reproduce_gripper.py --from-csv out/ens.csv  # report again
-    PYTHONPATH=. python validation/reproduce_gripper.py --converged      # tight Newton solves
+    python validation/reproduce_gripper.py --from-csv out/ens.csv  # report again
+    python validation/reproduce_gripper.py --converged      # tight Newton solves
 
 For each pattern and performance column it prints the median, 90th and 99th percentile and
 maximum of |ours - published| / |published|, the closure-step agreement (the published finalQ
@@ -33,16 +33,13 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from reproduce import load, reference_folder
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from design.scenarios.gripper import (  # noqa: E402
+from holofold.design.scenarios.gripper import (
     GripperOptions,
     decode_closing_step,
     simulate,
 )
-from validation.reproduce import load, reference_folder  # noqa: E402
 
 STEMS = {1: "data2_MiuraBased_sample", 2: "data2_SplittedMiura_sample", 3: "data2_TwoPanel_sample"}
 NAMES = {1: "Miura-based", 2: "splitted Miura", 3: "two-panel"}

@@ -4,7 +4,7 @@ Runs :func:`mechanics.analyses.snap_check_mgdcm` (path following, limit point be
 arch rows of data3 that snap in the published data and on the non-snapping rows closest to the
 threshold (smallest Zstiff), and prints the confusion table.
 
-    PYTHONPATH=. python validation/snap_compare.py [--near 100] [--workers 2]
+    python validation/snap_compare.py [--near 100] [--workers 2]
 """
 
 from __future__ import annotations
@@ -12,22 +12,17 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
-
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from validation.reproduce import emit, load, reference_folder  # noqa: E402
+from reproduce import emit, load, reference_folder
 
 
 def _check(row: dict) -> tuple[bool, float, float, str]:
     from threadpoolctl import threadpool_limits
 
-    from design.scenarios.arch import arch_model
-    from mechanics.analyses import load_group, snap_check_mgdcm
+    from holofold.design.scenarios.arch import arch_model
+    from holofold.mechanics.analyses import load_group, snap_check_mgdcm
 
     with threadpool_limits(1):
         s, apex, _ = arch_model(row)

@@ -7,17 +7,17 @@ performance columns with units and the paper's sampling ranges, a validity check
 
 from __future__ import annotations
 
-from design.scenarios.base import STATUS_OK, Column, Scenario
+from holofold.design.scenarios.base import STATUS_OK, Column, Scenario
 
 __all__ = ["Column", "Scenario", "STATUS_OK", "SCENARIO_NAMES", "get_scenario"]
 
 #: command-line name -> module (its ``SCENARIO``) or ``module:ATTRIBUTE``
 _MODULES = {
-    "single-miura": "design.scenarios.single_miura",
-    "canopy": "design.scenarios.canopy",
-    "arch": "design.scenarios.arch",
-    "gripper": "design.scenarios.gripper",
-    "gripper-converged": "design.scenarios.gripper:SCENARIO_CONVERGED",
+    "single-miura": "holofold.design.scenarios.single_miura",
+    "canopy": "holofold.design.scenarios.canopy",
+    "arch": "holofold.design.scenarios.arch",
+    "gripper": "holofold.design.scenarios.gripper",
+    "gripper-converged": "holofold.design.scenarios.gripper:SCENARIO_CONVERGED",
 }
 SCENARIO_NAMES = tuple(_MODULES)
 

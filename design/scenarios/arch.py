@@ -18,15 +18,28 @@ from functools import lru_cache
 
 import numpy as np
 
-from design.scenarios.base import STATUS_OK, Column, Scenario, integer, positive, single_thread
-from fitting.curves import builtin_curve
-from fitting.error import index_matched_error
-from fitting.strip import side_line, strip_faces, strip_nodes, strip_samples, zigzag_centre_line
-from geometry.pattern import CreasePattern
-from mechanics.analyses import load_group, secant_stiffness
-from mechanics.assembly import Assembler
-from mechanics.compat import PAPER
-from mechanics.hinges import build_concentrated
+from holofold.design.scenarios.base import (
+    STATUS_OK,
+    Column,
+    Scenario,
+    integer,
+    positive,
+    single_thread,
+)
+from holofold.fitting.curves import builtin_curve
+from holofold.fitting.error import index_matched_error
+from holofold.fitting.strip import (
+    side_line,
+    strip_faces,
+    strip_nodes,
+    strip_samples,
+    zigzag_centre_line,
+)
+from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.analyses import load_group, secant_stiffness
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.compat import PAPER
+from holofold.mechanics.hinges import build_concentrated
 
 __all__ = ["SCENARIO", "evaluate", "check", "arch_model", "SNAP_DISPLACEMENT"]
 

@@ -16,14 +16,21 @@ from functools import lru_cache
 
 import numpy as np
 
-from design.scenarios.base import STATUS_OK, Column, Scenario, integer, positive, single_thread
-from geometry.miura import miura_faces, miura_nodes
-from geometry.pattern import CreasePattern
-from geometry.tmp import tmp_faces, tmp_nodes
-from mechanics.analyses import load_group, secant_stiffness
-from mechanics.assembly import Assembler
-from mechanics.compat import PAPER
-from mechanics.hinges import build_concentrated
+from holofold.design.scenarios.base import (
+    STATUS_OK,
+    Column,
+    Scenario,
+    integer,
+    positive,
+    single_thread,
+)
+from holofold.geometry.miura import miura_faces, miura_nodes
+from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.tmp import tmp_faces, tmp_nodes
+from holofold.mechanics.analyses import load_group, secant_stiffness
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.compat import PAPER
+from holofold.mechanics.hinges import build_concentrated
 
 __all__ = ["SCENARIO", "evaluate", "check", "sheet_models", "SIZE", "GAMMA", "EXTENSIONS"]
 

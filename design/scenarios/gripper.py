@@ -74,16 +74,16 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from design.scenarios.base import STATUS_OK, Column, Scenario, positive
-from geometry.errors import ParameterError
-from geometry.gripper import DEFAULT_RANGE, gripper_pattern
-from mechanics.assembly import Assembler
-from mechanics.compat import PAPER, Profile
-from mechanics.hinges import build_compliant
-from mechanics.modal import lumped_mass, natural_frequencies
-from mechanics.solvers import solve_newton
-from mechanics.springs import dihedral_angle
-from mechanics.thermal import (
+from holofold.design.scenarios.base import STATUS_OK, Column, Scenario, positive
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.gripper import DEFAULT_RANGE, gripper_pattern
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.compat import PAPER, Profile
+from holofold.mechanics.hinges import build_compliant
+from holofold.mechanics.modal import lumped_mass, natural_frequencies
+from holofold.mechanics.solvers import solve_newton
+from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.thermal import (
     Bimorph,
     crease_temperature_matrix,
     electrothermal_stage,

@@ -14,12 +14,12 @@ from functools import lru_cache
 
 import numpy as np
 
-from design.scenarios.base import STATUS_OK, Column, Scenario, positive, single_thread
-from geometry.miura import miura_faces, miura_nodes
-from geometry.pattern import CreasePattern
-from mechanics.analyses import load_group, secant_stiffness
-from mechanics.compat import PAPER
-from mechanics.hinges import build_concentrated
+from holofold.design.scenarios.base import STATUS_OK, Column, Scenario, positive, single_thread
+from holofold.geometry.miura import miura_faces, miura_nodes
+from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.analyses import load_group, secant_stiffness
+from holofold.mechanics.compat import PAPER
+from holofold.mechanics.hinges import build_concentrated
 
 __all__ = ["SCENARIO", "evaluate", "check", "cell_models", "EXTENSIONS", "SIZE", "E", "NU"]
 

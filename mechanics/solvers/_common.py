@@ -6,12 +6,12 @@ import logging
 
 import numpy as np
 
-from geometry.errors import ParameterError, check_range
-from mechanics.assembly import Assembler, SingularSystemError
-from mechanics.solvers.result import SolveResult
-from mechanics.structure import Structure
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.mechanics.assembly import Assembler, SingularSystemError
+from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.structure import Structure
 
-logger = logging.getLogger("mechanics.solvers")
+logger = logging.getLogger("holofold.mechanics.solvers")
 
 _MAX_LISTED = 6
 

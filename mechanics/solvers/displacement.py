@@ -17,16 +17,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from geometry.errors import ParameterError, check_range
-from mechanics.assembly import Assembler
-from mechanics.solvers._common import (
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.solvers._common import (
     check_controls,
     follow_path,
     get_assembler,
     nodal_array,
 )
-from mechanics.solvers.result import SolveResult
-from mechanics.structure import Structure
+from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.structure import Structure
 
 __all__ = ["solve_displacement"]
 

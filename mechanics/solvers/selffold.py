@@ -16,16 +16,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechanics.assembly import Assembler, SingularSystemError
-from mechanics.solvers._common import (
+from holofold.mechanics.assembly import Assembler, SingularSystemError
+from holofold.mechanics.solvers._common import (
     History,
     check_controls,
     get_assembler,
     nodal_array,
     spring_array,
 )
-from mechanics.solvers.result import SolveResult
-from mechanics.structure import Structure
+from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.structure import Structure
 
 __all__ = ["solve_selffold"]
 

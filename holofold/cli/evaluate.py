@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from design.cli._parallel import add_parallel_arguments, parallel_settings
-from design.runner import evaluate_designs, validate_designs
-from design.scenarios import SCENARIO_NAMES, get_scenario
+from holofold.cli._parallel import add_parallel_arguments, parallel_settings
+from holofold.design.runner import evaluate_designs, validate_designs
+from holofold.design.scenarios import SCENARIO_NAMES, get_scenario
 
 __all__ = ["register", "run", "read_designs", "write_results"]
 
@@ -74,7 +74,7 @@ def _epilog() -> str:
 
 def read_designs(path: Path) -> pd.DataFrame:
     """Read a design table (.csv, .parquet/.pq, or a published headerless .txt)."""
-    from design.database import read_table
+    from holofold.design.database import read_table
 
     path = Path(path)
     if path.suffix.lower() not in _CSV + _PARQUET + _TXT:

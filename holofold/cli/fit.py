@@ -29,12 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
-from fitting.auto import DEFAULT_M_RANGE, fit_auto
-from fitting.curves import load_curve
-from fitting.strip import SAMPLINGS, StripFit, fit_strip
-from geometry.errors import ParameterError, check_range
-from geometry.export import export
-from geometry.solid import thick_solid
+from holofold.fitting.auto import DEFAULT_M_RANGE, fit_auto
+from holofold.fitting.curves import load_curve
+from holofold.fitting.strip import SAMPLINGS, StripFit, fit_strip
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.export import export
+from holofold.geometry.solid import thick_solid
 
 log = logging.getLogger(__name__)
 

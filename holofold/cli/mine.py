@@ -102,11 +102,11 @@ def _check_output(path: str | None, what: str, suffixes=None) -> Path | None:
 
 
 def run(args) -> int:
-    from design.database import column_roles, read_table
-    from design.evaluation import rule_scores, split_indices
-    from design.report import plot_rules, rules_to_records, rules_to_text
-    from design.rules import FewRulesWarning, ForestRuleMiner
-    from design.targets import parse_target
+    from holofold.design.database import column_roles, read_table
+    from holofold.design.evaluation import rule_scores, split_indices
+    from holofold.design.report import plot_rules, rules_to_records, rules_to_text
+    from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+    from holofold.design.targets import parse_target
 
     # ---- validate everything before any output --------------------------------------------
     if args.rules < 1:

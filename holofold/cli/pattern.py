@@ -42,9 +42,9 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 def _build(args):
-    from geometry.errors import ParameterError, check_range
-    from geometry.miura import miura_sheet
-    from geometry.tmp import tmp_sheet
+    from holofold.geometry.errors import ParameterError, check_range
+    from holofold.geometry.miura import miura_sheet
+    from holofold.geometry.tmp import tmp_sheet
 
     check_range("--ext", args.ext, 0.0, 1.0, low_open=True)
     if args.kind == "miura":
@@ -80,9 +80,9 @@ def run(args) -> int:
 
     import numpy as np
 
-    from geometry.errors import check_range
-    from geometry.export import export
-    from geometry.solid import SolidWarning, shrunk_panels, thick_solid
+    from holofold.geometry.errors import check_range
+    from holofold.geometry.export import export
+    from holofold.geometry.solid import SolidWarning, shrunk_panels, thick_solid
 
     pattern = _build(args)
     W = check_range("--crease-width", args.crease_width, 0.0, None)

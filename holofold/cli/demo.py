@@ -42,9 +42,9 @@ def run(args) -> int:
     import json
     from pathlib import Path
 
-    from design.cli import main as holofold
-    from design.scenarios import get_scenario
-    from design.targets import parse_target
+    from holofold.cli import main as holofold
+    from holofold.design.scenarios import get_scenario
+    from holofold.design.targets import parse_target
 
     arch = get_scenario("arch")
     parse_target(args.target, arch.performance_names)

@@ -1,5 +1,5 @@
 import sys
 
-from design.cli import main
+from holofold.cli import main
 
 sys.exit(main())

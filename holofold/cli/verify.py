@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from design.cli._parallel import add_parallel_arguments, parallel_settings
-from design.scenarios import SCENARIO_NAMES
+from holofold.cli._parallel import add_parallel_arguments, parallel_settings
+from holofold.design.scenarios import SCENARIO_NAMES
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -34,10 +34,10 @@ def run(args) -> int:
     from contextlib import nullcontext
     from pathlib import Path
 
-    from design.runner import dask_scheduler
-    from design.scenarios import get_scenario
-    from design.targets import parse_target
-    from design.verify import rule_ranges, verify_rule
+    from holofold.design.runner import dask_scheduler
+    from holofold.design.scenarios import get_scenario
+    from holofold.design.targets import parse_target
+    from holofold.design.verify import rule_ranges, verify_rule
 
     scenario = get_scenario(args.scenario)
     parse_target(args.target, scenario.performance_names)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from design.cli._parallel import add_parallel_arguments, parallel_settings
-from design.scenarios import SCENARIO_NAMES
+from holofold.cli._parallel import add_parallel_arguments, parallel_settings
+from holofold.design.scenarios import SCENARIO_NAMES
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -56,9 +56,9 @@ def _parse_ranges(items):
 def run(args) -> int:
     from pathlib import Path
 
-    from design.sampling import sample_designs
-    from design.scenarios import get_scenario
-    from design.store import build_database
+    from holofold.design.sampling import sample_designs
+    from holofold.design.scenarios import get_scenario
+    from holofold.design.store import build_database
 
     scenario = get_scenario(args.scenario)
     if args.samples < 1:

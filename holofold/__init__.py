@@ -1,0 +1,1 @@
+"""holofold: holistic inverse design of origami, shape and function."""
