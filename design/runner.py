@@ -25,6 +25,7 @@ import pandas as pd
 
 from holofold.design.scenarios import Scenario, get_scenario
 from holofold.design.scenarios.base import single_thread
+from holofold.mechanics.status import Status
 
 __all__ = [
     "DesignTableError",
@@ -142,10 +143,20 @@ def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
 
 def _failed(scenario: Scenario, exc: BaseException) -> dict:
     """NaN outputs and ``status = "failed: <ExceptionName>: <first line of the message>"``."""
-    reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    out = {c: float("nan") for c in scenario.performance_names}
-    out["status"] = f"failed: {type(exc).__name__}: {reason}"
+    out: dict = {c: float("nan") for c in scenario.performance_names}
+    out["status"] = Status.from_exception(exc)
     return out
+
+
+def _checked_output(scenario: Scenario, out: dict) -> dict:
+    """``out`` with a :class:`Status`; a converged row with a non-finite output is not."""
+    status = Status.parse(out.get("status", "failed: the evaluator returned no status"))
+    if status.converged:
+        values = {c: _as_number(out.get(c)) for c in scenario.performance_names}
+        bad = [c for c, v in values.items() if v is None or not math.isfinite(v)]
+        if bad:
+            status = Status.not_converged(f"non-finite output: {', '.join(bad)}")
+    return {**out, "status": status}
 
 
 def _evaluate_one(scenario: Scenario, row: dict, limit_threads: bool) -> dict:
@@ -153,8 +164,10 @@ def _evaluate_one(scenario: Scenario, row: dict, limit_threads: bool) -> dict:
     try:
         if limit_threads:
             with single_thread():
-                return scenario.evaluate(row)
-        return scenario.evaluate(row)
+                out = scenario.evaluate(row)
+        else:
+            out = scenario.evaluate(row)
+        return _checked_output(scenario, out)
     except Exception as exc:  # noqa: BLE001 - a failed row must not stop the batch
         return _failed(scenario, exc)
 
@@ -397,6 +410,6 @@ def _assemble(scenario: Scenario, table: pd.DataFrame, outs: list) -> pd.DataFra
     res = table[keep].reset_index(drop=True).copy()
     for c in perf:
         res[c] = np.array([o.get(c, np.nan) for o in outs], dtype=float)
-    res["status"] = [o.get("status", "") for o in outs]
+    res["status"] = [str(o["status"]) for o in outs]
     res.index = table.index
     return res

@@ -18,6 +18,7 @@ from holofold.design.runner import evaluate_designs
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, get_scenario
 from holofold.design.targets import parse_target
+from holofold.mechanics.status import failed_mask
 
 __all__ = ["rule_ranges", "verify_rule", "Verification"]
 
@@ -108,7 +109,7 @@ def verify_rule(
     res = evaluate_designs(
         scenario, designs, workers=workers, progress=progress, scheduler=scheduler
     )
-    failed = res["status"].str.startswith("failed")
+    failed = pd.Series(failed_mask(res["status"]), index=res.index)
     meets = pd.Series(False, index=res.index)
     ok = res.loc[~failed]
     if len(ok):

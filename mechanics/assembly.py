@@ -36,7 +36,7 @@ from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from holofold.mechanics.bars import bar_kernel
-from holofold.mechanics.springs import SPRING_BLOCKS, spring_kernel
+from holofold.mechanics.springs import SPRING_BLOCKS, arccos_shift, spring_kernel
 from holofold.mechanics.structure import Structure
 
 __all__ = [
@@ -372,6 +372,7 @@ class Assembler:
         self._b1 = self.bars[:, 1].copy()
         self._D0 = self._XT[:, self._b1] - self._XT[:, self._b0]  # (3, nb)
         self._sT = np.ascontiguousarray(self.springs.T)  # (4, ns)
+        self._arccos = structure.profile.arccos_dihedral and len(self.springs) > 0
 
     @cached_property
     def reduction(self) -> ReducedPattern:
@@ -398,6 +399,8 @@ class Assembler:
                 raise ValueError(
                     f"spring_rest must have shape {self.theta0.shape}, got {theta0.shape}"
                 )
+        if self._arccos:  # the reference's arccos angle (compat.Profile.arccos_dihedral)
+            theta0 = theta0 + arccos_shift(self.X + UT.T, self.springs)
         rb = bar_kernel(
             self._D0, UT[:, self._b1] - UT[:, self._b0], self.L0, self.EA, tangent=tangent
         )

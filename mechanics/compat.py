@@ -27,7 +27,7 @@ class Profile:
     Attributes
     ----------
     name : str
-        Label recorded in ``Structure.meta["profile"]``.
+        Label of the profile (a structure records its profile in ``Structure.profile``).
     edge_bar_area_last_panel : bool
         Concentrated hinges: the reference sets every panel-edge bar to ``2 A_p`` of the *last*
         panel (in panel order) that contains the edge, overwriting instead of accumulating
@@ -82,6 +82,10 @@ class Profile:
     mass_centre_share: float = 1.0 / 3.0
     reset_non_crease_rest_angles: bool = True
     thermal_reinterpolate_from_stage_start: bool = True
+    arccos_dihedral: bool = False
+    raw_crease_polarity: bool = True
+    dissipation_pi_314: bool = True
+    published_gripper_stiffness: bool = True
 
     def __post_init__(self):
         share = float(self.mass_centre_share)
@@ -103,4 +107,8 @@ PHYSICAL = Profile(
     mass_centre_share=1.0 / 3.0,
     reset_non_crease_rest_angles=False,
     thermal_reinterpolate_from_stage_start=False,
+    arccos_dihedral=False,
+    raw_crease_polarity=False,
+    dissipation_pi_314=False,
+    published_gripper_stiffness=False,
 )

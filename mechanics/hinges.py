@@ -27,7 +27,14 @@ from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.compat import PAPER, Profile
 from holofold.mechanics.springs import dihedral_angle
-from holofold.mechanics.structure import BarType, SpringRole, Structure
+from holofold.mechanics.structure import (
+    COMPLIANT,
+    CONCENTRATED,
+    BarType,
+    CreaseModel,
+    SpringRole,
+    Structure,
+)
 
 __all__ = [
     "build_concentrated",
@@ -56,13 +63,15 @@ def _group_mean(values: np.ndarray, group: np.ndarray, sizes: np.ndarray) -> np.
     return out / sizes[:, None]
 
 
-def orient_springs(x: np.ndarray, springs: np.ndarray, *, z_only: bool = True) -> np.ndarray:
+def orient_springs(
+    x: np.ndarray, springs: np.ndarray, *, z_only: bool = True, where: np.ndarray | None = None
+) -> np.ndarray:
     """Polarity normalisation of specs/mechanics.md 2.2-E (returns a new (ns, 4) array).
 
     Swaps i and l where the z component of ``(x_j - x_i) x (x_k - x_j)`` is positive, so that
     ``m = r_ij x r_kj`` points to +z (theta > pi when the wings rotate towards +z). With
     ``z_only=False`` a spring whose z component vanishes (relative 1e-12) is judged by the y,
-    then the x component instead.
+    then the x component instead. ``where`` (ns,) bool limits it to some springs.
     """
     springs = np.array(springs, dtype=np.intp, copy=True)
     if len(springs) == 0:
@@ -76,6 +85,8 @@ def orient_springs(x: np.ndarray, springs: np.ndarray, *, z_only: bool = True) -
             np.abs(v[:, 2]) > tiny, v[:, 2], np.where(np.abs(v[:, 1]) > tiny, v[:, 1], v[:, 0])
         )
     swap = comp > 0
+    if where is not None:
+        swap &= np.asarray(where, bool)
     springs[swap, 0], springs[swap, 3] = springs[swap, 3], springs[swap, 0].copy()
     return springs
 
@@ -232,9 +243,8 @@ def build_concentrated(
         Nodes: the ``nv`` vertices, then one centre per panel (node ``nv + p``). Bars: edge ``i``
         is bar ``i`` (type 1), then the spokes panel by panel, corner by corner (type 5).
         Springs: one per interior edge in edge order (role HINGE, ``spring_crease`` = edge
-        id), then one per spoke (role PANEL). ``meta`` holds ``crease_ids`` (interior edge ids),
-        ``hinge_springs`` (their spring indices), ``panel_centres`` (nf,), ``node_vertex``
-        (vertex id, -2 for centres), ``model = "concentrated"`` and ``profile``.
+        id), then one per spoke (role PANEL). ``creases`` lists the interior edges with their
+        hinge springs and end vertices; ``node_vertex`` is the vertex id (-2 for centres).
     """
     E_panel = _scalar(E_panel, "E_panel", 0.0, None, low_open=True)
     E_crease = _scalar(E_crease, "E_crease", 0.0, None, low_open=True)
@@ -317,15 +327,12 @@ def build_concentrated(
         tri_crease=np.full(len(triangles), -1),
         tri_panel=face,
         supports=supports,
-        meta={
-            "model": "concentrated",
-            "profile": profile,
-            "crease_ids": cid,
-            "hinge_springs": np.arange(len(cid)),
-            "panel_centres": nv + np.arange(nf),
-            "node_vertex": np.concatenate([np.arange(nv), np.full(nf, -2)]),
-            "n_vertices": nv,
-        },
+        creases=CreaseModel(
+            kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=e
+        ),
+        panel_centres=nv + np.arange(nf),
+        node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]),
+        profile=profile,
     )
 
 
@@ -378,15 +385,14 @@ def build_compliant(
     Returns
     -------
     Structure
-        Nodes: shrunk panel corners panel by panel (``meta["n_corner_nodes"]`` of them), then
-        (p1, p2, c) per interior crease in crease order, then one centre per panel. Bars:
-        perimeter bars (same numbering as the corner nodes), 10 per crease, then the spokes.
-        Springs are ordered by the bar they sit on (the reference's slot order). ``meta``:
-        ``crease_ids (nci,)``, ``crease_nodes (nci, 7)`` = [N11, N12, N21, N22, p1, p2, c],
-        ``crease_springs (nci, 8)`` = [edge1, edge2, diag N11-c, diag N12-c, centre p1-c,
-        centre p2-c, diag N21-c, diag N22-c], ``panel_centres (nf,)``, ``node_vertex (nn,)``
-        (vertex id, -1 crease node, -2 centre), ``n_corner_nodes``, ``spring_bar (ns,)``,
-        ``split_factor``, ``diagonal_rate``.
+        Nodes: shrunk panel corners panel by panel (one per face corner), then (p1, p2, c) per
+        interior crease in crease order, then one centre per panel. Bars: perimeter bars (same
+        numbering as the corner nodes), 10 per crease, then the spokes. Springs are ordered by
+        the bar they sit on (the reference's slot order). ``creases``: the crease ids, their
+        8 springs and 7 nodes (:class:`~holofold.mechanics.structure.CreaseModel`);
+        ``node_vertex`` (nn,): vertex id, -1 crease node, -2 centre. With
+        ``profile.raw_crease_polarity`` the crease springs keep the reference mesher's raw
+        orientation (only panel springs are oriented).
     """
     E_panel = _scalar(E_panel, "E_panel", 0.0, None, low_open=True)
     E_crease = _scalar(E_crease, "E_crease", 0.0, None, low_open=True)
@@ -516,7 +522,6 @@ def build_compliant(
                 slot_spr[b_crease0 + 10 * r + t] = s
     slot_spr[b_spoke0:] = np.column_stack([prv, np.arange(nc0), cnode, nxt])
     slots = np.flatnonzero(slot_spr[:, 0] >= 0)
-    springs = orient_springs(nodes, slot_spr[slots], z_only=profile.polarity_z_only)
     slot_to_spring = np.full(nb, -1, np.intp)
     slot_to_spring[slots] = np.arange(len(slots))
     crease_springs = np.zeros((nci, 8), np.intp)
@@ -524,6 +529,10 @@ def build_compliant(
     crease_springs[:, 1] = slot_to_spring[crease_edge_bars[:, 1]]
     for col, t in zip(range(2, 8), (1, 2, 4, 5, 7, 8), strict=True):
         crease_springs[:, col] = slot_to_spring[b_crease0 + 10 * np.arange(nci) + t]
+    orient = np.ones(len(slots), bool)
+    if profile.raw_crease_polarity:  # the reference's raw crease springs (compat)
+        orient[crease_springs.ravel()] = False
+    springs = orient_springs(nodes, slot_spr[slots], z_only=profile.polarity_z_only, where=orient)
 
     # stiffness and areas
     ell = L[crease_edge_bars[:, 0]] if nci else np.zeros(0)
@@ -588,19 +597,16 @@ def build_compliant(
         tri_thickness=np.concatenate([np.repeat(tcc, 6), tp[face]]),
         tri_crease=np.concatenate([np.repeat(cid, 6), np.full(nc0, -1)]),
         tri_panel=np.concatenate([np.full(nct, -1), face]),
-        meta={
-            "model": "compliant",
-            "profile": profile,
-            "crease_ids": cid,
-            "crease_nodes": crease_nodes,
-            "crease_springs": crease_springs,
-            "panel_centres": n_cnodes + np.arange(nf),
-            "node_vertex": node_vertex,
-            "n_corner_nodes": nc0,
-            "spring_bar": slots,
-            "split_factor": split_factor,
-            "diagonal_rate": diagonal_rate,
-        },
+        creases=CreaseModel(
+            kind=COMPLIANT,
+            ids=cid,
+            springs=crease_springs,
+            nodes=crease_nodes,
+            split_factor=split_factor,
+        ),
+        panel_centres=n_cnodes + np.arange(nf),
+        node_vertex=node_vertex,
+        profile=profile,
     )
 
 
@@ -615,31 +621,33 @@ def crease_rest_targets(structure: Structure, crease_angle, *, profile: Profile 
         Crease-level rest angle per pattern edge, rad (pi = flat, the spring convention);
         border edges are ignored.
     profile : Profile, optional
-        Defaults to the profile the structure was built with. With
-        ``reset_non_crease_rest_angles`` (the reference, specs/mechanics.md 2.5) every other
-        spring (panel, diagonal) is set to pi; otherwise it keeps its current rest angle.
+        Defaults to the structure's. With ``reset_non_crease_rest_angles`` (the reference,
+        specs/mechanics.md 2.5) every other spring (panel, diagonal) is set to pi; otherwise it
+        keeps its current rest angle.
 
     Returns
     -------
     (ns,) float
         Compliant creases: the two edge springs get ``pi + (1 - f)/2 (theta_c - pi)`` and the
-        two centre springs ``pi + f (theta_c - pi)`` (f = ``meta["split_factor"]``);
+        two centre springs ``pi + f (theta_c - pi)`` (f = ``creases.split_factor``);
         concentrated hinges get ``theta_c``.
     """
-    profile = profile or structure.meta.get("profile", PAPER)
+    profile = profile or structure.profile
+    creases = structure.creases
+    if creases is None:
+        raise ValueError("the structure has no crease model (build it with holofold.mechanics)")
     theta = np.asarray(crease_angle, float)
-    cid = np.asarray(structure.meta["crease_ids"])
     out = (
         np.full(len(structure.springs), np.pi)
         if profile.reset_non_crease_rest_angles
         else structure.spring_rest.copy()
     )
-    tc = theta[cid]
-    if structure.meta.get("model") == "compliant":
-        f = float(structure.meta["split_factor"])
-        cs = structure.meta["crease_springs"]
+    tc = theta[creases.ids]
+    cs = creases.springs
+    if creases.compliant:
+        f = float(creases.split_factor)
         out[cs[:, 0]] = out[cs[:, 1]] = np.pi + 0.5 * (1.0 - f) * (tc - np.pi)
         out[cs[:, 4]] = out[cs[:, 5]] = np.pi + f * (tc - np.pi)
     else:
-        out[structure.meta["hinge_springs"]] = tc
+        out[cs[:, 0]] = tc
     return out

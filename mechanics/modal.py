@@ -32,7 +32,7 @@ def lumped_mass(
     ----------
     structure : Structure
         Uses ``triangles``, ``tri_thickness``, ``tri_panel`` and reference ``nodes``; panel
-        centre nodes are ``meta["panel_centres"]`` (else the first vertex of each panel
+        centre nodes are ``structure.panel_centres`` (else the first vertex of each panel
         triangle).
     density : float or (nt,) float
         Mass density rho, kg/m^3 (per triangle if an array).
@@ -61,7 +61,7 @@ def lumped_mass(
     share = np.full((nt, 3), 1.0 / 3.0)
     panel = structure.tri_panel >= 0
     if panel.any() and centre_share != 1.0 / 3.0:
-        centres = structure.meta.get("panel_centres")
+        centres = structure.panel_centres
         if centres is not None:
             cnode = np.asarray(centres)[structure.tri_panel[panel]]
             is_c = tri[panel] == cnode[:, None]

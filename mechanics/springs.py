@@ -28,6 +28,7 @@ from holofold.mechanics.bars import ElementResponse
 
 __all__ = [
     "dihedral_angle",
+    "arccos_shift",
     "dihedral_gradient",
     "dihedral_derivatives",
     "spring_forces",
@@ -105,9 +106,9 @@ def _angle_from_dots(d, form="atan2", ell=None):
         if ell is None:
             ell = np.sqrt(d[..., 0, :])
         return np.mod(np.arctan2(ell * d[..., 5, :], d[..., 6, :]), TWO_PI)
-    if form == "acos":
+    if form == "acos":  # the reference's form and order of operations (compat.arccos_dihedral)
         eta = np.where(d[..., 5, :] == 0.0, 1.0, np.sign(d[..., 5, :]))
-        c = d[..., 6, :] / np.sqrt(d[..., 1, :] * d[..., 2, :])
+        c = d[..., 6, :] / np.sqrt(d[..., 1, :]) / np.sqrt(d[..., 2, :])
         return np.mod(eta * np.arccos(np.clip(c, -1.0, 1.0)), TWO_PI)
     raise ValueError(f"form must be 'atan2' or 'acos', got {form!r}")
 
@@ -130,6 +131,18 @@ def dihedral_angle(x, springs, *, form: str = "atan2") -> np.ndarray:
     """
     _, _, d = _banks(_gather(x, springs))
     return _angle_from_dots(d, form)
+
+
+def arccos_shift(x, springs) -> np.ndarray:
+    """``theta_atan2 - theta_arccos`` of every spring, wrapped to [-pi, pi), rad, (..., ns).
+
+    Adding it to the rest angles makes the linear spring law act on the reference's arccos
+    angle while gradient and Hessian stay those of the exact angle
+    (:attr:`holofold.mechanics.compat.Profile.arccos_dihedral`).
+    """
+    _, _, d = _banks(_gather(x, springs))
+    exact = _angle_from_dots(d, "atan2")
+    return np.mod(exact - _angle_from_dots(d, "acos") + np.pi, TWO_PI) - np.pi
 
 
 def _first_order(P):

@@ -21,7 +21,14 @@ creases), but any code may build one directly::
     tri_thickness  (nt,) float     thickness of each triangle, m
     tri_crease     (nt,) int       crease id of a crease-region triangle, -1 for panel triangles
     tri_panel      (nt,) int       panel id of a panel triangle, -1 for crease triangles
-    meta           dict            builder details (node maps, crease tables, profile, ...)
+    creases        CreaseModel     how the pattern's interior creases are modelled (or None)
+    panel_centres  (nf,) int       centre node of each panel (or None)
+    node_vertex    (nn,) int       pattern vertex of each node: -1 crease node, -2 panel centre
+                                   (or None)
+    profile        Profile         the paper-compatibility switches the model was built with
+
+Supports and loads are chosen by node: :meth:`Structure.fixed` fixes the DOFs of named nodes
+and :meth:`Structure.vertex_nodes` gives the nodes standing for a pattern vertex.
 
 Degrees of freedom are interleaved per node: node ``n`` owns DOFs ``3n, 3n+1, 3n+2`` (x, y, z).
 Displacements are ``(nn, 3)`` arrays relative to ``nodes``.
@@ -29,14 +36,26 @@ Displacements are ``(nn, 3)`` arrays relative to ``nodes``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from enum import IntEnum
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
-__all__ = ["Structure", "SpringRole", "BarType"]
+from holofold.mechanics.compat import PAPER, Profile
+
+__all__ = [
+    "Structure",
+    "CreaseModel",
+    "SpringRole",
+    "BarType",
+    "CONCENTRATED",
+    "COMPLIANT",
+    "support_mask",
+]
+
+CONCENTRATED = "concentrated"
+COMPLIANT = "compliant"
 
 
 class BarType(IntEnum):
@@ -69,6 +88,53 @@ def _arr(x, dtype, shape_tail, name, n=None):
 
 
 @dataclass(frozen=True, eq=False)
+class CreaseModel:
+    """How a :class:`Structure` models the pattern's interior creases (docs/bar-and-hinge.md §3-4).
+
+    Attributes
+    ----------
+    kind : {"concentrated", "compliant"}
+        One rotational spring per crease, or a crease strip of finite width.
+    ids : (nci,) int
+        Pattern edge id of each modelled crease, increasing.
+    springs : (nci, 1) or (nci, 8) int
+        Spring ids per crease. Concentrated: the hinge spring. Compliant: [edge line 1, edge
+        line 2, diagonal N11-c, diagonal N12-c, centre p1-c, centre p2-c, diagonal N21-c,
+        diagonal N22-c].
+    nodes : (nci, 2) or (nci, 7) int
+        Model nodes per crease. Concentrated: the two end vertices of the hinge line.
+        Compliant: [N11, N12, N21, N22, p1, p2, c] (the corners of the two shrunk panels on
+        the crease, its centre-line end nodes and its centre node).
+    split_factor : float
+        Compliant: the share f of a crease's fold carried by its centre spring line.
+    """
+
+    kind: str
+    ids: np.ndarray
+    springs: np.ndarray
+    nodes: np.ndarray
+    split_factor: float = 0.5
+
+    def __post_init__(self):
+        if self.kind not in (CONCENTRATED, COMPLIANT):
+            raise ValueError(f"kind = {self.kind!r}; allowed: {CONCENTRATED!r}, {COMPLIANT!r}")
+        ids = np.asarray(self.ids, np.intp).reshape(-1)
+        width = (1, 2) if self.kind == CONCENTRATED else (8, 7)
+        springs = np.asarray(self.springs, np.intp).reshape(len(ids), width[0])
+        nodes = np.asarray(self.nodes, np.intp).reshape(len(ids), width[1])
+        object.__setattr__(self, "ids", ids)
+        object.__setattr__(self, "springs", springs)
+        object.__setattr__(self, "nodes", nodes)
+
+    @property
+    def compliant(self) -> bool:
+        return self.kind == COMPLIANT
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+
+@dataclass(frozen=True, eq=False)
 class Structure:
     """Bar-and-hinge model; see the module docstring for every array's meaning and shape."""
 
@@ -88,7 +154,10 @@ class Structure:
     tri_thickness: np.ndarray | None = None
     tri_crease: np.ndarray | None = None
     tri_panel: np.ndarray | None = None
-    meta: dict[str, Any] = field(default_factory=dict)
+    creases: CreaseModel | None = None
+    panel_centres: np.ndarray | None = None
+    node_vertex: np.ndarray | None = None
+    profile: Profile = PAPER
 
     def __post_init__(self):
         s = object.__setattr__
@@ -171,7 +240,14 @@ class Structure:
             if self.tri_panel is None
             else _arr(self.tri_panel, np.intp, (), "tri_panel", nt),
         )
-        s(self, "meta", dict(self.meta))
+        if self.creases is not None and not isinstance(self.creases, CreaseModel):
+            raise TypeError(f"creases must be a CreaseModel, got {type(self.creases).__name__}")
+        if self.panel_centres is not None:
+            s(self, "panel_centres", np.asarray(self.panel_centres, np.intp).reshape(-1))
+        if self.node_vertex is not None:
+            s(self, "node_vertex", _arr(self.node_vertex, np.intp, (), "node_vertex", nn))
+        if not isinstance(self.profile, Profile):
+            raise TypeError(f"profile must be a Profile, got {type(self.profile).__name__}")
 
     # ------------------------------------------------------------------ sizes and DOFs
     @property
@@ -197,10 +273,26 @@ class Structure:
         """(nf,) int: DOFs that are not supported."""
         return np.flatnonzero(~self.supports.ravel())
 
+    def vertex_nodes(self, vertices) -> np.ndarray:
+        """Ids of the nodes standing for the pattern vertices ``vertices`` (every copy of a
+        vertex in a compliant model, the vertex itself in a concentrated one), ascending."""
+        v = np.atleast_1d(np.asarray(vertices, np.intp))
+        if self.node_vertex is None:
+            return np.unique(v)
+        return np.flatnonzero(np.isin(self.node_vertex, v))
+
     # ------------------------------------------------------------------ changed copies
     def with_supports(self, supports) -> Structure:
         """A copy with another (nn, 3) bool support mask."""
         return replace(self, supports=np.asarray(supports, bool))
+
+    def fixed(self, nodes, dofs: str = "xyz") -> Structure:
+        """A copy with the ``dofs`` (any of "x", "y", "z") of ``nodes`` fixed, nothing else.
+
+        ``nodes``: node ids, or a sequence of ``(nodes, dofs)`` pairs when the directions
+        differ per node group (``dofs`` is then ignored).
+        """
+        return replace(self, supports=support_mask(self.n_nodes, nodes, dofs))
 
     def with_rest_angles(self, spring_rest) -> Structure:
         """A copy with other spring rest angles (ns,), rad."""
@@ -209,3 +301,29 @@ class Structure:
     def replace(self, **changes) -> Structure:
         """``dataclasses.replace`` for this structure."""
         return replace(self, **changes)
+
+
+_AXIS = {"x": 0, "y": 1, "z": 2}
+
+
+def support_mask(n_nodes: int, nodes, dofs: str = "xyz") -> np.ndarray:
+    """(n_nodes, 3) bool mask fixing the ``dofs`` of ``nodes`` (see :meth:`Structure.fixed`)."""
+    groups = nodes if _is_group_list(nodes) else [(nodes, dofs)]
+    sup = np.zeros((n_nodes, 3), bool)
+    for ids, d in groups:
+        ids = np.atleast_1d(np.asarray(ids, np.intp))
+        if ids.size and (ids.min() < 0 or ids.max() >= n_nodes):
+            raise ValueError(f"support nodes outside 0..{n_nodes - 1}: {ids.tolist()}")
+        bad = set(d) - set(_AXIS)
+        if bad or not d:
+            raise ValueError(f"dofs = {d!r}; allowed: any of 'x', 'y', 'z'")
+        sup[np.ix_(ids, [_AXIS[c] for c in d])] = True
+    return sup
+
+
+def _is_group_list(nodes) -> bool:
+    return (
+        isinstance(nodes, list | tuple)
+        and len(nodes) > 0
+        and all(isinstance(g, tuple) and len(g) == 2 and isinstance(g[1], str) for g in nodes)
+    )

@@ -29,7 +29,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from holofold.mechanics.compat import PAPER
+from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
 from holofold.mechanics.solvers import solve_selffold
 
@@ -138,7 +138,7 @@ def thermal_model(
     room_temperature: float = 21.0,
     room_temp_nodes=(),
     reference_geometry: bool = True,
-    pi_value: float = np.pi,
+    profile: Profile | None = None,
 ) -> ThermalModel:
     """Thermal model of a compliant-crease :class:`~mechanics.structure.Structure`.
 
@@ -146,10 +146,11 @@ def thermal_model(
     ``panel_conductivity`` (scalar or per panel, indexed by ``tri_panel``). Thicknesses are
     ``structure.tri_thickness``. ``air_thickness`` (m) is a scalar or per triangle (the
     reference's ``t2RT``; no substrate panels). The spreading angle is
-    ``dissipation_deg * pi_value / 180`` rad: the reference simulator converts with
-    ``pi_value = 3.14`` (this reproduces the published gripper temperatures to ~1e-8; with the
-    true pi they come out 4e-4 too low).
+    ``dissipation_deg * pi / 180`` rad, with pi = 3.14 where ``profile.dissipation_pi_314``
+    (default: the structure's profile), as the reference converts it.
     """
+    profile = profile or structure.profile
+    pi_value = 3.14 if profile.dissipation_pi_314 else np.pi
     tri = structure.triangles
     pc = np.asarray(panel_conductivity, float)
     k_panel = pc[np.maximum(structure.tri_panel, 0)] if pc.ndim else np.full(len(tri), pc)
@@ -384,7 +385,7 @@ _TEMP_WEIGHT = np.array([1 / 8, 1 / 8, 1 / 8, 1 / 8, 1 / 6, 1 / 6, 1 / 6])
 def heat_input_matrix(crease_nodes, n_nodes: int) -> sp.csr_matrix:
     """(nn, nci) matrix H mapping per-crease power (W) to nodal heat input: ``q = H Q``.
 
-    ``crease_nodes`` (nci, 7) = [N11, N12, N21, N22, p1, p2, c] (``Structure.meta``). Each
+    ``crease_nodes`` (nci, 7) = [N11, N12, N21, N22, p1, p2, c] (``Structure.creases.nodes``). Each
     crease gives 1/8 to each edge node, 1/12 to p1 and p2 and 1/3 to c; contributions of
     creases sharing a node add up.
     """
@@ -430,7 +431,7 @@ def timoshenko_curvature(dT, d_alpha, t1, t2, E1=1.0, E2=1.0):
 # --------------------------------------------------------------------------- folding stage
 @dataclass(frozen=True, eq=False)
 class Bimorph:
-    """Bimorph coating of the compliant creases (per crease in ``meta["crease_ids"]`` order).
+    """Bimorph coating of the compliant creases (per crease in ``Structure.creases.ids`` order).
 
     Attributes
     ----------
@@ -492,7 +493,7 @@ class ThermalState:
 def initial_thermal_state(structure, room_temperature: float = 21.0) -> ThermalState:
     """Unloaded state: U = 0, no force or heat, T = room temperature, creases flat (pi)."""
     nn = structure.n_nodes
-    nci = len(structure.meta["crease_ids"])
+    nci = len(structure.creases)
     return ThermalState(
         U=np.zeros((nn, 3)),
         force=np.zeros((nn, 3)),
@@ -549,9 +550,9 @@ def electrothermal_stage(
     results : list of SolveResult
         The self-folding solve of each thermal step.
     """
-    profile = profile or structure.meta.get("profile", PAPER)
+    profile = profile or structure.profile
     nn = structure.n_nodes
-    cid = np.asarray(structure.meta["crease_ids"])
+    cid = structure.creases.ids
     nci = len(cid)
     Q = np.asarray(crease_heat, float)
     if Q.shape != (nci,):
@@ -559,7 +560,7 @@ def electrothermal_stage(
     steps = int(steps)
     if steps < 1:
         raise ValueError(f"steps = {steps!r} must be >= 1")
-    cn = structure.meta["crease_nodes"]
+    cn = structure.creases.nodes
     H = heat_input_matrix(cn, nn) if heat_matrix is None else heat_matrix
     A = crease_temperature_matrix(cn, nn) if temp_matrix is None else temp_matrix
     q_stage = H @ Q

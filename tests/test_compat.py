@@ -20,6 +20,9 @@ FIELDS = {
     "mass_centre_share",
     "reset_non_crease_rest_angles",
     "thermal_reinterpolate_from_stage_start",
+    "raw_crease_polarity",
+    "dissipation_pi_314",
+    "published_gripper_stiffness",
 }
 
 
@@ -30,6 +33,7 @@ def test_profiles_have_every_switch():
         assert getattr(PAPER, f) is True, f
         assert getattr(PHYSICAL, f) is False, f
     assert PAPER.mass_centre_share == PHYSICAL.mass_centre_share == pytest.approx(1 / 3)
+    assert PAPER.arccos_dihedral is PHYSICAL.arccos_dihedral is False  # opt-in, see its doc
     with pytest.raises(dataclasses.FrozenInstanceError):
         PAPER.polarity_z_only = False  # type: ignore[misc]
     with pytest.raises(ValueError, match="mass_centre_share"):
@@ -52,3 +56,55 @@ def test_edge_area_quirk_moves_data0_row1_as_documented(reference_data):
     summed = _stiffness(row, dataclasses.replace(PAPER, edge_bar_area_last_panel=False))
     assert np.allclose(summed, [5870.5, 11683.2, 70595.0], rtol=2e-5)
     assert len(EXTENSIONS) == 3
+
+
+def test_arccos_dihedral_matches_exact_angle_and_rounds_near_flat():
+    """compat.arccos_dihedral: the reference's arccos angle, applied by the assembly."""
+    from holofold.mechanics.assembly import Assembler
+    from holofold.mechanics.springs import dihedral_angle
+    from holofold.mechanics.structure import Structure
+
+    def arccos_dihedral(x, springs):
+        return dihedral_angle(x, springs, form="acos")
+
+    # hinge j-k on the x axis, wing i in the xy plane, wing l rotated by phi about the hinge
+    def quad(phi):
+        return np.array(
+            [[0.5, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0],
+             [0.5, -np.cos(phi), np.sin(phi)]]
+        )  # fmt: skip
+
+    springs = np.array([[0, 1, 2, 3]])
+    for phi in (0.3, 1.0, 2.0, -0.7):
+        x = quad(phi)
+        assert arccos_dihedral(x, springs)[0] == pytest.approx(dihedral_angle(x, springs)[0],
+                                                               abs=1e-12)  # fmt: skip
+    # 1e-9 rad from flat: the exact angle sees it, arccos (resolution ~1e-8 rad) does not
+    x = quad(1e-9)
+    assert abs(dihedral_angle(x, springs)[0] - np.pi) == pytest.approx(1e-9, rel=1e-6)
+    d = abs(arccos_dihedral(x, springs)[0] - np.pi)
+    assert d < 1e-12 or d > 1e-8
+    # the assembler's spring moment uses the arccos angle: force = k (theta_acos - theta0) grad
+    s = Structure(
+        nodes=quad(0.0),
+        bars=np.array([[0, 1], [1, 2], [2, 0], [1, 3], [2, 3]]),
+        bar_area=np.full(5, 1e-6),
+        bar_E=np.full(5, 1e9),
+        springs=springs,
+        spring_k=np.array([2.0]),
+        spring_rest=np.array([np.pi - 0.1]),
+    )
+    s_acos = s.replace(profile=dataclasses.replace(PAPER, arccos_dihedral=True))
+    U = quad(0.5) - quad(0.0)
+    _, f_exact, _ = Assembler(s).evaluate(U)
+    _, f_acos, _ = Assembler(s_acos).evaluate(U)
+    np.testing.assert_allclose(f_acos, f_exact, rtol=1e-9, atol=1e-12)
+    # near flat the arccos rounding reaches the moment: f scales with (theta_acos - theta0)
+    U = quad(3e-9) - quad(0.0)
+    x = quad(3e-9)
+    t_exact, t_acos = dihedral_angle(x, springs)[0], arccos_dihedral(x, springs)[0]
+    assert abs(t_exact - t_acos) > 1e-10  # the two angles differ measurably here
+    _, f_exact, _ = Assembler(s).evaluate(U)
+    _, f_acos, _ = Assembler(s_acos).evaluate(U)
+    ratio = (t_acos - s.spring_rest[0]) / (t_exact - s.spring_rest[0])
+    np.testing.assert_allclose(f_acos[9:], ratio * f_exact[9:], rtol=1e-9)

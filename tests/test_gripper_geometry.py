@@ -92,15 +92,15 @@ NODE_IDS = {
 @pytest.mark.parametrize("p", [1, 2, 3])
 def test_meshed_node_ids(p):
     pat, s = _mesh(p)
-    nv = s.meta["node_vertex"]
+    nv = s.node_vertex
     for mid, v in NODE_IDS[p]:
         assert nv[mid - 1] == v - 1, (mid, v)
     if p == 1:
-        assert s.meta["panel_centres"][:2].tolist() == [73, 74]  # ids 74, 75
-        cid = s.meta["crease_ids"].tolist()
+        assert s.panel_centres[:2].tolist() == [73, 74]  # ids 74, 75
+        cid = s.creases.ids.tolist()
         # 59 / 71: first crease node (p1) of c12 / c19, at the tip end of the axial crease
         for c, node, tip in ((12, 59, 8), (19, 71, 12)):
-            p1, p2 = s.meta["crease_nodes"][cid.index(c - 1), 4:6]
+            p1, p2 = s.creases.nodes[cid.index(c - 1), 4:6]
             assert p1 == node - 1
             d1, d2 = np.linalg.norm(s.nodes[[p1, p2]] - pat.coords[tip - 1], axis=1)
             assert d1 < 4 * W < d2
@@ -111,9 +111,9 @@ def test_fold_sign_matches_raw_mesh_orientation(p):
     """fold_sign = alpha_sign * (orientation of the raw spring [N11, c, p1, N21])."""
     pat, s = _mesh(p)
     X = s.nodes
-    n11, _, n21, _, p1, _, c = s.meta["crease_nodes"].T
+    n11, _, n21, _, p1, _, c = s.creases.nodes.T
     z = np.cross(X[c] - X[n11], X[p1] - X[c])[:, 2]
-    order = np.searchsorted(pat.meta["active"], s.meta["crease_ids"])
+    order = np.searchsorted(pat.meta["active"], s.creases.ids)
     expect = pat.meta["alpha_sign"][order] * np.where(z > 0, -1.0, 1.0)
     np.testing.assert_array_equal(pat.meta["fold_sign"][order], expect)
     asg = pat.assignment[pat.meta["active"]]

@@ -54,16 +54,16 @@ def test_compliant_four_vertex_counts_and_numbering():
     assert len(s.bars) == 16 + 40 + 16 == 72
     assert len(s.springs) == 48
     assert np.bincount(s.spring_role, minlength=5).tolist() == [0, 16, 8, 8, 16]
-    cn = s.meta["crease_nodes"] + 1  # 1-based like the reference
+    cn = s.creases.nodes + 1  # 1-based like the reference
     assert cn[:, 4:].tolist() == [[17, 18, 19], [20, 21, 22], [23, 24, 25], [26, 27, 28]]
-    assert (s.meta["panel_centres"] + 1).tolist() == [29, 30, 31, 32]
+    assert (s.panel_centres + 1).tolist() == [29, 30, 31, 32]
     # the four copies of the central vertex are the example's supports 2, 5, 11, 16
-    assert (np.flatnonzero(s.meta["node_vertex"] == 4) + 1).tolist() == [2, 5, 11, 16]
-    assert (s.meta["crease_ids"] + 1).tolist() == [2, 3, 5, 10]
+    assert (np.flatnonzero(s.node_vertex == 4) + 1).tolist() == [2, 5, 11, 16]
+    assert (s.creases.ids + 1).tolist() == [2, 3, 5, 10]
     # crease_springs columns sit on the right bars
-    spr = s.springs[s.meta["crease_springs"]]
+    spr = s.springs[s.creases.springs]
     hinge = np.sort(spr[:, :, 1:3], axis=2)
-    n11, n12, n21, n22, p1, p2, c = s.meta["crease_nodes"].T
+    n11, n12, n21, n22, p1, p2, c = s.creases.nodes.T
     assert np.array_equal(hinge[:, 0], np.sort(np.stack([n11, n12], 1), 1))
     assert np.array_equal(hinge[:, 1], np.sort(np.stack([n21, n22], 1), 1))
     assert np.array_equal(hinge[:, 2], np.sort(np.stack([n11, c], 1), 1))
@@ -81,7 +81,7 @@ def test_compliant_shrinks_panels_by_half_width():
     # panel 1 = [2,5,4,1]: the central corner moves to (0.95, 0.95), the others by 0.05 once
     assert np.allclose(s.nodes[:4, :2], [[0.95, 0], [0.95, 0.95], [0, 0.95], [0, 0]])
     # crease strip: N11..N22 at distance W/2 from the crease line x = 1 (crease 2 = (2,5))
-    n11, n12, n21, n22 = s.meta["crease_nodes"][0, :4]
+    n11, n12, n21, n22 = s.creases.nodes[0, :4]
     assert np.allclose(sorted(s.nodes[[n11, n12, n21, n22], 0]), [0.95, 0.95, 1.05, 1.05])
 
 
@@ -110,7 +110,7 @@ def test_compliant_areas_and_stiffness_formulas():
     s = build_compliant(four_vertex(), crease_width=W, crease_thickness=tc, panel_thickness=tp,
                         diagonal_rate=4.0, **MAT)  # fmt: skip
     Ec, nu = 2e9, 0.3
-    cs = s.meta["crease_springs"][0]
+    cs = s.creases.springs[0]
     ell = 0.95
     k1 = Ec * tc**3 / (4 * W)
     L = np.linalg.norm(s.nodes[s.springs[:, 2]] - s.nodes[s.springs[:, 1]], axis=1)
@@ -266,7 +266,7 @@ def test_crease_rest_targets():
                         split_factor=0.5, **MAT)  # fmt: skip
     theta = np.full(p.n_edges, 2.0)
     t = crease_rest_targets(s, theta)
-    cs = s.meta["crease_springs"]
+    cs = s.creases.springs
     assert np.allclose(t[cs[:, :2]], np.pi + 0.25 * (2.0 - np.pi))
     assert np.allclose(t[cs[:, 4:6]], np.pi + 0.5 * (2.0 - np.pi))
     rest = np.setdiff1d(np.arange(len(t)), cs[:, [0, 1, 4, 5]].ravel())
@@ -302,8 +302,8 @@ def test_compliant_gripper_numbering_matches_the_reference_scripts():
     kw = dict(crease_width=2e-4, crease_thickness=1e-6, panel_thickness=1e-5, **MAT)
     s = build_compliant(gripper.miura_based_gripper(5e-3, 4e-3, 0.4), **kw)
     assert (s.n_nodes, len(s.bars)) == (83, 198)
-    assert (s.meta["crease_ids"] + 1).tolist() == [1, 2, 3, 4, 5, 6, 8, 9, 12, 14, 15, 17, 19]
-    nv = s.meta["node_vertex"]
+    assert (s.creases.ids + 1).tolist() == [1, 2, 3, 4, 5, 6, 8, 9, 12, 14, 15, 17, 19]
+    nv = s.node_vertex
 
     def copies(v):  # 1-based ids of the copies of 1-based old vertex v
         return (np.flatnonzero(nv == v - 1) + 1).tolist()
@@ -311,12 +311,12 @@ def test_compliant_gripper_numbering_matches_the_reference_scripts():
     assert copies(1)[:2] == [1, 4] and copies(2)[:2] == [3, 5]
     assert copies(3) == [2, 8, 24] and copies(4) == [6, 14, 27]
     assert copies(8) == [16, 19] and copies(12) == [29, 32]
-    assert (s.meta["panel_centres"][:2] + 1).tolist() == [74, 75]
-    cid = s.meta["crease_ids"].tolist()
-    assert s.meta["crease_nodes"][[cid.index(11), cid.index(18)], 4].tolist() == [58, 70]
+    assert (s.panel_centres[:2] + 1).tolist() == [74, 75]
+    cid = s.creases.ids.tolist()
+    assert s.creases.nodes[[cid.index(11), cid.index(18)], 4].tolist() == [58, 70]
     s2 = build_compliant(gripper.splitted_miura_gripper(5e-3, 4e-3, 0.4), **kw)
-    assert (s2.n_nodes, len(s2.bars), len(s2.meta["crease_ids"])) == (141, 340, 22)
-    assert (s2.meta["panel_centres"][0] + 1) == 127
+    assert (s2.n_nodes, len(s2.bars), len(s2.creases.ids)) == (141, 340, 22)
+    assert (s2.panel_centres[0] + 1) == 127
     s3 = build_compliant(gripper.two_panel_gripper(5e-3, 4e-3, 0.4), **kw)
     assert (s3.n_nodes, len(s3.bars)) == (37, 80)
-    assert (s3.meta["crease_ids"] + 1).tolist() == [2, 4, 7, 12]
+    assert (s3.creases.ids + 1).tolist() == [2, 4, 7, 12]

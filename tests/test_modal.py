@@ -82,12 +82,12 @@ def test_lumped_mass_totals_and_shares():
     assert m_skip.sum() == pytest.approx(mt.sum() - mt[:P].sum(), rel=1e-13)
     assert (s.tri_crease[:P] >= 0).all()  # the skipped ones are crease triangles (quirk)
     # the first crease's p1, p2, c lose (part of) their mass
-    c0 = s.meta["crease_nodes"][0, 4:]
+    c0 = s.creases.nodes[0, 4:]
     assert np.all(m_skip[c0] < m[c0])
     # 4/6 to the panel centre (later SWOMPS versions)
     m46 = lumped_mass(s, 1200.0, centre_share=4 / 6)
     assert m46.sum() == pytest.approx(mt.sum(), rel=1e-13)
-    centres = s.meta["panel_centres"]
+    centres = s.panel_centres
     panel_mass = np.bincount(s.tri_panel[s.tri_panel >= 0], weights=mt[s.tri_panel >= 0])
     np.testing.assert_allclose(m46[centres], 4 / 6 * panel_mass, rtol=1e-13)
     np.testing.assert_allclose(m[centres], 1 / 3 * panel_mass, rtol=1e-13)

@@ -29,7 +29,7 @@ def _evaluate(name, df):
     return (
         sc,
         {c: np.array([o[c] for o in out]) for c in sc.performance_names},
-        [o["status"] for o in out],
+        [str(o["status"]) for o in out],
     )
 
 

@@ -111,8 +111,8 @@ def test_energy_balance_and_chain_reduction(room_nodes):
         room_temp_nodes=room_nodes,
     )
     rng = np.random.default_rng(1)
-    H = heat_input_matrix(s.meta["crease_nodes"], s.n_nodes)
-    q = H @ rng.uniform(0.01, 0.05, len(s.meta["crease_ids"]))
+    H = heat_input_matrix(s.creases.nodes, s.n_nodes)
+    q = H @ rng.uniform(0.01, 0.05, len(s.creases.ids))
     x = s.nodes + rng.normal(0, 1e-6, s.nodes.shape)  # a slightly deformed state
     T = steady_temperature(model, x, q)
     G = chain_conductance(model, x)
@@ -154,7 +154,7 @@ def test_conduction_matrix_properties():
 
 def test_heat_and_temperature_matrices():
     _, s = _gripper_structure()
-    cn = s.meta["crease_nodes"]
+    cn = s.creases.nodes
     H = heat_input_matrix(cn, s.n_nodes).toarray()
     A = crease_temperature_matrix(cn, s.n_nodes).toarray()
     np.testing.assert_allclose(H.sum(axis=0), 1.0)  # every watt lands on a node
@@ -204,7 +204,7 @@ def test_electrothermal_stage_folds_toward_plus_z():
     sup[:4] = True
     s = s.with_supports(sup)
     model = thermal_model(s, panel_conductivity=0.3, crease_conductivity=0.3, air_thickness=4.6e-3)
-    nci = len(s.meta["crease_ids"])
+    nci = len(s.creases.ids)
     bim = Bimorph(np.full(nci, 50e-6), 0.2e-6, 1.0e-6, 2e9, 2e9, np.full(nci, 150e-6))
     state = initial_thermal_state(s)
     Q = np.full(nci, 0.1 * 3.1e-3 * 20)  # 20 heating steps at once
@@ -214,7 +214,7 @@ def test_electrothermal_stage_folds_toward_plus_z():
     z = new.U[tips, 2]
     assert np.all(z > 1e-5)
     np.testing.assert_allclose(z, z[0], rtol=1e-6)
-    dT = crease_temperature_matrix(s.meta["crease_nodes"], s.n_nodes) @ (new.T - 21.0)
+    dT = crease_temperature_matrix(s.creases.nodes, s.n_nodes) @ (new.T - 21.0)
     np.testing.assert_allclose(new.crease_angle - np.pi, bim.fold_increment(dT), rtol=1e-12)
     assert np.all(new.crease_angle > np.pi)
     np.testing.assert_allclose(new.q.sum(), Q.sum(), rtol=1e-12)

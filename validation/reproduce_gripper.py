@@ -48,6 +48,11 @@ OUTPUTS = ["freqFinal", "finalQ", "Tmax", "stiff"]
 DEFAULT = GripperOptions()
 
 
+def with_arccos(options: GripperOptions, arccos: bool) -> GripperOptions:
+    """``options`` with the reference's arccos dihedral angle switched on or off."""
+    return replace(options, profile=replace(options.profile, arccos_dihedral=arccos))
+
+
 def emit(text: str = "") -> None:
     sys.stdout.write(text + "\n")
     sys.stdout.flush()
@@ -491,7 +496,7 @@ def main(argv=None) -> int:
                 k = np.arange(1, args.ensemble)
                 arccos = args.ensemble_arccos & (k % 2 == 1)
                 spec = [
-                    (args.perturb + 1e-15 * kk, replace(options, arccos_angle=bool(a)))
+                    (args.perturb + 1e-15 * kk, with_arccos(options, bool(a)))
                     for kk, a in zip(k, arccos, strict=True)
                 ]
                 members = run_ensemble(rows, spec, args.workers)

@@ -7,9 +7,9 @@ performance columns with units and the paper's sampling ranges, a validity check
 
 from __future__ import annotations
 
-from holofold.design.scenarios.base import STATUS_OK, Column, Scenario
+from holofold.design.scenarios.base import Column, Scenario
 
-__all__ = ["Column", "Scenario", "STATUS_OK", "SCENARIO_NAMES", "get_scenario"]
+__all__ = ["Column", "Scenario", "SCENARIO_NAMES", "get_scenario"]
 
 #: command-line name -> module (its ``SCENARIO``) or ``module:ATTRIBUTE``
 _MODULES = {

@@ -19,7 +19,6 @@ from functools import lru_cache
 import numpy as np
 
 from holofold.design.scenarios.base import (
-    STATUS_OK,
     Column,
     Scenario,
     integer,
@@ -40,6 +39,7 @@ from holofold.mechanics.analyses import load_group, secant_stiffness
 from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.status import Outcome, Status
 
 __all__ = ["SCENARIO", "evaluate", "check", "arch_model", "SNAP_DISPLACEMENT"]
 
@@ -137,17 +137,14 @@ def evaluate(row) -> dict:
             s, load_group([apex], "+x"), increments=INCREMENTS, tol=TOL, assembler=asm
         )
     snap = z.displacement > SNAP_DISPLACEMENT
-    bad = []
-    if not z.converged:
-        bad.append(f"Z case{' (snap-through)' if snap else ''}: {z.result.status}")
-    if not x.converged:
-        bad.append(f"X case: {x.result.status}")
+    z_case = "Z case (snap-through)" if snap else "Z case"
+    cases = {z_case: z.result.status, "X case": x.result.status}
     return {
         "Zstiff": z.stiffness,
         "Zsnap": 1.0 if snap else 0.0,
         "Xstiff": x.stiffness,
         "error": err,
-        "status": STATUS_OK if not bad else "not converged: " + "; ".join(bad),
+        "status": Status.gather(cases, worst=Outcome.NOT_CONVERGED),
     }
 
 

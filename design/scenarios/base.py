@@ -6,8 +6,9 @@ simulates one design. The runner (:mod:`design.runner`) and the ``holofold evalu
 work from this description only.
 
 ``evaluate(row)`` takes a mapping of feature name -> value (SI units) and returns a dict with one
-entry per performance column plus ``status``: ``"converged"`` or a sentence naming what did not
-converge (the outputs are still those the paper defines for that case).
+entry per performance column plus ``status``, a :class:`~holofold.mechanics.status.Status`:
+converged, or not converged with what did not converge (the outputs are still those the paper
+defines for that case), or failed (no outputs).
 """
 
 from __future__ import annotations
@@ -16,9 +17,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-__all__ = ["Column", "Scenario", "STATUS_OK", "single_thread"]
-
-STATUS_OK = "converged"
+__all__ = ["Column", "Scenario", "single_thread"]
 
 _CONTROLLER = None
 

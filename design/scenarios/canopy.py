@@ -17,7 +17,6 @@ from functools import lru_cache
 import numpy as np
 
 from holofold.design.scenarios.base import (
-    STATUS_OK,
     Column,
     Scenario,
     integer,
@@ -31,6 +30,7 @@ from holofold.mechanics.analyses import load_group, secant_stiffness
 from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.status import Outcome, Status
 
 __all__ = ["SCENARIO", "evaluate", "check", "sheet_models", "SIZE", "GAMMA", "EXTENSIONS"]
 
@@ -154,7 +154,7 @@ def sheet_models(row, *, profile=PAPER, extensions=EXTENSIONS):
 
 def evaluate(row) -> dict:
     """Bending and axial stiffness at the three extensions (N/m) and a status."""
-    out, bad = {}, []
+    out, cases = {}, {}
     models = sheet_models(row)
     for ext, (s, bend, axial) in zip(EXTENSIONS, models, strict=True):
         tag = int(round(100 * ext))
@@ -163,10 +163,9 @@ def evaluate(row) -> dict:
             with single_thread():
                 r = secant_stiffness(s, grp, increments=INCREMENTS, tol=TOL, assembler=asm)
             out[f"{kind}stiff{tag}"] = r.stiffness
-            if not r.converged:
-                bad.append(f"{kind} Ext {ext}: {r.result.status}")
+            cases[f"{kind} Ext {ext}"] = r.result.status
     out = {c.name: out[c.name] for c in PERFORMANCE}
-    out["status"] = STATUS_OK if not bad else "not converged: " + "; ".join(bad)
+    out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
     return out
 
 

@@ -74,7 +74,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from holofold.design.scenarios.base import STATUS_OK, Column, Scenario, positive
+from holofold.design.scenarios.base import Column, Scenario, positive
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.gripper import DEFAULT_RANGE, gripper_pattern
 from holofold.mechanics.assembly import Assembler
@@ -82,7 +82,7 @@ from holofold.mechanics.compat import PAPER, Profile
 from holofold.mechanics.hinges import build_compliant
 from holofold.mechanics.modal import lumped_mass, natural_frequencies
 from holofold.mechanics.solvers import solve_newton
-from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.status import CONVERGED, Outcome, Status
 from holofold.mechanics.thermal import (
     Bimorph,
     crease_temperature_matrix,
@@ -102,13 +102,10 @@ __all__ = [
     "check",
     "decode_closing_step",
     "published_q",
-    "reference_polarity",
     "build_model",
     "natural_frequency",
     "STATUS_NO_CLOSURE",
     "CLOSURE_PAIR",
-    "ArccosAssembler",
-    "arccos_dihedral",
 ]
 
 # constants of every gripper script (specs/scenarios.md 4.1)
@@ -124,7 +121,7 @@ ROOM_T = 21.0
 ENV_LAYERS = 10
 DISSIPATION_DEG = 20.0
 STEP_CAP = {1: 400, 2: 400, 3: 300}
-STATUS_NO_CLOSURE = "failed: no closure"
+STATUS_NO_CLOSURE = Status.failed("no closure")
 #: tolerances of ``GripperOptions(converged=True)``: self-folding residual (N), load-control
 #: displacement step (m), and the iteration cap of every Newton solve
 CONVERGED_TOL = {"force": 1e-10, "displacement": 1e-12, "max_iter": 200}
@@ -231,31 +228,19 @@ class GripperOptions:
     Attributes
     ----------
     profile : Profile
-        Mechanics quirk switches (:data:`mechanics.compat.PAPER`).
+        Paper-compatibility switches (:data:`~holofold.mechanics.compat.PAPER`); those of the
+        gripper are ``raw_crease_polarity``, ``dissipation_pi_314``,
+        ``published_gripper_stiffness`` and ``arccos_dihedral``.
     step_cap : int or None
         Heating-step cap (default 400 / 400 / 300 per pattern).
     prebias_7cd7abc : bool
         Miura-based pre-bias supports of script version 7cd7abc (x of nodes 74, 75 free)
         instead of 2ede7cc (specs/scenarios.md 4.6; the published version is not known).
-    stiffness_published : bool
-        Report the stiffness by the published formulas (pattern 1 divides 5 increments of
-        force by the displacement after 3; pattern 3 uses the per-node force, no factor 2).
-        False: the plain secant stiffness of the loaded pair (total force on one arm's tip
-        over that node's displacement), from the same runs.
     stiffness_tol : float
         Newton tolerance (m) of the 1e-8 N prying runs of patterns 1 and 2 (the scripts'
         first 1e-10 N runs use 1e-7).
     keep_history : bool
         Keep per-step tip distance and Tmax in the result.
-    raw_polarity : bool
-        Give the crease springs the reference's raw (un-normalised) orientation and use the
-        scripts' expansion-mismatch signs, as the published data did
-        (:func:`reference_polarity`). False: normalised springs with the physical fold
-        directions ``fold_sign`` of the pattern -- the same folding, up to round-off.
-    dissipation_pi_314 : bool
-        The reference converts the 20 degree heat-spreading angle of the air layers to radians
-        with pi = 3.14 (found by reproducing the published Tmax: with it the two-panel rows
-        match to ~1e-8, with the true pi they are 4e-4 too low). False uses the true pi.
     converged : bool
         Run every Newton solve to a tight tolerance (:data:`CONVERGED_TOL`: self-folding
         residual 1e-10 N, load-control steps ||dU|| 1e-12 m, at most 199 iterations) instead of
@@ -263,24 +248,13 @@ class GripperOptions:
         1e-15 change of the input moves them by < 1e-11, measured); the published prying
         stiffness is not (see the module docstring). Use it for new databases; the default
         reproduces the published one.
-    arccos_angle : bool
-        Spring moments from the reference's arccos dihedral angle (:class:`ArccosAssembler`,
-        ~1e-8 rad resolution near flat) instead of the exact atan2 form. The gripper solves
-        are so sensitive that this rounding (like any round-off) changes the outcome of the
-        near-tie rows, but on the sample rows it is no closer to the published values overall
-        (splitted Miura: the same 95.5 % closing-step agreement, on a different set of rows), so
-        the exact angle is the default.
     """
 
     profile: Profile = PAPER
     step_cap: int | None = None
     prebias_7cd7abc: bool = False
-    stiffness_published: bool = True
     stiffness_tol: float = 1e-7
     keep_history: bool = False
-    dissipation_pi_314: bool = True
-    raw_polarity: bool = True
-    arccos_angle: bool = False
     converged: bool = False
 
     def tolerance(self, tol: float, kind: str) -> dict:
@@ -307,7 +281,7 @@ class GripperResult:
     Tmax: float
     stiff: float
     closing_step: int | None
-    status: str
+    status: Status
     tip_distance: np.ndarray = field(default_factory=lambda: np.zeros(0))
     Tmax_history: np.ndarray = field(default_factory=lambda: np.zeros(0))
     unconverged_steps: int = 0
@@ -327,85 +301,11 @@ class GripperResult:
         }
 
 
-def arccos_dihedral(x: np.ndarray, springs: np.ndarray) -> np.ndarray:
-    """Dihedral angles (ns,) in [0, 2 pi) computed as the data-era reference simulator does.
-
-    ``theta = mod(eta * arccos((m . n) / |m| / |n|), 2 pi)`` with ``eta = sign(m . r_kl)``
-    (1 if zero), in the reference's order of operations (mechanics.md 4). Near flat
-    (theta ~ pi) arccos resolves the angle only to ~1e-8 rad; the rounding of these angles moves
-    the published gripper results (see the module docstring), so it is reproduced here.
-    ``x`` (nn, 3) current coordinates, m; ``springs`` (ns, 4) node ids (i, j, k, l).
-    """
-    xi, xj, xk, xl = (x[springs[:, c]] for c in range(4))
-    rij, rkj, rkl = xi - xj, xk - xj, xk - xl
-
-    def cross(a, b):
-        return np.column_stack(
-            [
-                a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
-                a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0],
-            ]
-        )
-
-    def dot(a, b):
-        return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
-
-    m, n = cross(rij, rkj), cross(rkj, rkl)
-    d = dot(m, rkl)
-    eta = np.where(d == 0.0, 1.0, np.sign(d))
-    c = dot(m, n) / np.sqrt(dot(m, m)) / np.sqrt(dot(n, n))
-    return np.mod(eta * np.arccos(np.clip(c, -1.0, 1.0)), 2.0 * np.pi)
-
-
-class ArccosAssembler(Assembler):
-    """:class:`~mechanics.assembly.Assembler` whose spring moments use :func:`arccos_dihedral`.
-
-    The spring law becomes ``M = k (theta_arccos - theta0)`` (gradient and Hessian unchanged,
-    analytic) by shifting each rest angle by ``theta_exact - theta_arccos`` at the current
-    shape; the reported energy is that of the shifted law. Used by the gripper scenario with
-    ``GripperOptions(arccos_angle=True)``.
-    """
-
-    def element_response(self, U, spring_rest=None, *, tangent: bool = True):
-        theta0 = self.theta0 if spring_rest is None else np.asarray(spring_rest, float)
-        if len(self.springs):
-            x = self.X + np.asarray(U, float).reshape(-1, 3)
-            exact = dihedral_angle(x, self.springs)
-            shift = np.mod(exact - arccos_dihedral(x, self.springs) + np.pi, 2 * np.pi) - np.pi
-            theta0 = theta0 + shift
-        return super().element_response(U, theta0, tangent=tangent)
-
-
 def _load(nn: int, groups, magnitude: float) -> np.ndarray:
     F = np.zeros((nn, 3))
     for nodes, axis, sign in groups:
         F[np.asarray(nodes) - 1, axis] = sign * magnitude
     return F
-
-
-def reference_polarity(structure):
-    """A copy whose compliant-crease springs have the reference mesher's raw orientation.
-
-    The simulator version that produced the published data (2022) did not normalise spring
-    polarity (mechanics.md 2.2-E), and the gripper scripts' expansion-mismatch signs are
-    relative to the raw orientation ``[c, N11, N12, C1]``, ``[c, N22, N21, C2]``,
-    ``[N11, c, p1, N21]``, ``[N12, p2, c, N22]`` and the four diagonals (2.2-B). The
-    orientation changes no energy (theta -> 2 pi - theta with flat rest angles); it only fixes
-    which way a rest-angle increase folds. Only i and l are swapped where needed.
-    """
-    cn = structure.meta["crease_nodes"]
-    cs = structure.meta["crease_springs"]
-    n11, n12, n21, n22, p1, p2, c = cn.T
-    first = np.column_stack([c, c, n12, p2, n11, n12, p1, p2])  # expected raw i per column
-    springs = structure.springs.copy()
-    sid = cs.ravel()
-    want = first.ravel()
-    swap = springs[sid, 0] != want
-    if not np.array_equal(springs[sid[swap], 3], want[swap]):
-        raise ValueError("crease springs do not follow the compliant-crease layout")
-    springs[sid[swap], 0], springs[sid[swap], 3] = want[swap], springs[sid[swap], 0]
-    return structure.replace(springs=springs)
 
 
 def build_model(
@@ -419,13 +319,12 @@ def build_model(
     W,
     *,
     profile: Profile = PAPER,
-    raw_polarity: bool = True,
 ):
     """Crease pattern and compliant-crease structure (no supports) of one gripper design.
 
-    ``raw_polarity`` gives the crease springs the reference's raw orientation
-    (:func:`reference_polarity`); use the pattern's ``meta["alpha_sign"]`` with it and
-    ``meta["fold_sign"]`` without it (both give the same physical folding).
+    With ``profile.raw_crease_polarity`` the crease springs keep the reference's raw
+    orientation: use the pattern's ``meta["alpha_sign"]`` with it and ``meta["fold_sign"]``
+    without it (both give the same physical folding).
     """
     pat = gripper_pattern(pattern, L1, L2, rate)
     s = build_compliant(
@@ -440,8 +339,6 @@ def build_model(
         diagonal_rate=100.0 if pattern == 3 else 4.0,
         profile=profile,
     )
-    if raw_polarity:
-        s = reference_polarity(s)
     return pat, s
 
 
@@ -482,28 +379,27 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
         float(row[k]) for k in ("L1", "L2", "t1", "t2", "tpanel", "rate", "W")
     )
     prof = options.profile
-    pat, s0 = build_model(
-        P, L1, L2, t1, t2, tp, rate, W, profile=prof, raw_polarity=options.raw_polarity
-    )
+    pat, s0 = build_model(P, L1, L2, t1, t2, tp, rate, W, profile=prof)
     nn = s0.n_nodes
     freq = natural_frequency(P, pat, s0, prof)
-    make_asm = ArccosAssembler if options.arccos_angle else Assembler
 
     # B. pre-bias
     state = initial_thermal_state(s0, ROOM_T)
+    prebias = CONVERGED
     if P in (1, 2):
         spec = PREBIAS_SUPPORTS_7CD7ABC if (P == 1 and options.prebias_7cd7abc) else None
         sb = s0.with_supports(_supports(nn, spec or PREBIAS_SUPPORTS[P]))
         load = _load(nn, PREBIAS_LOADS[P], 1e-10)
         res = solve_newton(
-            sb, load, increments=10, assembler=make_asm(sb),
+            sb, load, increments=10, assembler=Assembler(sb),
             **options.tolerance(5e-6, "displacement"),
         )  # fmt: skip
         state = state.replace(U=res.U.copy(), force=res.applied_force.copy())
+        prebias = res.status
 
     # C. heating until closure
     st = s0.with_supports(_supports(nn, THERMAL_SUPPORTS[P]))
-    asm = make_asm(st)
+    asm = Assembler(st)
     r = pat.meta["range"]
     model = thermal_model(
         st,
@@ -514,13 +410,12 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
         env_layers=ENV_LAYERS,
         dissipation_deg=DISSIPATION_DEG,
         room_temperature=ROOM_T,
-        pi_value=3.14 if options.dissipation_pi_314 else math.pi,
     )
-    cid = st.meta["crease_ids"]
+    cid = st.creases.ids
     active = pat.meta["active"]
     pos = {int(c): i for i, c in enumerate(active)}
     order = np.array([pos[int(c)] for c in cid])  # structure crease order -> active order
-    sign = pat.meta["alpha_sign" if options.raw_polarity else "fold_sign"]
+    sign = pat.meta["alpha_sign" if prof.raw_crease_polarity else "fold_sign"]
     bim = Bimorph(
         d_alpha=D_ALPHA * sign[order],
         t1=t1,
@@ -530,8 +425,8 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
         width=np.full(len(cid), W),
     )
     heat_len = pat.meta["heat_length"][order]
-    H = heat_input_matrix(st.meta["crease_nodes"], nn)
-    A = crease_temperature_matrix(st.meta["crease_nodes"], nn)
+    H = heat_input_matrix(st.creases.nodes, nn)
+    A = crease_temperature_matrix(st.creases.nodes, nn)
     a, b = (i - 1 for i in CLOSURE_PAIR[P])
     cap = options.step_cap or STEP_CAP[P]
     dist_hist, tmax_hist = [], []
@@ -558,7 +453,7 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
         dist_hist.append(d)
         tmax_hist.append(float(state.T.max()))
         if results[-1].failed:
-            failure = f"failed: heating step {step}: {results[-1].status}"
+            failure = Status.failed(f"heating step {step}: {results[-1].status}")
             break
         if d < CLOSURE:
             closing = step
@@ -583,7 +478,7 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
 
     # D. prying stiffness (loads keep accumulating; rest angles = the last targets)
     ss = s0.with_supports(_supports(nn, STIFF_SUPPORTS[P])).with_rest_angles(state.spring_rest)
-    asm_s = make_asm(ss)
+    asm_s = Assembler(ss)
     groups = STIFF_LOADS[P]
     if P == 3:
         res = solve_newton(
@@ -591,8 +486,7 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
             assembler=asm_s, **options.tolerance(5e-6, "displacement"),
         )  # fmt: skip
         du = abs(res.U_history[49, 10, 1] - res.U_history[0, 10, 1])
-        stiff = 49 * 1e-10 / du if options.stiffness_published else 49 * 2e-10 / du
-        ok = res.ok
+        stiff = 49 * 1e-10 / du if prof.published_gripper_stiffness else 49 * 2e-10 / du
         runs = (res,)
     else:
         node, axis = (15, 0) if P == 1 else (30, 1)
@@ -607,20 +501,18 @@ def _simulate(row, options: GripperOptions) -> GripperResult:
             assembler=asm_s, **options.tolerance(options.stiffness_tol, "displacement"),
         )  # fmt: skip
         du = abs(r2.U_history[2, node, axis] - u_before)
-        stiff = (n2 if options.stiffness_published else 3) * 2 * 1e-8 / du
-        ok = r1.ok and r2.ok
+        stiff = (n2 if prof.published_gripper_stiffness else 3) * 2 * 1e-8 / du
         runs = (r1, r2)
-    status = STATUS_OK
     if P == 1 and finalQ <= 0:  # the script discarded these (scenarios.md 4.1)
-        status = f"failed: early closure at heating step {closing} (published finalQ <= 0)"
-    elif unconverged or not ok:
-        parts = []
+        status = Status.failed(f"early closure at heating step {closing} (published finalQ <= 0)")
+    else:
+        parts = {"pre-bias": prebias}
         if unconverged:
-            parts.append(f"{unconverged} of {closing} heating steps did not meet the tolerance")
-        for k, run in enumerate(runs, start=1):
-            if not run.ok:
-                parts.append(f"prying-stiffness run {k}: {run.status}")
-        status = "not converged: " + "; ".join(parts)
+            parts["heating"] = Status.not_converged(
+                f"{unconverged} of {closing} heating steps did not meet the tolerance"
+            )
+        parts.update({f"prying-stiffness run {k}": r.status for k, r in enumerate(runs, 1)})
+        status = Status.gather(parts, worst=Outcome.NOT_CONVERGED)
     return GripperResult(
         freq,
         finalQ,
@@ -683,7 +575,7 @@ def evaluate(row) -> dict:
 
 def evaluate_converged(row) -> dict:
     """As :func:`evaluate`, every Newton solve converged tightly (``converged=True``)."""
-    return simulate(row, CONVERGED).as_row()
+    return simulate(row, CONVERGED_OPTIONS).as_row()
 
 
 SCENARIO = Scenario(
@@ -700,7 +592,7 @@ SCENARIO = Scenario(
     categorical=("Pattern",),
     reference_files=("data2_MiuraBased", "data2_SplittedMiura", "data2_TwoPanel"),
 )
-CONVERGED = GripperOptions(converged=True)
+CONVERGED_OPTIONS = GripperOptions(converged=True)
 #: the gripper with tightly converged Newton solves: repeatable outputs for new databases
 SCENARIO_CONVERGED = replace(
     SCENARIO,

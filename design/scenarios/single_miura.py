@@ -14,12 +14,13 @@ from functools import lru_cache
 
 import numpy as np
 
-from holofold.design.scenarios.base import STATUS_OK, Column, Scenario, positive, single_thread
+from holofold.design.scenarios.base import Column, Scenario, positive, single_thread
 from holofold.geometry.miura import miura_faces, miura_nodes
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_group, secant_stiffness
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.status import Outcome, Status
 
 __all__ = ["SCENARIO", "evaluate", "check", "cell_models", "EXTENSIONS", "SIZE", "E", "NU"]
 
@@ -97,15 +98,14 @@ def cell_models(tcrease, tpanel, W, gama, *, profile=PAPER, extensions=EXTENSION
 
 def evaluate(row) -> dict:
     """Axial stiffness at the three extensions (N/m) and a status."""
-    out, bad = {}, []
+    out, cases = {}, {}
     models = cell_models(row["tcrease"], row["tpanel"], row["W"], row["gama"])
     for col, ext, (s, grp) in zip(PERFORMANCE, EXTENSIONS, models, strict=True):
         with single_thread():
             r = secant_stiffness(s, grp, increments=INCREMENTS, tol=TOL)
         out[col.name] = r.stiffness
-        if not r.converged:
-            bad.append(f"Ext {ext}: {r.result.status}")
-    out["status"] = STATUS_OK if not bad else "not converged: " + "; ".join(bad)
+        cases[f"Ext {ext}"] = r.result.status
+    out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
     return out
 
 

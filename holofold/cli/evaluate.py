@@ -19,6 +19,7 @@ import pandas as pd
 from holofold.cli._parallel import add_parallel_arguments, parallel_settings
 from holofold.design.runner import evaluate_designs, validate_designs
 from holofold.design.scenarios import SCENARIO_NAMES, get_scenario
+from holofold.mechanics.status import converged_mask, failed_mask
 
 __all__ = ["register", "run", "read_designs", "write_results"]
 
@@ -130,8 +131,8 @@ def run(args) -> int:
         scheduler=scheduler,
     )
     write_results(res, args.output)
-    ok = (res["status"] == "converged").sum()
-    failed = res["status"].str.startswith("failed").sum()
+    ok = int(converged_mask(res["status"]).sum())
+    failed = int(failed_mask(res["status"]).sum())
     print(
         f"{len(res)} design(s) evaluated with {scenario.name}: {ok} converged, "
         f"{len(res) - ok - failed} not converged, {failed} failed -> {args.output}"

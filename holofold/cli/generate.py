@@ -59,6 +59,7 @@ def run(args) -> int:
     from holofold.design.sampling import sample_designs
     from holofold.design.scenarios import get_scenario
     from holofold.design.store import build_database
+    from holofold.mechanics.status import failed_mask
 
     scenario = get_scenario(args.scenario)
     if args.samples < 1:
@@ -78,7 +79,7 @@ def run(args) -> int:
     )
     if args.csv:
         db.to_csv(Path(args.output) / "database.csv", index=False)
-    failed = int(db["status"].str.startswith("failed").sum())
+    failed = int(failed_mask(db["status"]).sum())
     print(
         f"{scenario.name}: {len(db)} designs in {Path(args.output) / 'database.parquet'} "
         f"({failed} failed)"

@@ -107,6 +107,7 @@ def run(args) -> int:
     from holofold.design.report import plot_rules, rules_to_records, rules_to_text
     from holofold.design.rules import FewRulesWarning, ForestRuleMiner
     from holofold.design.targets import parse_target
+    from holofold.mechanics.status import failed_mask
 
     # ---- validate everything before any output --------------------------------------------
     if args.rules < 1:
@@ -130,7 +131,7 @@ def run(args) -> int:
 
     table = read_table(args.database, columns=_names(args.columns))
     if "status" in table.columns:  # a holofold database: failed simulations have no outputs
-        failed = table["status"].astype(str).str.startswith("failed")
+        failed = failed_mask(table["status"])
         if failed.any():
             print(f"note: {int(failed.sum())} failed simulation(s) left out")
             table = table.loc[~failed].reset_index(drop=True)

@@ -9,6 +9,7 @@ import numpy as np
 from holofold.geometry.errors import ParameterError, check_range
 from holofold.mechanics.assembly import Assembler, SingularSystemError
 from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.status import CONVERGED, Status
 from holofold.mechanics.structure import Structure
 
 logger = logging.getLogger("holofold.mechanics.solvers")
@@ -71,11 +72,13 @@ def spring_array(name: str, value, ns: int) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------------- results
-def describe(converged, iterations, residual, tol, measure: str, failure: str | None) -> str:
+def describe(converged, iterations, residual, tol, measure: str, failure: str | None) -> Status:
+    """The :class:`Status` of a stage: failed (``failure``), not converged (the increments that
+    missed ``tol``, up to six listed) or converged."""
     bad = np.flatnonzero(~np.asarray(converged, bool))
-    parts = []
+    reasons = []
     if failure is not None:
-        parts.append(failure)
+        reasons.append(failure)
         bad = bad[:-1]  # the failing increment is described by the failure itself
     if bad.size:
         items = [
@@ -84,12 +87,12 @@ def describe(converged, iterations, residual, tol, measure: str, failure: str | 
             for b in bad[:_MAX_LISTED]
         ]
         more = f" and {bad.size - _MAX_LISTED} more" if bad.size > _MAX_LISTED else ""
-        parts.append(
-            f"not converged in {bad.size} of {len(converged)} increments: "
-            + ", ".join(items)
-            + more
+        reasons.append(
+            f"{bad.size} of {len(converged)} increments above tol: " + ", ".join(items) + more
         )
-    return "; ".join(parts) if parts else "converged"
+    if failure is not None:
+        return Status.failed(*reasons)
+    return Status.not_converged(*reasons) if reasons else CONVERGED
 
 
 class History:
@@ -116,7 +119,7 @@ class History:
     def result(self, tol, measure, applied_force, spring_rest, solver: str) -> SolveResult:
         c = self.count
         status = describe(self.conv[:c], self.iters[:c], self.res[:c], tol, measure, self.failure)
-        if status != "converged":
+        if not status.converged:
             logger.info("%s: %s", solver, status)
         return SolveResult(
             U_history=self.U[:c].copy(),
@@ -127,7 +130,6 @@ class History:
             status=status,
             applied_force=np.asarray(applied_force, float).reshape(-1, 3).copy(),
             spring_rest=np.asarray(spring_rest, float).copy(),
-            failed=self.failure is not None,
         )
 
 
@@ -224,7 +226,7 @@ def follow_path(
                 step += 1
                 last_step = step
         except SingularSystemError as exc:
-            hist.failure = f"failed at increment {i}, iteration {step}: {exc}"
+            hist.failure = f"increment {i}, iteration {step}: {exc}"
             hist.record(U, lam, False, step - 1, R)
             break
         hist.record(U, lam, R <= tol, step - 1, R)

@@ -93,7 +93,7 @@ def solve_newton(
                 R = float(np.sqrt(dU @ dU))
                 step += 1
         except SingularSystemError as exc:
-            hist.failure = f"failed at increment {i}, iteration {step}: {exc}"
+            hist.failure = f"increment {i}, iteration {step}: {exc}"
             hist.record(U, i, False, step - 1, R)
             break
         hist.record(U, i, R <= tol, step - 1, R)

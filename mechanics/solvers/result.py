@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from holofold.mechanics.status import Status
+
 __all__ = ["SolveResult"]
 
 
@@ -27,15 +29,14 @@ class SolveResult:
     residual : (n_inc,) float
         Last convergence measure of each increment (``||dU||_2`` in m for the loading solvers,
         ``||r||_2`` in N for self-folding).
-    status : str
-        ``"converged"``, or a sentence naming the failing increments and why.
+    status : Status
+        Converged; not converged, naming the increments that missed the tolerance; or failed
+        (the stage stopped early on a singular or non-finite system: the histories then end at
+        the failing increment).
     applied_force : (nn, 3) float
         Total external force at the end of the stage (start force + final load), N.
     spring_rest : (ns,) float
         Spring rest angles at the end of the stage, rad.
-    failed : bool
-        True if the stage stopped early (singular or non-finite system); the histories then
-        end at the failing increment.
 
     A stage whose increments exceed the iteration cap is not an error: like the reference
     simulator it accepts the last iterate and goes on; ``converged``/``status`` record it.
@@ -46,15 +47,19 @@ class SolveResult:
     converged: np.ndarray
     iterations: np.ndarray
     residual: np.ndarray
-    status: str
+    status: Status
     applied_force: np.ndarray
     spring_rest: np.ndarray
-    failed: bool = False
 
     @property
     def ok(self) -> bool:
         """True if every increment converged and nothing failed."""
-        return (not self.failed) and bool(np.all(self.converged))
+        return self.status.converged
+
+    @property
+    def failed(self) -> bool:
+        """True if the stage stopped early (singular or non-finite system)."""
+        return self.status.is_failed
 
     @property
     def U(self) -> np.ndarray:

@@ -95,7 +95,7 @@ def solve_selffold(
                 R = float(np.sqrt(r @ r))
                 step += 1
         except SingularSystemError as exc:
-            hist.failure = f"failed at increment {i}, iteration {step}: {exc}"
+            hist.failure = f"increment {i}, iteration {step}: {exc}"
             hist.record(U, s, False, step - 1, R)
             break
         hist.record(U, s, R <= tol, step - 1, R)
