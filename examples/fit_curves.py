@@ -101,10 +101,10 @@ def main(out_dir: str | Path = "docs", render: bool = True) -> dict:
     fits = fit_three()
     strips = []
     for title, fit in fits:
-        row = {"title": title, "m": fit.m, "offset": fit.meta["offset"], **fit.errors}
+        row = {"title": title, "m": fit.m, "offset": fit.offset, **fit.errors}
         strips.append(row)
         print(
-            f"{title:32s} m={fit.m:3d} offset={fit.meta['offset']:.3f} m "
+            f"{title:32s} m={fit.m:3d} offset={fit.offset:.3f} m "
             f"closest max={fit.closest.max:.4f} m mean={fit.closest.mean:.4f} m "
             f"warp max={fit.warp.max():.3%}"
         )

@@ -23,7 +23,8 @@ from holofold.fitting.error import (
     index_matched_error,
     paper_error,
 )
-from holofold.fitting.strip import SAMPLINGS, StripFit, fit_strip
+from holofold.fitting.strip import SAMPLINGS, StripGeometry, strip_geometry
+from holofold.fitting.strip_fit import StripFit, fit_strip
 
 __all__ = [
     "BUILTIN_CURVES",
@@ -39,6 +40,8 @@ __all__ = [
     "index_matched_error",
     "paper_error",
     "SAMPLINGS",
+    "StripGeometry",
+    "strip_geometry",
     "StripFit",
     "fit_strip",
     "AutoFit",

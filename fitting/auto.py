@@ -20,15 +20,8 @@ import pandas as pd
 
 from holofold.fitting.curves import load_curve
 from holofold.fitting.error import closest_point_error, index_matched_error
-from holofold.fitting.strip import (
-    StripFit,
-    _check_m,
-    _check_sampling,
-    fit_strip,
-    side_line,
-    strip_samples,
-    zigzag_centre_line,
-)
+from holofold.fitting.strip import _check_m, side_line, strip_samples, zigzag_centre_line
+from holofold.fitting.strip_fit import StripFit, _check_sampling, fit_strip
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 
 __all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"]

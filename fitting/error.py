@@ -15,11 +15,12 @@ Two measures:
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.fitting.curves import PlanarCurve
+from holofold.fitting.curves import PlanarCurve, load_curve
+from holofold.fitting.strip import chord_normals
 from holofold.geometry.errors import ParameterError
 
 __all__ = [
@@ -70,9 +71,6 @@ def paper_error(curve, m, offset, seg: int = SEG):
         e in metres, the shape of the broadcast inputs. Vectorised: one evaluation of the
         curve per distinct m.
     """
-    from holofold.fitting.curves import load_curve
-    from holofold.fitting.strip import _odd_normals
-
     curve = load_curve(curve)
     m_arr, off_arr = np.broadcast_arrays(np.asarray(m), np.asarray(offset, dtype=float))
     if not np.isfinite(off_arr).all():
@@ -90,7 +88,7 @@ def paper_error(curve, m, offset, seg: int = SEG):
         n = 2 * int(mm)
         P = curve(np.arange(n + 1) / n)
         N = np.zeros_like(P)
-        N[1::2] = _odd_normals(P)
+        N[1::2] = chord_normals(P)
         # centre line for every offset: P + l_o N, sub-sampled per segment (n_off, n*seg, 2)
         F0 = (P[:-1, None] * (1 - j)[None, :, None] + P[1:, None] * j[None, :, None]).reshape(-1, 2)
         G = (N[:-1, None] * (1 - j)[None, :, None] + N[1:, None] * j[None, :, None]).reshape(-1, 2)
@@ -124,9 +122,6 @@ class ClosestPointError:
     max: float
     curve_mean: float = float("nan")
     curve_max: float = float("nan")
-
-    def as_dict(self) -> dict[str, float]:
-        return asdict(self)
 
 
 def closest_point_error(

@@ -1,4 +1,4 @@
-"""Analytic Miura-like strip fitted to a planar curve (specs/scenarios.md 5.3-5.4).
+"""The analytic Miura-like strip over a planar curve: its construction steps and named nodes.
 
 Construction (metres; curve in the x-z plane, strip width along y):
 
@@ -19,49 +19,40 @@ What holds and what does not (checked in tests/test_strip.py):
 
 * At every interior centre-line vertex the four sector angles sum to 2 pi, and on each side
   the two angles are supplementary (they sum to pi).
-* The quads are **not planar**: :attr:`StripFit.warp` is, per panel, the distance between the
+* The quads are **not planar**: :func:`quad_warp` is, per panel, the distance between the
   two diagonals (shortest distance of the lines P_j-S_{j+1} and S_j-P_{j+1}) divided by the
   mean diagonal length (0 for a planar quad). Over the 3000 published designs the largest
   warp of a design ranges 0.07 %-3.5 % (median 0.86 %); specs/scenarios.md 5.4 quotes
   8-40 % with an unstated measure. The construction is kept as published; the mechanics
   model fans each panel from its centre node, so the as-built shape is its stress-free state.
 * The two panels of a segment have opposite vertex orientation (as in the reference), so
-  :attr:`StripFit.pattern` has no flat layout.
-* Flat layout for fabrication (:attr:`StripFit.flat`, :attr:`StripFit.flat_pattern`): the
-  *sector-angle development*. Because the angles on each side of the centre line are
-  supplementary, the centre line develops to a straight line (segment lengths kept) and
-  each transverse crease P_k-S_k is drawn with its 3-D length at its 3-D angle to the centre
-  line. Centre-line lengths, transverse-crease lengths and the sector angles at centre-line
-  vertices are exact; the side-line edges are not (the warped quads cannot be flattened
-  isometrically): :attr:`StripFit.flat_length_error` is their largest relative length error.
-  An exactly isometric development exists only for each side separately (as a triangle
+  the 3-D strip pattern has no flat layout.
+* Flat layout for fabrication (:func:`sector_angle_development`, used by
+  ``StripFit.flat_pattern``): the *sector-angle development*. Because the angles on each side of
+  the centre line are supplementary, the centre line develops to a straight line (segment
+  lengths kept) and each transverse crease P_k-S_k is drawn with its 3-D length at its 3-D angle
+  to the centre line. Centre-line lengths, transverse-crease lengths and the sector angles at
+  centre-line vertices are exact; the side-line edges are not (the warped quads cannot be
+  flattened isometrically): ``StripFit.flat_length_error`` is their largest relative length
+  error. An exactly isometric development exists only for each side separately (as a triangle
   strip), which is not provided.
 """
 
 from __future__ import annotations
 
-import logging
 import math
-from dataclasses import dataclass, field
-from functools import cached_property
-from typing import Any
+from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.fitting.curves import PlanarCurve, load_curve
-from holofold.fitting.error import ClosestPointError, closest_point_error, index_matched_error
-from holofold.geometry.errors import (
-    DegenerateGeometryError,
-    InvalidPatternError,
-    ParameterError,
-    check_range,
-)
-from holofold.geometry.pattern import CreasePattern
+from holofold.fitting.curves import PlanarCurve
+from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 
 __all__ = [
-    "StripFit",
-    "fit_strip",
+    "StripGeometry",
+    "strip_geometry",
     "strip_samples",
+    "chord_normals",
     "zigzag_centre_line",
     "side_line",
     "strip_nodes",
@@ -71,103 +62,69 @@ __all__ = [
     "SAMPLINGS",
 ]
 
-log = logging.getLogger(__name__)
-
 SAMPLINGS = ("paper", "arclength")
 _MIN_SIN_PHI = 1e-6  # below this the tangential shift W_s/sin(phi) is considered unbounded
 
 
-@dataclass(frozen=True, eq=False, repr=False)
-class StripFit:
-    """A Miura-like strip fitted to a curve.
+@dataclass(frozen=True, eq=False)
+class StripGeometry:
+    """The strip of one curve and design, with its node numbering named.
 
     Attributes
     ----------
-    pattern : CreasePattern
-        3-D strip, 6m+3 nodes, 4m quads in the published numbering (``flat`` is None).
-    curve : PlanarCurve
-        The target.
+    m : int
+        Number of Miura units (2m centre-line segments).
     t : (2m+1,) float
         Curve parameters of the samples.
     samples : (2m+1, 2) float
-        On-curve samples c(t_k) before the offset, metres.
+        On-curve samples c(t_k) before the offset, m.
     centre_line : (2m+1, 2) float
-        The zigzag centre fold line P (x, z), metres.
+        The zigzag centre fold line P (x, z), m.
     side_line : (2m+1, 2) float
-        The side line S (x, z) shared by both sides, metres.
-    warp : (4m,) float
-        Relative out-of-plane warp of each panel (diagonal distance / mean diagonal).
-    index_error : float
-        Index-matched error of 5.5 for this sampling (= the published error for ``paper``).
-    closest : ClosestPointError
-        Closest-point errors (centre line -> curve, curve -> centre line).
-    flat : (6m+3, 2) float
-        Sector-angle development (see module docstring).
-    flat_length_error : float
-        Largest relative edge-length difference between ``flat`` and the 3-D strip.
-    meta : dict
-        m, offset, strip_width, extrude, sampling, curve name and parameters.
+        The side line S (x, z) shared by both sides, m.
+    nodes : (6m+3, 3) float
+        3-D nodes: centre line, side A (y = -l_e), side B (y = +l_e), m.
+    faces : (4m, 4) int
+        Panels in the published order.
 
-    ``flat_pattern`` (computed on first use): the same strip with ``flat`` as layout and every
-    face counter-clockwise in it (side B loops reversed), for fabrication export; None if that
-    layout is not a valid pattern (overlapping panels).
+    Named node sets (ids into ``nodes``): :attr:`centre`, :attr:`side_a`, :attr:`side_b`
+    (the three lines), :attr:`ends` (their six end nodes, the paper's supports) and
+    :attr:`apex` (the middle centre-line vertex, the paper's loaded node).
     """
 
-    pattern: CreasePattern
-    curve: PlanarCurve
+    m: int
     t: np.ndarray
     samples: np.ndarray
     centre_line: np.ndarray
     side_line: np.ndarray
-    warp: np.ndarray
-    index_error: float
-    closest: ClosestPointError
-    flat: np.ndarray
-    flat_length_error: float
-    meta: dict[str, Any] = field(default_factory=dict)
-
-    @cached_property
-    def flat_pattern(self) -> CreasePattern | None:
-        """The strip with :attr:`flat` as layout, faces counter-clockwise in it (or None)."""
-        ff = [f.copy() for f in self.pattern.faces]
-        ff[1::2] = [f[::-1].copy() for f in ff[1::2]]  # side B loops reversed
-        try:
-            return CreasePattern.from_faces(
-                self.pattern.coords,
-                ff,
-                flat=self.flat,
-                meta={**self.meta, "flat_layout": "sector-angle development"},
-            )
-        except ValueError as exc:  # an overlapping development is not a valid layout
-            log.info("no flat layout for this strip: %s", exc)
-            return None
+    nodes: np.ndarray
+    faces: np.ndarray
 
     @property
-    def m(self) -> int:
-        return int(self.meta["m"])
-
-    def __repr__(self) -> str:
-        mt = self.meta
-        return (
-            f"StripFit(curve={mt['curve']!r}, m={mt['m']}, offset={mt['offset']:.6g}, "
-            f"strip_width={mt['strip_width']:.6g}, extrude={mt['extrude']:.6g}, "
-            f"sampling={mt['sampling']!r}, index_error={self.index_error:.6g}, "
-            f"closest_max={self.closest.max:.6g})"
-        )
+    def centre(self) -> np.ndarray:
+        """(2m+1,) ids of the centre-line nodes, in curve order."""
+        return np.arange(2 * self.m + 1)
 
     @property
-    def errors(self) -> dict[str, float]:
-        """All error measures as a flat dict (metres; warp relative)."""
-        return {
-            "index_error": self.index_error,
-            "closest_mean": self.closest.mean,
-            "closest_max": self.closest.max,
-            "curve_to_strip_mean": self.closest.curve_mean,
-            "curve_to_strip_max": self.closest.curve_max,
-            "warp_max": float(self.warp.max()),
-            "warp_mean": float(self.warp.mean()),
-            "flat_length_error": self.flat_length_error,
-        }
+    def side_a(self) -> np.ndarray:
+        """(2m+1,) ids of the side-A nodes (y = -l_e)."""
+        return self.centre + 2 * self.m + 1
+
+    @property
+    def side_b(self) -> np.ndarray:
+        """(2m+1,) ids of the side-B nodes (y = +l_e)."""
+        return self.centre + 4 * self.m + 2
+
+    @property
+    def ends(self) -> np.ndarray:
+        """(6,) ids of the first and last node of the centre line, side A and side B."""
+        return np.array([line[k] for line in (self.centre, self.side_a, self.side_b)
+                         for k in (0, -1)])  # fmt: skip
+
+    @property
+    def apex(self) -> int:
+        """Id of the middle centre-line vertex (node m; on the curve for even m)."""
+        return self.m
 
 
 # ---------------------------------------------------------------------- validation
@@ -179,13 +136,6 @@ def _check_m(m) -> int:
     if not math.isfinite(mf) or mf != round(mf) or mf < 2:
         raise ParameterError(f"m must be an integer >= 2 (number of Miura units), got {m!r}")
     return int(mf)
-
-
-def _check_sampling(sampling: str | None, curve: PlanarCurve) -> str:
-    s = curve.default_sampling if sampling is None else sampling
-    if s not in SAMPLINGS:
-        raise ParameterError(f"sampling must be one of {SAMPLINGS}, got {sampling!r}")
-    return s
 
 
 # ---------------------------------------------------------------------- construction steps
@@ -200,7 +150,7 @@ def strip_samples(curve: PlanarCurve, m: int, sampling: str = "paper"):
     raise ParameterError(f"sampling must be one of {SAMPLINGS}, got {sampling!r}")
 
 
-def _odd_normals(P: np.ndarray) -> np.ndarray:
+def chord_normals(P: np.ndarray) -> np.ndarray:
     """Unit left normals (-c_z, c_x) of the chords P_{2i} - P_{2i-2}, (m, 2)."""
     c = P[2::2] - P[:-2:2]
     n = np.linalg.norm(c, axis=1)
@@ -217,7 +167,7 @@ def _odd_normals(P: np.ndarray) -> np.ndarray:
 def zigzag_centre_line(samples: np.ndarray, offset: float) -> np.ndarray:
     """Centre line (2m+1, 2): odd samples moved by ``offset`` along the chord's left normal."""
     P = np.array(samples, dtype=float)
-    P[1::2] += offset * _odd_normals(P)
+    P[1::2] += offset * chord_normals(P)
     return P
 
 
@@ -321,89 +271,36 @@ def sector_angle_development(X: np.ndarray, m: int) -> tuple[np.ndarray, np.ndar
     return flat, defect
 
 
-# ---------------------------------------------------------------------- the fit
-def fit_strip(
-    curve,
+def strip_geometry(
+    curve: PlanarCurve,
     m: int,
     offset: float,
     strip_width: float,
     extrude: float,
-    *,
-    sampling: str | None = None,
-    closest_both: bool = True,
-) -> StripFit:
-    """Fit the Miura-like strip of specs/scenarios.md 5.3-5.4 to ``curve``.
+    sampling: str = "paper",
+) -> StripGeometry:
+    """Construct the strip (steps 1-4 of the module docstring) for one design.
 
     Parameters
     ----------
-    curve : PlanarCurve or anything :func:`fitting.curves.load_curve` accepts
-        Target curve in the x-z plane, metres.
+    curve : PlanarCurve
+        Target curve in the x-z plane, m.
     m : int
-        Number of Miura units, >= 2 (2m centre-line segments). The paper uses even m so that
-        the apex sample t = 1/2 is an unshifted vertex (node m); odd m is allowed.
-    offset : float
-        l_o > 0, offset of the middle vertices along the chord's left normal, metres.
-    strip_width : float
-        W_s > 0, the side-line shift parameter, metres.
-    extrude : float
-        l_e > 0, half-width of the strip in y, metres.
-    sampling : {"paper", "arclength"} or None
-        None: the curve's default (``paper`` for the built-in half circle, else ``arclength``).
+        Number of Miura units, >= 2.
+    offset, strip_width, extrude : float
+        l_o, W_s and l_e, m (each > 0).
+    sampling : {"paper", "arclength"}
 
-    Returns
-    -------
-    StripFit
+    Raises
+    ------
+    ParameterError, DegenerateGeometryError
+        Invalid values, or a centre line that does not turn (the side line is unbounded).
     """
-    curve = load_curve(curve)
     m = _check_m(m)
     offset = check_range("offset", offset, 0.0, None, low_open=True)
     strip_width = check_range("strip_width", strip_width, 0.0, None, low_open=True)
     extrude = check_range("extrude", extrude, 0.0, None, low_open=True)
-    sampling = _check_sampling(sampling, curve)
-
     t, samples = strip_samples(curve, m, sampling)
     P = zigzag_centre_line(samples, offset)
     S = side_line(P, strip_width)
-    X = strip_nodes(P, S, extrude)
-    faces = strip_faces(m)
-    meta = {
-        "m": m,
-        "offset": offset,
-        "strip_width": strip_width,
-        "extrude": extrude,
-        "sampling": sampling,
-        "curve": curve.name,
-        "curve_params": dict(curve.params),
-        "generator": "holofold.fitting.strip.fit_strip (specs/scenarios.md 5.3-5.4)",
-    }
-    try:
-        pattern = CreasePattern.from_faces(X, list(faces), flat=None, meta=meta)
-    except InvalidPatternError as exc:
-        shift = np.linalg.norm(S - P, axis=1)
-        raise DegenerateGeometryError(
-            f"the fitted strip is self-overlapping ({exc}); the side-line shift W_s cot(phi) "
-            f"reaches {shift.max():.4g} m at vertex {int(np.argmax(shift))} against centre "
-            f"segments of {np.linalg.norm(np.diff(P, axis=0), axis=1).min():.4g} m: use a "
-            f"smaller strip_width, a larger offset or another m"
-        ) from None
-    warp = quad_warp(X, faces)
-    flat, defect = sector_angle_development(X, m)
-    e = pattern.edges
-    l3 = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
-    lf = np.linalg.norm(flat[e[:, 1]] - flat[e[:, 0]], axis=1)
-    flat_err = float(np.max(np.abs(lf - l3) / l3))
-    meta["max_angle_defect"] = float(np.abs(defect).max()) if defect.size else 0.0
-    return StripFit(
-        pattern=pattern,
-        curve=curve,
-        t=t,
-        samples=samples,
-        centre_line=P,
-        side_line=S,
-        warp=warp,
-        index_error=index_matched_error(curve, P, t),
-        closest=closest_point_error(curve, P, both=closest_both),
-        flat=flat,
-        flat_length_error=flat_err,
-        meta=meta,
-    )
+    return StripGeometry(m, t, samples, P, S, strip_nodes(P, S, extrude), strip_faces(m))

@@ -99,15 +99,20 @@ class Status:
     @classmethod
     def gather(cls, parts: Mapping[str, Status], *, worst: Outcome | None = None) -> Status:
         """One status from labelled parts: converged if every part is, otherwise the worst
-        outcome among them (capped at ``worst``) with one ``"label: part"`` reason per part
-        that did not converge."""
+        outcome among them (capped at ``worst``) with one ``"label: why"`` reason per part that
+        did not converge (a part whose outcome differs from the result's names it:
+        ``"label: failed: why"``)."""
         bad = {k: s for k, s in parts.items() if not s.converged}
         if not bad:
             return CONVERGED
         outcome = max((s.outcome for s in bad.values()), key=lambda o: o.rank)
         if worst is not None and outcome.rank > worst.rank:
             outcome = worst
-        return cls(outcome, tuple(f"{label}: {s}" for label, s in bad.items()))
+        reasons = tuple(
+            f"{label}: " + ("; ".join(s.reasons) if s.outcome is outcome else str(s))
+            for label, s in bad.items()
+        )
+        return cls(outcome, reasons)
 
     # ------------------------------------------------------------------ queries
     @property

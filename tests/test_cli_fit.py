@@ -105,7 +105,7 @@ def test_thick_solid(tmp_path, capsys):
 
 def test_plan_view_svg_without_layout():
     from holofold.cli.fit import _plan_view_svg
-    from holofold.fitting.strip import fit_strip
+    from holofold.fitting import fit_strip
 
     fit = fit_strip("half-circle", 8, 0.2, 0.02, 0.1)
     svg = _plan_view_svg(fit)

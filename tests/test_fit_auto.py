@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from holofold.fitting import fit_strip
 from holofold.fitting.auto import FitNotFoundError, fit_auto
 from holofold.fitting.curves import parse_curve_spec
-from holofold.fitting.strip import fit_strip
 from holofold.geometry.errors import ParameterError
 
 HALF = parse_curve_spec("half-circle:radius=2")
@@ -23,17 +23,17 @@ def test_half_circle_smallest_m_and_largest_offset():
     np.testing.assert_allclose(table["closest_max"][fine], table["offset"][fine], rtol=1e-9)
     # m = 2: the long chords cut inside the circle by more than 0.1 for small offsets
     np.testing.assert_allclose(table["closest_max"][:2], [0.129119485, 0.110257353], rtol=1e-8)
-    assert fit.meta["m"] == 4
-    assert fit.meta["offset"] == 0.1
+    assert fit.m == 4
+    assert fit.offset == 0.1
     chosen = table[table["chosen"]]
-    assert len(chosen) == 1 and int(chosen["m"].iloc[0]) == fit.meta["m"]
+    assert len(chosen) == 1 and int(chosen["m"].iloc[0]) == fit.m
     # every smaller m tried has no valid candidate meeting the tolerance
-    smaller = table[table["m"] < fit.meta["m"]]
+    smaller = table[table["m"] < fit.m]
     assert not (smaller["meets"] & smaller["valid"]).any()
     assert fit.closest.max <= 0.1 * (1 + 1e-9)
     # strip_width default: offset / 8; extrude default: length / 40
-    np.testing.assert_allclose(fit.meta["strip_width"], 0.1 / 8)
-    np.testing.assert_allclose(fit.meta["extrude"], np.pi * 2 / 40, rtol=1e-6)
+    np.testing.assert_allclose(fit.strip_width, 0.1 / 8)
+    np.testing.assert_allclose(fit.extrude, np.pi * 2 / 40, rtol=1e-6)
     # the candidates' numbers are those of the full fit
     row = chosen.iloc[0]
     ref = fit_strip(HALF, int(row["m"]), row["offset"], row["strip_width"], row["extrude"])
@@ -55,7 +55,7 @@ def test_mean_metric_and_smallest_error_preference():
     same_m = t[(t["m"] == row["m"]) & t["meets"]]
     assert row["closest_mean"] == same_m["closest_mean"].min()
     assert row["closest_mean"] <= 0.02
-    assert res.strip.meta["strip_width"] == 0.002 and res.strip.meta["extrude"] == 0.05
+    assert res.strip.strip_width == 0.002 and res.strip.extrude == 0.05
 
 
 def test_no_fit_found_reports_best():

@@ -7,6 +7,7 @@ import time
 import numpy as np
 import pytest
 
+from holofold.fitting import fit_strip
 from holofold.fitting.curves import PlanarCurve, parse_curve_spec
 from holofold.fitting.error import (
     closest_point_error,
@@ -14,7 +15,6 @@ from holofold.fitting.error import (
     paper_error,
     polyline_distance,
 )
-from holofold.fitting.strip import fit_strip
 from holofold.geometry.errors import ParameterError
 
 HALF = parse_curve_spec("half-circle:radius=2")

@@ -320,3 +320,22 @@ def test_compliant_gripper_numbering_matches_the_reference_scripts():
     s3 = build_compliant(gripper.two_panel_gripper(5e-3, 4e-3, 0.4), **kw)
     assert (s3.n_nodes, len(s3.bars)) == (37, 80)
     assert (s3.creases.ids + 1).tolist() == [2, 4, 7, 12]
+
+
+def test_supports_and_vertex_nodes_by_name():
+    """Structure.fixed fixes named nodes' DOFs; vertex_nodes finds every copy of a vertex."""
+    p = four_vertex()
+    c = build_concentrated(p, crease_width=1e-3, crease_thickness=1e-3, panel_thickness=1e-3)
+    f = c.fixed([0, 2], "xz")
+    assert f.supports.sum() == 4 and f.supports[0].tolist() == [True, False, True]
+    g = c.fixed([([0], "xyz"), ([3], "y")])
+    assert g.supports.sum() == 4 and g.supports[3].tolist() == [False, True, False]
+    assert c.vertex_nodes([4]).tolist() == [4]  # concentrated: vertex v is node v
+    s = build_compliant(p, crease_width=0.1, crease_thickness=1e-3, panel_thickness=1e-2, **MAT)
+    copies = s.vertex_nodes(4)
+    assert len(copies) == 4 and np.all(s.node_vertex[copies] == 4)
+    np.testing.assert_allclose(s.nodes[copies].mean(axis=0), p.coords[4], atol=1e-12)
+    with pytest.raises(ValueError, match="dofs"):
+        c.fixed([0], "w")
+    with pytest.raises(ValueError, match="outside"):
+        c.fixed([99])

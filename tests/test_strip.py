@@ -5,10 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from holofold.fitting import StripFit, fit_strip, strip_geometry
 from holofold.fitting.curves import PlanarCurve, parse_curve_spec
 from holofold.fitting.strip import (
-    StripFit,
-    fit_strip,
     quad_warp,
     side_line,
     strip_faces,
@@ -33,7 +32,7 @@ def test_centre_line_test_vector(fit8):
     np.testing.assert_allclose(r[1::2], 2.2, rtol=1e-14)
     np.testing.assert_allclose(r[::2], 2.0, rtol=1e-14)
     np.testing.assert_allclose(P[8], [2.0, 2.0], atol=1e-15)
-    assert fit8.meta["sampling"] == "paper"
+    assert fit8.sampling == "paper"
     np.testing.assert_array_equal(fit8.t, np.arange(17) / 16)
 
 
@@ -100,7 +99,7 @@ def test_sector_angles_sum_to_two_pi(curve, sampling):
     for f, a in zip(p.faces, p.sector_angles(), strict=True):
         np.add.at(total, f, a)
     np.testing.assert_allclose(total[1:12], 2 * np.pi, atol=1e-12)
-    assert fit.meta["max_angle_defect"] < 1e-12
+    assert fit.max_angle_defect < 1e-12
 
 
 def test_quads_are_warped_and_warp_measure(fit8):
@@ -144,7 +143,7 @@ def test_flat_layout_keeps_centre_and_transverse_lengths(fit8):
 
 def test_arclength_sampling_default_for_user_curves():
     fit = fit_strip("parabola:span=4,height=1", 4, 0.3, 0.02, 0.1)
-    assert fit.meta["sampling"] == "arclength"
+    assert fit.sampling == "arclength"
     s = fit.curve.arc_length(fit.t)
     np.testing.assert_allclose(np.diff(s), s[-1] / 8, rtol=1e-9)
 
@@ -198,3 +197,19 @@ def test_odd_m_is_allowed_but_apex_is_shifted():
     # t = 1/2 is the odd vertex 3, moved outward by l_o: no vertex stays at the apex
     np.testing.assert_allclose(fit.centre_line[3], [2.0, 2.2], atol=1e-15)
     assert np.linalg.norm(fit.centre_line - [2.0, 2.0], axis=1).min() > 0.19
+
+
+def test_strip_geometry_names_the_paper_nodes():
+    """ends = the six end nodes of the three lines (the paper's supports), apex = node m."""
+    g = strip_geometry(HALF, 8, 0.2, 0.02, 0.1)
+    assert g.nodes.shape == (51, 3) and g.faces.shape == (32, 4)
+    assert g.ends.tolist() == [0, 16, 17, 33, 34, 50]
+    assert g.apex == 8 and np.allclose(g.nodes[g.apex, [0, 2]], [2.0, 2.0])  # the top
+    np.testing.assert_allclose(g.nodes[g.side_a, 1], -0.1)
+    np.testing.assert_allclose(g.nodes[g.side_b, 1], 0.1)
+    np.testing.assert_array_equal(g.nodes[g.centre, 1], 0.0)
+    fit = fit_strip(HALF, 8, 0.2, 0.02, 0.1)
+    np.testing.assert_array_equal(fit.geometry.nodes, g.nodes)
+    np.testing.assert_array_equal(fit.pattern.coords, g.nodes)
+    with pytest.raises(ParameterError, match="offset"):
+        strip_geometry(HALF, 8, -0.2, 0.02, 0.1)

@@ -16,8 +16,6 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-import numpy as np
-
 from holofold.design.scenarios.base import (
     Column,
     Scenario,
@@ -25,15 +23,7 @@ from holofold.design.scenarios.base import (
     positive,
     single_thread,
 )
-from holofold.fitting.curves import builtin_curve
-from holofold.fitting.error import index_matched_error
-from holofold.fitting.strip import (
-    side_line,
-    strip_faces,
-    strip_nodes,
-    strip_samples,
-    zigzag_centre_line,
-)
+from holofold.fitting import builtin_curve, index_matched_error, strip_geometry
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_group, secant_stiffness
 from holofold.mechanics.assembly import Assembler
@@ -74,11 +64,9 @@ def _curve():
 
 @lru_cache(maxsize=16)
 def _topology(m: int) -> CreasePattern:
-    """A strip with the right faces (coordinates are replaced per design)."""
-    t, samples = strip_samples(_curve(), m, "paper")
-    P = zigzag_centre_line(samples, 0.2)
-    X = strip_nodes(P, side_line(P, 0.02), 0.15)
-    return CreasePattern.from_faces(X, list(strip_faces(m)))
+    """A strip with the right faces, validated once per m (coordinates are replaced per design)."""
+    g = strip_geometry(_curve(), m, 0.2, 0.02, 0.15)
+    return CreasePattern.from_faces(g.nodes, list(g.faces))
 
 
 def check(row) -> list[str]:
@@ -97,21 +85,17 @@ def arch_model(row, *, profile=PAPER):
     -------
     structure : Structure
     apex : int
-        Loaded node (m).
+        Loaded node: the strip's apex (node m).
     error : float
         Fitting error e, m.
     """
     m = int(row["m"])
-    t, samples = strip_samples(_curve(), m, "paper")
-    P = zigzag_centre_line(samples, float(row["offset"]))
-    S = side_line(P, float(row["stripeWidth"]))
-    X = strip_nodes(P, S, float(row["extrude"]))
-    topo = _topology(m)
-    sup = np.zeros((len(X) + topo.n_faces, 3), bool)
-    sup[[0, 2 * m, 2 * m + 1, 4 * m + 1, 4 * m + 2, 6 * m + 2]] = True
+    g = strip_geometry(
+        _curve(), m, float(row["offset"]), float(row["stripeWidth"]), float(row["extrude"])
+    )
     s = build_concentrated(
-        topo,
-        coords=X,
+        _topology(m),
+        coords=g.nodes,
         crease_width=row["W"],
         crease_thickness=row["tcrease"],
         panel_thickness=row["tpanel"],
@@ -120,9 +104,8 @@ def arch_model(row, *, profile=PAPER):
         nu_panel=NU,
         nu_crease=NU,
         profile=profile,
-        supports=sup,
-    )
-    return s, m, index_matched_error(_curve(), P, t)
+    ).fixed(g.ends)
+    return s, g.apex, index_matched_error(_curve(), g.centre_line, g.t)
 
 
 def evaluate(row) -> dict:

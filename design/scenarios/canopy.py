@@ -132,8 +132,6 @@ def sheet_models(row, *, profile=PAPER, extensions=EXTENSIONS):
         else:
             X = tmp_nodes(m, n, SIZE, ext)
         x = X[:, 0]
-        sup = np.zeros((len(X) + topo.n_faces, 3), bool)
-        sup[np.flatnonzero(x == x.min())] = True
         tip = np.flatnonzero(x == x.max())
         s = build_concentrated(
             topo,
@@ -146,8 +144,7 @@ def sheet_models(row, *, profile=PAPER, extensions=EXTENSIONS):
             nu_panel=NU,
             nu_crease=NU,
             profile=profile,
-            supports=sup,
-        )
+        ).fixed(np.flatnonzero(x == x.min()))  # vertex v is node v
         out.append((s, load_group(tip, "-z"), load_group(tip, "+x")))
     return out
 

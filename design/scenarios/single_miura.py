@@ -77,8 +77,6 @@ def cell_models(tcrease, tpanel, W, gama, *, profile=PAPER, extensions=EXTENSION
     for ext in extensions:
         X = miura_nodes(m, n, a, b, gama, ext)
         x = X[:, 0]
-        sup = np.zeros((len(X) + pattern.n_faces, 3), bool)
-        sup[: len(X)][x == 0.0] = True
         s = build_concentrated(
             pattern,
             coords=X,
@@ -90,8 +88,7 @@ def cell_models(tcrease, tpanel, W, gama, *, profile=PAPER, extensions=EXTENSION
             nu_panel=NU,
             nu_crease=NU,
             profile=profile,
-            supports=sup,
-        )
+        ).fixed(np.flatnonzero(x == 0.0))  # vertex v is node v
         out.append((s, load_group(np.flatnonzero(x == x.max()), "+x")))
     return out
 

@@ -31,7 +31,8 @@ import numpy as np
 
 from holofold.fitting.auto import DEFAULT_M_RANGE, fit_auto
 from holofold.fitting.curves import load_curve
-from holofold.fitting.strip import SAMPLINGS, StripFit, fit_strip
+from holofold.fitting.strip import SAMPLINGS
+from holofold.fitting.strip_fit import StripFit, fit_strip
 from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.export import export
 from holofold.geometry.solid import thick_solid
@@ -215,15 +216,10 @@ def run(args) -> int:
         table.to_csv(p_csv, index=False)
         written.append(p_csv)
     summary = {
-        "curve": fit.meta["curve"],
-        "m": fit.m,
-        "offset": fit.meta["offset"],
-        "strip_width": fit.meta["strip_width"],
-        "extrude": fit.meta["extrude"],
-        "sampling": fit.meta["sampling"],
+        **fit.parameters,
         **fit.errors,
         "files": [str(w) for w in written],
     }
-    print(f"fitted m={fit.m} strip ({fit.pattern.n_vertices} nodes) to {fit.meta['curve']}")
+    print(f"fitted m={fit.m} strip ({fit.pattern.n_vertices} nodes) to {fit.curve.name}")
     print(json.dumps(summary))
     return 0
