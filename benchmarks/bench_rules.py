@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.database import read_table
 from holofold.design.evaluation import grid_search, rule_scores, split_indices
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.tables import read_table
 from holofold.design.targets import parse_target
 
 FEATURES = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]

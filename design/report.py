@@ -1,4 +1,4 @@
-"""Output of mined rules: text, JSON, DataFrame, and figures.
+"""Output of mined rules: text, DataFrame and figures (JSON: :mod:`holofold.design.rulefile`).
 
 Figures follow the paper: a box chart per rule (each feature's full range as a bar, the rule's
 range shaded; Fig. 2F), a scatter of two features with the rows inside the rule marked against
@@ -8,21 +8,21 @@ plotting functions (Agg backend when none is set), so importing this module cost
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 import pandas as pd
 
-from holofold.design.rules import ForestRuleMiner, format_rule
+from holofold.design.rules import ForestRuleMiner, format_rule, level_value
+from holofold.geometry.outputs import atomic_write
 
 __all__ = [
     "rules_frame",
     "rules_to_text",
-    "rules_to_records",
-    "rules_to_json",
+    "mining_summary",
     "plot_rule_boxes",
     "plot_rules",
+    "save_figure",
     "plot_rule_scatter",
     "plot_feature_importance",
 ]
@@ -36,10 +36,6 @@ def rules_frame(miner: ForestRuleMiner, test: pd.DataFrame | None = None) -> pd.
             raise ValueError(f"test has {len(test)} rows for {len(frame)} rules")
         frame = pd.concat([frame, test.reset_index(drop=True).add_prefix("test_")], axis=1)
     return frame
-
-
-def _bounds(miner: ForestRuleMiner, i: int) -> list:
-    return miner.rule_bounds(i)
 
 
 def _categorical_names(miner: ForestRuleMiner) -> set:
@@ -75,7 +71,7 @@ def rules_to_text(
     lines = []
     for i, row in rules.iterrows():
         text = format_rule(
-            _bounds(miner, i),
+            miner.rule_bounds(i),
             miner.feature_names_,
             categorical=_categorical_names(miner),
             digits=digits,
@@ -98,62 +94,28 @@ def rules_to_text(
     return "\n".join(lines)
 
 
-def _num(v: float):
-    return None if not math.isfinite(v) else float(v)
+def mining_summary(mined, source: str) -> str:
+    """What ``holofold mine`` prints: the table, target, features, split and the rules.
 
-
-def _level(v):
-    if isinstance(v, float | np.floating) and float(v).is_integer():
-        return int(v)
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
-def rules_to_records(miner: ForestRuleMiner, test: pd.DataFrame | None = None) -> list[dict]:
-    """The kept rules, best first, as JSON-ready dicts.
-
-    Each has ``rule`` (text), ``bounds`` (per constrained feature ``{"gt": .., "le": ..}``
-    with null for an open side, or ``{"in": [levels]}``), ``train`` (precision, recall,
-    support) and, when ``test`` is given, ``test``.
+    ``mined``: a :class:`~holofold.design.mining.MinedRules`; ``source``: the table's name.
     """
-    out = []
-    for i, row in miner.rules_.iterrows():
-        bounds = {}
-        for name, b in zip(miner.feature_names_, _bounds(miner, i), strict=True):
-            if b is None:
-                continue
-            if miner._encoding.categorical[miner.feature_names_.index(name)]:
-                bounds[name] = {"in": [_level(v) for v in b]}
-            elif math.isfinite(b[0]) or math.isfinite(b[1]):
-                bounds[name] = {"gt": _num(b[0]), "le": _num(b[1])}
-        rec = {
-            "rank": int(i) + 1,
-            "rule": row["rule"],
-            "bounds": bounds,
-            "train": {
-                "precision": float(row["precision"]),
-                "recall": float(row["recall"]),
-                "support": int(row["support"]),
-            },
-        }
-        if "oob_precision" in row:
-            rec["train"]["oob_precision"] = float(row["oob_precision"])
-        if test is not None:
-            t = test.iloc[i]
-            rec["test"] = {
-                "precision": float(t["precision"]),
-                "recall": float(t["recall"]),
-                "support": int(t["support"]),
-            }
-        out.append(rec)
-    return out
-
-
-def rules_to_json(miner: ForestRuleMiner, test: pd.DataFrame | None = None, **kw) -> str:
-    """:func:`rules_to_records` as a JSON string (``kw`` go to ``json.dumps``)."""
-    kw.setdefault("indent", 2)
-    return json.dumps(rules_to_records(miner, test), **kw)
+    m, h = mined.miner, mined.holdout
+    y = mined.meets
+    n_hit = int(y.sum())
+    cats = f" (categorical: {', '.join(mined.categorical)})" if mined.categorical else ""
+    lines = []
+    if mined.n_failed:
+        lines.append(f"note: {mined.n_failed} failed simulation(s) left out")
+    lines += [
+        f"database: {source} ({len(mined.table)} rows)",
+        f"target:   {mined.target} (met by {n_hit} rows, {100 * n_hit / y.size:.1f} %)",
+        f"features: {', '.join(mined.features)}{cats}",
+        f"split:    {len(h.train_index)} train / {len(h.test_index)} test rows "
+        f"(seed {m.random_state}); {m.n_candidates_} candidate boxes, "
+        f"{len(m.candidate_rules_)} pass the filters",
+        rules_to_text(m, mined.test_scores),
+    ]
+    return "\n".join(lines)
 
 
 def _pyplot():
@@ -217,7 +179,8 @@ def plot_rule_boxes(
             for i, v in enumerate(lv.tolist()):
                 if v in allowed:
                     ax.barh(yk, w, left=i * w, height=0.5, color="tab:blue", alpha=0.7)
-                ax.text((i + 0.5) * w, yk, str(_level(v)), ha="center", va="center", fontsize=7)
+                label = str(level_value(v))
+                ax.text((i + 0.5) * w, yk, label, ha="center", va="center", fontsize=7)
             continue
         col = df[name].to_numpy(dtype=float)
         lo, hi = float(np.min(col)), float(np.max(col))
@@ -240,6 +203,16 @@ def plot_rule_boxes(
     return fig
 
 
+def save_figure(fig, path, dpi: int = 120):
+    """Save a matplotlib figure atomically (the format from the suffix) and close it."""
+    import matplotlib.pyplot as plt
+
+    try:
+        return atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi))
+    finally:
+        plt.close(fig)
+
+
 def plot_rules(miner: ForestRuleMiner, X, path=None, **kw):
     """Box charts of all kept rules side by side; saved to ``path`` when given.
 
@@ -258,7 +231,7 @@ def plot_rules(miner: ForestRuleMiner, X, path=None, **kw):
         plot_rule_boxes(miner, X, i, ax=axes[0, i], **kw)
     fig.tight_layout()
     if path is not None:
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path)
     return fig
 
 

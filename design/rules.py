@@ -43,6 +43,7 @@ __all__ = [
     "forest_boxes",
     "boxes_contain",
     "format_rule",
+    "level_value",
 ]
 
 logger = logging.getLogger(__name__)
@@ -300,10 +301,17 @@ class _Encoding:
         ]
 
 
-def _fmt_level(v) -> str:
+def level_value(v):
+    """A categorical level as a plain Python number (8.0 -> 8) for text and JSON."""
     if isinstance(v, float | np.floating) and float(v).is_integer():
-        return str(int(v))
-    return str(v)
+        return int(v)
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+def _fmt_level(v) -> str:
+    return str(level_value(v))
 
 
 def _fmt_num(v: float, digits: int) -> str:

@@ -17,7 +17,7 @@ import re
 import sys
 from collections import Counter
 from collections.abc import Iterator
-from contextlib import closing, contextmanager
+from contextlib import closing, contextmanager, nullcontext
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,6 +32,9 @@ __all__ = [
     "ValidatedTable",
     "validate_designs",
     "evaluate_designs",
+    "iter_results",
+    "results_table",
+    "progress_bar",
     "check_scheduler",
     "check_workers",
     "dask_scheduler",
@@ -305,29 +308,43 @@ def _iter_on_dask(
             client.cancel([f for f in futures if not f.done()])
 
 
-def _evaluate_on_dask(
-    scenario: Scenario, rows: list, limit_threads: bool, address: str, progress: bool
-) -> list:
-    """Evaluate ``rows`` on the Dask scheduler at ``address``; results in input order.
+def iter_results(
+    scenario: Scenario,
+    rows: list,
+    *,
+    workers: int = 1,
+    address: str | None = None,
+    limit_threads: bool = True,
+) -> Iterator[tuple[int, dict]]:
+    """Simulate validated ``rows``, yielding ``(position, output)`` as each row finishes.
 
-    See :func:`_iter_on_dask` (failed rows, workers without holofold, cancellation).
+    ``address``: a running Dask scheduler (rows come in order of completion, see
+    :func:`dask_scheduler`); otherwise joblib processes (``workers``, -1 = every core; rows in
+    order). Each output has the performance columns and a :class:`Status`; a row whose
+    simulation raises is a failed row, never an exception. Close the iterator
+    (:func:`contextlib.closing`) to cancel what is still running.
     """
-    outs: list = [None] * len(rows)
-    bar = None
-    if progress:
-        from tqdm import tqdm
+    if address is not None:
+        yield from _iter_on_dask(scenario, rows, limit_threads, address)
+        return
+    if workers == 1 or len(rows) <= 1:
+        yield from enumerate(_evaluate_one(scenario, r, limit_threads) for r in rows)
+        return
+    from joblib import Parallel, delayed
 
-        bar = tqdm(total=len(rows), desc=scenario.name, unit="design", file=sys.stderr)
-    try:
-        with closing(_iter_on_dask(scenario, rows, limit_threads, address)) as results:
-            for i, out in results:
-                outs[i] = out
-                if bar is not None:
-                    bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
-    return outs
+    par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
+    yield from enumerate(par(delayed(_evaluate_one)(scenario, r, limit_threads) for r in rows))
+
+
+def progress_bar(total: int, desc: str, enabled: bool | None = None, initial: int = 0):
+    """A tqdm bar on stderr (shown by default only on a terminal), or None."""
+    if enabled is None:
+        enabled = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, initial=initial, desc=desc, unit="design", file=sys.stderr)
 
 
 def evaluate_designs(
@@ -345,7 +362,7 @@ def evaluate_designs(
     Parameters
     ----------
     scenario : Scenario or str
-        The scenario or its name (:data:`design.scenarios.SCENARIO_NAMES`).
+        The scenario or its name (:data:`holofold.design.scenarios.SCENARIO_NAMES`).
     table : DataFrame
         Feature columns in SI units (names as in the published files); other columns are
         kept. Input columns named like a performance column are replaced.
@@ -379,29 +396,29 @@ def evaluate_designs(
     checked = validate_designs(scenario, table)
     for w in checked.warnings if log_warnings else ():
         log.warning("outside the paper's sampling ranges: %s", w)
-    if progress is None:
-        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
-    n = len(checked.rows)
-    if scheduler is not None and n:
-        with dask_scheduler(scheduler, workers) as address:
-            outs = _evaluate_on_dask(scenario, checked.rows, limit_threads, address, progress)
-        return _assemble(scenario, table, outs)
-    if workers == 1 or n <= 1:
-        results = (_evaluate_one(scenario, r, limit_threads) for r in checked.rows)
-    else:
-        from joblib import Parallel, delayed
+    rows = checked.rows
+    outs: list = [None] * len(rows)
+    cluster = dask_scheduler(scheduler, workers) if scheduler and rows else nullcontext()
+    bar = progress_bar(len(rows), scenario.name, progress)
+    try:
+        with cluster as address:
+            results = iter_results(
+                scenario, rows, workers=workers, address=address, limit_threads=limit_threads
+            )
+            with closing(results):
+                for i, out in results:
+                    outs[i] = out
+                    if bar is not None:
+                        bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return results_table(scenario, table, outs)
 
-        par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
-        results = par(delayed(_evaluate_one)(scenario, r, limit_threads) for r in checked.rows)
-    if progress:
-        from tqdm import tqdm
 
-        results = tqdm(results, total=n, desc=scenario.name, unit="design", file=sys.stderr)
-    return _assemble(scenario, table, list(results))
-
-
-def _assemble(scenario: Scenario, table: pd.DataFrame, outs: list) -> pd.DataFrame:
-    """The input rows (index kept), then the performance columns and ``status``."""
+def results_table(scenario: Scenario, table: pd.DataFrame, outs: list) -> pd.DataFrame:
+    """The input rows (index kept), then the performance columns and ``status`` (text) of
+    ``outs`` (one output of :func:`iter_results` per row, in row order)."""
     perf = scenario.performance_names
     keep = [c for c in table.columns if c not in perf and c != "status"]
     replaced = [c for c in table.columns if c in perf or c == "status"]

@@ -18,7 +18,6 @@ from __future__ import annotations
 import json
 import logging
 import os
-import sys
 from contextlib import closing
 from pathlib import Path
 
@@ -26,34 +25,31 @@ import numpy as np
 import pandas as pd
 
 from holofold.design.runner import (
-    _assemble,
-    _iter_on_dask,
     check_scheduler,
     check_workers,
     dask_scheduler,
     evaluate_designs,
+    iter_results,
+    progress_bar,
+    results_table,
     validate_designs,
 )
+from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.tables import write_table
 
-__all__ = ["build_database", "load_database"]
+__all__ = ["build_database", "generate_database", "load_database"]
 
 log = logging.getLogger(__name__)
 
 
 def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
     try:
-        from importlib.metadata import version
-
         return version("holofold")
-    except Exception:  # noqa: BLE001 - not installed: running from a checkout
+    except PackageNotFoundError:  # not installed: running from a checkout
         return "unknown"
-
-
-def _write_atomic(df: pd.DataFrame, path: Path) -> None:
-    tmp = path.with_suffix(".tmp")
-    df.to_parquet(tmp, index=False)
-    os.replace(tmp, path)
 
 
 def build_database(
@@ -127,7 +123,7 @@ def build_database(
                 "(or delete it) instead of mixing two databases"
             )
     else:
-        _write_atomic(designs, dpath)
+        write_table(designs, dpath)
         info = {
             "scenario": scenario.name,
             "features": {c.name: c.unit for c in scenario.features},
@@ -143,22 +139,10 @@ def build_database(
     todo = [k for k in range(n_chunks) if not (chunks / f"part-{k:05d}.parquet").exists()]
     if len(todo) < n_chunks:
         log.info("resuming: %d of %d chunks already done", n_chunks - len(todo), n_chunks)
-    if progress is None:
-        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
     bar = None
-    if progress and todo:
-        from tqdm import tqdm
-
-        done_rows = sum(
-            min(chunk_size, len(designs) - k * chunk_size) for k in range(n_chunks)
-        ) - sum(min(chunk_size, len(designs) - k * chunk_size) for k in todo)
-        bar = tqdm(
-            total=len(designs),
-            initial=done_rows,
-            desc=scenario.name,
-            unit="design",
-            file=sys.stderr,
-        )
+    if todo:
+        left = sum(min(chunk_size, len(designs) - k * chunk_size) for k in todo)
+        bar = progress_bar(len(designs), scenario.name, progress, initial=len(designs) - left)
     try:
         if scheduler is not None and todo:
             for w in checked.warnings:
@@ -172,7 +156,7 @@ def build_database(
             for k in todo:
                 part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
                 res = evaluate_designs(scenario, part, workers=workers, progress=False)
-                _write_atomic(res, chunks / f"part-{k:05d}.parquet")
+                write_table(res, chunks / f"part-{k:05d}.parquet")
                 if bar is not None:
                     bar.update(len(part))
     finally:
@@ -212,7 +196,7 @@ def _build_on_dask(
     outs = {k: [None] * (hi - lo) for k, (lo, hi) in spans.items()}
     left = {k: hi - lo for k, (lo, hi) in spans.items()}
     pending = [rows[i] for lo, hi in spans.values() for i in range(lo, hi)]
-    with closing(_iter_on_dask(scenario, pending, True, address)) as results:
+    with closing(iter_results(scenario, pending, address=address)) as results:
         for j, out in results:
             k, pos = owner[j]
             outs[k][pos] = out
@@ -222,8 +206,43 @@ def _build_on_dask(
             if not left[k]:
                 lo, hi = spans[k]
                 # the same table as evaluate_designs(scenario, part) would give
-                res = _assemble(scenario, designs.iloc[lo:hi], outs.pop(k))
-                _write_atomic(res, chunks / f"part-{k:05d}.parquet")
+                res = results_table(scenario, designs.iloc[lo:hi], outs.pop(k))
+                write_table(res, chunks / f"part-{k:05d}.parquet")
+
+
+def generate_database(
+    scenario: Scenario | str,
+    n: int,
+    folder: str | os.PathLike,
+    *,
+    seed: int = 0,
+    method: str = "random",
+    ranges: dict | None = None,
+    chunk_size: int = 100,
+    workers: int = 1,
+    progress: bool | None = None,
+    scheduler: str | None = None,
+    csv: bool = False,
+) -> pd.DataFrame:
+    """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
+
+    ``seed``, ``method`` and ``ranges`` go to :func:`holofold.design.sampling.sample_designs`
+    and are recorded in ``meta.json``; the rest to :func:`build_database`. ``csv`` also
+    writes ``database.csv``. Returns the database.
+    """
+    if isinstance(scenario, str):
+        scenario = get_scenario(scenario)
+    if int(n) < 1:
+        raise ValueError(f"n = {n} designs must be >= 1")
+    designs = sample_designs(scenario, int(n), seed=seed, method=method, ranges=ranges)
+    recorded = {k: list(v) for k, v in (ranges or {}).items()}
+    db = build_database(
+        scenario, designs, folder, chunk_size=chunk_size, workers=workers, progress=progress,
+        meta={"seed": seed, "method": method, "ranges": recorded}, scheduler=scheduler,
+    )  # fmt: skip
+    if csv:
+        write_table(db, Path(folder) / "database.csv")
+    return db
 
 
 def load_database(folder: str | os.PathLike, *, _write: bool = False) -> pd.DataFrame:
@@ -234,5 +253,5 @@ def load_database(folder: str | os.PathLike, *, _write: bool = False) -> pd.Data
         raise FileNotFoundError(f"{folder} holds no finished chunks")
     df = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
     if _write:
-        _write_atomic(df, folder / "database.parquet")
+        write_table(df, folder / "database.parquet")
     return df

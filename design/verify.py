@@ -9,18 +9,22 @@ interval: the rule's precision on designs it has never seen.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass
+from pathlib import Path
 
 import pandas as pd
 
-from holofold.design.runner import evaluate_designs
+from holofold.design.runner import dask_scheduler, evaluate_designs
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.tables import write_table
 from holofold.design.targets import parse_target
+from holofold.geometry.outputs import write_json
 from holofold.mechanics.status import failed_mask
 
-__all__ = ["rule_ranges", "verify_rule", "Verification"]
+__all__ = ["rule_ranges", "verify_rule", "verify_rules", "write_verification", "Verification"]
 
 
 def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
@@ -76,14 +80,26 @@ class Verification:
         return (centre - half, centre + half)
 
     def summary(self) -> dict:
+        """JSON-ready counts, precision and interval (None where no design simulated)."""
         lo, hi = self.interval
+        finite = self.n_ok > 0
         return {
             "simulated": self.n_ok,
             "failed": self.n_failed,
             "meeting_target": self.n_meeting,
-            "precision": self.precision,
-            "precision_95ci": [lo, hi],
+            "precision": self.precision if finite else None,
+            "precision_95ci": [lo, hi] if finite else None,
         }
+
+    def describe(self) -> str:
+        """One line: how many fresh designs meet the target, with the interval."""
+        if not self.n_ok:
+            return f"no fresh design simulated successfully ({self.n_failed} failed)"
+        lo, hi = self.interval
+        return (
+            f"fresh designs meeting the target: {self.n_meeting}/{self.n_ok} = "
+            f"{self.precision:.3f} (95 % CI {lo:.3f}-{hi:.3f}; {self.n_failed} failed)"
+        )
 
 
 def verify_rule(
@@ -116,3 +132,57 @@ def verify_rule(
         meets.loc[~failed] = tgt.evaluate(ok)
     res["meets_target"] = meets
     return Verification(res, int((~failed).sum()), int(failed.sum()), int(meets.sum()))
+
+
+def verify_rules(
+    scenario: Scenario | str,
+    rules: Sequence[Mapping],
+    target: str,
+    n: int = 50,
+    *,
+    seed: int = 0,
+    workers: int = 1,
+    progress: bool | None = None,
+    scheduler: str | None = None,
+) -> list[Verification]:
+    """:func:`verify_rule` for each rule record (``bounds`` as in a rules file), in order.
+
+    Every rule is checked against the scenario before anything is simulated; rule ``i``
+    (1-based) samples with seed ``seed + i``. A local Dask cluster (``scheduler="local"``) is
+    started once for all rules.
+    """
+    if isinstance(scenario, str):
+        scenario = get_scenario(scenario)
+    parse_target(target, scenario.performance_names)
+    if int(n) < 1:
+        raise ValueError(f"n = {n} designs per rule must be >= 1")
+    for r in rules:
+        rule_ranges(scenario, r["bounds"])
+    cluster = dask_scheduler(scheduler, workers) if scheduler else nullcontext()
+    with cluster as address:
+        return [
+            verify_rule(
+                scenario,
+                r["bounds"],
+                target,
+                n,
+                seed=seed + i,
+                workers=1 if address else workers,
+                progress=progress,
+                scheduler=address,
+            )  # fmt: skip
+            for i, r in enumerate(rules, start=1)
+        ]
+
+
+def write_verification(folder, rules: Sequence[Mapping], results: Sequence[Verification]):
+    """``verify.json`` (one record per rule: rank, rule, bounds and the summary) and
+    ``verify_rule{i}.csv`` (the simulated designs) in ``folder``; returns the records."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    report = []
+    for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
+        report.append({"rank": i, "rule": r.get("rule"), "bounds": r["bounds"], **v.summary()})
+        write_table(v.designs, folder / f"verify_rule{i}.csv")
+    write_json(folder / "verify.json", report)
+    return report

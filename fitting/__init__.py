@@ -1,12 +1,15 @@
-"""Fitting layer of holofold: planar target curves and Miura-like strips fitted to them.
+"""holofold.fitting: planar target curves and the Miura-like strips fitted to them.
 
-Modules: :mod:`fitting.curves` (curve types, parsing, lengths, distances),
-:mod:`fitting.strip` (the analytic strip of specs/scenarios.md 5.3-5.4),
-:mod:`fitting.error` (published index-matched error and closest-point error) and
-:mod:`fitting.auto` (choosing m and offset for a tolerance).
+:mod:`~holofold.fitting.curves` (curves from functions, points and drawings),
+:mod:`~holofold.fitting.strip` (the analytic strip and its named nodes),
+:mod:`~holofold.fitting.strip_fit` (the fit with its errors and flat layout),
+:mod:`~holofold.fitting.error` (index-matched and closest-point errors),
+:mod:`~holofold.fitting.auto` (choosing m and offset for a tolerance) and
+:mod:`~holofold.fitting.strip_files` (a fitted strip's fabrication files). See
+docs/strip-fit.md. Imports only from holofold.geometry.
 """
 
-from holofold.fitting.auto import AutoFit, FitNotFoundError, fit_auto
+from holofold.fitting.auto import DEFAULT_M_RANGE, AutoFit, FitNotFoundError, fit_auto
 from holofold.fitting.curves import (
     BUILTIN_CURVES,
     CurveError,
@@ -24,6 +27,7 @@ from holofold.fitting.error import (
     paper_error,
 )
 from holofold.fitting.strip import SAMPLINGS, StripGeometry, strip_geometry
+from holofold.fitting.strip_files import export_strip_files
 from holofold.fitting.strip_fit import StripFit, fit_strip
 
 __all__ = [
@@ -47,4 +51,6 @@ __all__ = [
     "AutoFit",
     "FitNotFoundError",
     "fit_auto",
+    "DEFAULT_M_RANGE",
+    "export_strip_files",
 ]

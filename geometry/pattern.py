@@ -123,12 +123,6 @@ def reference_edges(faces) -> tuple[np.ndarray, np.ndarray]:
     return p[first[order]], counts[order]
 
 
-def _face_edge_pairs(faces: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Directed boundary edges (u -> v, in loop order) of all faces and their face ids."""
-    t = _FaceTable(faces)
-    return t.pairs(), t.owner
-
-
 def newell_normals(coords: np.ndarray, faces) -> np.ndarray:
     """Area-weighted face normals (Newell's method), (nf, 3); length = polygon area."""
     faces = _as_faces(faces)

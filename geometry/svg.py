@@ -23,7 +23,7 @@ import numpy as np
 from holofold.geometry.errors import FormatError
 from holofold.geometry.pattern import CreasePattern
 
-__all__ = ["COLOURS", "export_svg", "load_svg", "SvgLines"]
+__all__ = ["COLOURS", "export_svg", "polylines_svg", "load_svg", "SvgLines"]
 
 COLOURS = {
     "M": "#ff0000",
@@ -85,6 +85,30 @@ def export_svg(
         f"<title>holofold crease pattern ({pattern.meta.get('kind', 'pattern')})</title>\n"
         + "\n".join(body)
         + "\n</svg>\n"
+    )
+
+
+def polylines_svg(
+    lines, colours, title: str, *, margin_mm: float = 5.0, stroke_mm: float = 0.5
+) -> str:
+    """SVG text (mm, y up as drawn) of 2-D polylines given in metres.
+
+    ``lines``: sequence of (k, 2) arrays (x, y), m; ``colours``: one stroke colour per line.
+    Used for drawings that are not crease patterns (e.g. a strip's plan view).
+    """
+    pts = [np.asarray(L, float) * np.array([1000.0, -1000.0]) for L in lines]
+    allp = np.vstack(pts)
+    lo, hi = allp.min(axis=0) - margin_mm, allp.max(axis=0) + margin_mm
+    w, h = hi - lo
+    body = [
+        f'<polyline fill="none" stroke="{c}" stroke-width="{stroke_mm}" points="'
+        + " ".join(f"{x - lo[0]:.6f},{y - lo[1]:.6f}" for x, y in P)
+        + '"/>'
+        for P, c in zip(pts, colours, strict=True)
+    ]
+    return (
+        f'<svg xmlns="{_SVG_NS}" width="{w:.6f}mm" height="{h:.6f}mm" '
+        f'viewBox="0 0 {w:.6f} {h:.6f}">\n<title>{title}</title>\n' + "\n".join(body) + "\n</svg>\n"
     )
 
 

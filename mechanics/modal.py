@@ -117,18 +117,9 @@ def eigenvalues(K, mass_dof: np.ndarray, free_dofs: np.ndarray | None = None) ->
     if nm == 0:
         return np.zeros(0)
     s = np.sqrt(m)
-    try:
-        try:
-            X = sla.cho_solve(sla.cho_factor(K, check_finite=False), np.diag(s))
-        except sla.LinAlgError:
-            X = sla.solve(K, np.diag(s), assume_a="sym")
-        B = s[:, None] * X
-        mu = sla.eigvalsh(0.5 * (B + B.T))
-        mu = mu[np.argsort(-np.abs(mu))][:nm]
-        if np.isfinite(mu).all() and (np.abs(mu) > 0).all():
-            return np.sort(1.0 / mu)
-    except (sla.LinAlgError, ValueError):
-        pass
+    mu = _inverse_form(K, s, nm)
+    if mu is not None:
+        return np.sort(1.0 / mu)
     if not has.all():  # direct form: condense massless DOFs out
         i, o = np.flatnonzero(has), np.flatnonzero(~has)
         Koi = K[np.ix_(o, i)]
@@ -136,6 +127,24 @@ def eigenvalues(K, mass_dof: np.ndarray, free_dofs: np.ndarray | None = None) ->
         s = s[i]
     A = K / s[:, None] / s[None, :]
     return sla.eigvalsh(0.5 * (A + A.T))
+
+
+def _inverse_form(K: np.ndarray, s: np.ndarray, nm: int) -> np.ndarray | None:
+    """The ``nm`` largest-magnitude eigenvalues mu of ``B = S K^-1 S`` (S = diag(s)), or None
+    when K is singular (a mechanism) or the result is not finite and nonzero."""
+    try:
+        X = sla.cho_solve(sla.cho_factor(K, check_finite=False), np.diag(s))
+    except sla.LinAlgError:  # not positive definite: a symmetric indefinite solve
+        try:
+            X = sla.solve(K, np.diag(s), assume_a="sym")
+        except sla.LinAlgError:  # singular
+            return None
+    if not np.isfinite(X).all():
+        return None
+    B = s[:, None] * X
+    mu = sla.eigvalsh(0.5 * (B + B.T))
+    mu = mu[np.argsort(-np.abs(mu))][:nm]
+    return mu if (np.isfinite(mu).all() and (np.abs(mu) > 0).all()) else None
 
 
 def natural_frequencies(

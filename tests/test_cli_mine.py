@@ -7,12 +7,10 @@ import pandas as pd
 import pytest
 
 from holofold.cli import main
-from holofold.design.evaluation import holdout
-from holofold.design.rules import ForestRuleMiner
-from holofold.design.targets import parse_target
+from holofold.design import read_rules
 
 
-def test_mine_published_txt_matches_holdout(reference_data, tmp_path, capsys):
+def test_mine_prints_the_summary_and_writes_strict_json(reference_data, tmp_path, capsys):
     db = reference_data.path("data0_SingleMiura")
     out = tmp_path / "rules.json"
     rc = main(
@@ -23,24 +21,10 @@ def test_mine_published_txt_matches_holdout(reference_data, tmp_path, capsys):
     assert "met by 70 rows, 7.0 %" in text
     assert "600 train / 400 test rows (seed 2)" in text
     assert text.count("    train: precision") == 3 and text.count("    test:  precision") == 3
-    recs = json.loads(out.read_text())
-    assert len(recs) == 3 and [r["rank"] for r in recs] == [1, 2, 3]
-    # the CLI figures are the library's hold-out with the same seed (split and forest)
-    df = reference_data.load("data0_SingleMiura")
-    res = holdout(
-        ForestRuleMiner(),
-        df[["tcrease", "tpanel", "W", "gama"]],
-        parse_target("axialstiff60 < 6000").evaluate(df),
-        random_state=2,
-    )
-    for rec, (_, row) in zip(recs, res.rules.iterrows(), strict=True):
-        assert rec["rule"] == row["rule"]
-        assert rec["test"]["precision"] == pytest.approx(row["test_precision"])
-        assert rec["test"]["support"] == row["test_support"]
-        assert rec["train"]["support"] == row["support"]
-        if "tcrease" in rec["bounds"]:
-            assert rec["bounds"]["tcrease"]["le"] == pytest.approx(row["tcrease_le"])
+    recs = read_rules(out)
+    assert [r["rank"] for r in recs] == [1, 2, 3]
     assert "axialstiff60" not in json.dumps([r["bounds"] for r in recs])
+    assert "NaN" not in out.read_text() and "Infinity" not in out.read_text()
 
 
 def _synthetic_csv(tmp_path):
@@ -98,7 +82,10 @@ def test_mine_csv_with_features_categorical_and_plot(tmp_path, capsys):
         (["--target", "k > 1300", "--features", "m,t", "--categorical", "w"], "'w' is not among"),
         (["--target", "k > 1e9", "--features", "m,t"], "met by 0 of 600 rows"),
         (["--target", "k > 1300"], "list them with --features"),
-        (["--target", "k > 1300", "--features", "t", "--rules", "0"], "--rules must be >= 1"),
+        (
+            ["--target", "k > 1300", "--features", "t", "--rules", "0"],
+            "--rules must be an int in the range [1, inf)",
+        ),
         (["--target", "k > 1300", "--features", "t", "--plot", "X.gif"], "expected one of"),
     ],
 )

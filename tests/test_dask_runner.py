@@ -167,8 +167,8 @@ def _chunk_files(folder):
 
 
 def _record_writes(monkeypatch, fail_at=None):
-    """Record the chunk files ``store._write_atomic`` writes; Ctrl-C instead of write fail_at."""
-    written, real = [], store._write_atomic
+    """Record the chunk files ``store.write_table`` writes; Ctrl-C instead of write fail_at."""
+    written, real = [], store.write_table
 
     def recording(df, path):
         if path.parent.name == "chunks":
@@ -177,7 +177,7 @@ def _record_writes(monkeypatch, fail_at=None):
             written.append(path.name)
         real(df, path)
 
-    monkeypatch.setattr(store, "_write_atomic", recording)
+    monkeypatch.setattr(store, "write_table", recording)
     return written
 
 

@@ -112,3 +112,16 @@ def test_published_freq_final(reference_data, stem):
     pat, s = build_model(P, *feats)
     w = natural_frequency(P, pat, s)
     assert w == pytest.approx(row["freqFinal"], rel=1e-6)
+
+
+def test_singular_stiffness_falls_back_to_the_direct_form():
+    """A free spring-mass chain is a mechanism (K singular): the inverse form cannot be used,
+    the direct form gives the rigid-body mode lambda = 0 and the analytic 2 k (1/m1 + 1/m2)/2."""
+    k, m1, m2 = 3.0, 2.0, 0.5
+    K = np.array([[k, -k], [-k, k]])
+    lam = eigenvalues(K, np.array([m1, m2]))
+    np.testing.assert_allclose(lam, [0.0, k * (1 / m1 + 1 / m2)], atol=1e-12)
+    # a massless middle node is condensed out: two springs k in series (k/2), masses 1 and 1
+    K3 = np.array([[2 * k, -k, -k], [-k, k, 0.0], [-k, 0.0, k]])
+    lam3 = eigenvalues(K3, np.array([0.0, 1.0, 1.0]))
+    np.testing.assert_allclose(lam3, [0.0, k], atol=1e-12)

@@ -9,7 +9,6 @@ import pandas as pd
 import pytest
 from sklearn.model_selection import train_test_split
 
-from holofold.design.database import PUBLISHED, column_roles, read_table
 from holofold.design.evaluation import (
     baselines,
     grid_search,
@@ -23,10 +22,11 @@ from holofold.design.report import (
     plot_feature_importance,
     plot_rule_boxes,
     plot_rule_scatter,
-    rules_to_json,
     rules_to_text,
 )
+from holofold.design.rulefile import rules_to_json
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.tables import PUBLISHED, column_roles, read_table
 from holofold.design.targets import parse_target
 
 D0_FEATURES = ["tcrease", "tpanel", "W", "gama"]

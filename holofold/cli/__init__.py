@@ -7,10 +7,14 @@ Each sub-command lives in its own module of this package and exposes two names:
 ``run(args) -> int``
     does the work and returns the exit status.
 
-Modules are discovered automatically, so adding a sub-command means adding one module.
+Modules are discovered automatically, so adding a sub-command means adding one module. A
+sub-command parses its arguments and calls the library through the layers' public faces
+(``holofold.geometry``, ``holofold.fitting``, ``holofold.mechanics``, ``holofold.design``);
+an import-linter contract in pyproject.toml keeps it so.
+
 User errors (``ValueError``, ``OSError``) become one line on stderr and exit status 2;
-nothing is written in that case, which each sub-command guarantees by validating its
-inputs before it creates any output file.
+nothing is written in that case (the library checks its inputs before it creates any output
+file, and writes every file atomically). Warnings become one line each on stderr.
 """
 
 from __future__ import annotations
@@ -20,11 +24,12 @@ import importlib
 import logging
 import pkgutil
 import sys
+import warnings
 
 __all__ = ["main", "build_parser"]
 
 # preferred order in --help; modules not listed here follow alphabetically
-_ORDER = ["demo", "pattern", "fit", "evaluate", "generate", "mine", "verify", "design"]
+_ORDER = ["demo", "pattern", "fit", "evaluate", "generate", "mine", "verify"]
 
 
 def _command_modules():
@@ -54,8 +59,14 @@ def main(argv: list[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+
+    def one_line(message, category, *_args, **_kw):
+        print(f"holofold {args.command}: warning: {message}", file=sys.stderr)
+
     try:
-        return int(args._run(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = one_line
+            return int(args._run(args) or 0)
     except (ValueError, OSError) as exc:
         print(f"holofold {args.command}: error: {exc}", file=sys.stderr)
         return 2

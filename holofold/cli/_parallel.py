@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.design.runner import check_scheduler, check_workers
+from holofold.design import check_scheduler, check_workers
 
 
 def add_parallel_arguments(p: argparse.ArgumentParser) -> None:

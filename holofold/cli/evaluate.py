@@ -9,23 +9,23 @@ columns and ``status`` (CSV or Parquet, by the output's extension).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
 from pathlib import Path
 
-import pandas as pd
-
 from holofold.cli._parallel import add_parallel_arguments, parallel_settings
-from holofold.design.runner import evaluate_designs, validate_designs
-from holofold.design.scenarios import SCENARIO_NAMES, get_scenario
-from holofold.mechanics.status import converged_mask, failed_mask
+from holofold.design import (
+    SCENARIO_NAMES,
+    check_table_path,
+    converged_mask,
+    evaluate_designs,
+    failed_mask,
+    get_scenario,
+    read_table,
+    validate_designs,
+    write_table,
+)
 
-__all__ = ["register", "run", "read_designs", "write_results"]
-
-_CSV = (".csv",)
-_PARQUET = (".parquet", ".pq")
-_TXT = (".txt",)
+__all__ = ["register", "run"]
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -73,50 +73,11 @@ def _epilog() -> str:
     return "\n".join(lines)
 
 
-def read_designs(path: Path) -> pd.DataFrame:
-    """Read a design table (.csv, .parquet/.pq, or a published headerless .txt)."""
-    from holofold.design.database import read_table
-
-    path = Path(path)
-    if path.suffix.lower() not in _CSV + _PARQUET + _TXT:
-        raise ValueError(
-            f"design table {path}: unknown extension {path.suffix!r}; allowed: .csv, .parquet, "
-            ".pq, .txt"
-        )
-    return read_table(path)
-
-
-def _check_output(path: Path) -> None:
-    if path.suffix.lower() not in _CSV + _PARQUET:
-        raise ValueError(
-            f"output {path}: unknown extension {path.suffix!r}; allowed: .csv, .parquet, .pq"
-        )
-    parent = path.resolve().parent
-    if not parent.is_dir():
-        raise OSError(f"output folder {parent} does not exist")
-
-
-def write_results(df: pd.DataFrame, path: Path) -> None:
-    """Write atomically (temporary file, then rename) as CSV or Parquet."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=".holofold-", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        if path.suffix.lower() in _CSV:
-            df.to_csv(tmp, index=False, float_format="%.12g")
-        else:
-            df.to_parquet(tmp, index=False)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def run(args) -> int:
     scenario = get_scenario(args.scenario)
-    _check_output(args.output)
+    check_table_path(args.output)
     workers, scheduler = parallel_settings(args)
-    table = read_designs(args.designs)
+    table = read_table(args.designs)
     if len(table) == 0:
         raise ValueError(f"{args.designs} has no rows")
     checked = validate_designs(scenario, table)  # raises before anything is simulated
@@ -130,7 +91,7 @@ def run(args) -> int:
         log_warnings=False,  # printed above
         scheduler=scheduler,
     )
-    write_results(res, args.output)
+    write_table(res, args.output)
     ok = int(converged_mask(res["status"]).sum())
     failed = int(failed_mask(res["status"]).sum())
     print(

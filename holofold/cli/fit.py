@@ -22,22 +22,11 @@ file is created.
 from __future__ import annotations
 
 import argparse
-import json
-import logging
 import math
 from pathlib import Path
 
-import numpy as np
-
-from holofold.fitting.auto import DEFAULT_M_RANGE, fit_auto
-from holofold.fitting.curves import load_curve
-from holofold.fitting.strip import SAMPLINGS
-from holofold.fitting.strip_fit import StripFit, fit_strip
-from holofold.geometry.errors import ParameterError, check_range
-from holofold.geometry.export import export
-from holofold.geometry.solid import thick_solid
-
-log = logging.getLogger(__name__)
+from holofold.fitting import DEFAULT_M_RANGE, SAMPLINGS
+from holofold.geometry import ParameterError, check_range
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -144,28 +133,11 @@ def _validate(args) -> dict:
     return opts
 
 
-# ---------------------------------------------------------------------- writers
-def _plan_view_svg(fit: StripFit) -> str:
-    """SVG (mm) of the centre line (black) and side line (grey) in the x-z plane."""
-    P = fit.centre_line * np.array([1000.0, -1000.0])
-    S = fit.side_line * np.array([1000.0, -1000.0])
-    pts = np.vstack([P, S])
-    lo, hi = pts.min(axis=0) - 5.0, pts.max(axis=0) + 5.0
-    w, h = hi - lo
-    lines = [
-        f'<polyline fill="none" stroke="{c}" stroke-width="0.5" points="'
-        + " ".join(f"{x - lo[0]:.6f},{y - lo[1]:.6f}" for x, y in L)
-        + '"/>'
-        for L, c in ((P, "#000000"), (S, "#7f7f7f"))
-    ]
-    return (
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w:.6f}mm" height="{h:.6f}mm" '
-        f'viewBox="0 0 {w:.6f} {h:.6f}">\n<title>plan view (x-z) of the strip: centre line '
-        "and side line (no flat layout)</title>\n" + "\n".join(lines) + "\n</svg>\n"
-    )
-
-
 def run(args) -> int:
+    import json
+
+    from holofold.fitting import export_strip_files, fit_auto, fit_strip, load_curve
+
     opts = _validate(args)
     curve = load_curve(args.curve)
     if args.curve_scale != 1.0:
@@ -184,42 +156,17 @@ def run(args) -> int:
         fit, table = res.strip, res.candidates
     else:
         fit = fit_strip(
-            curve,
-            opts["m"],
-            opts["offset"],
-            opts["strip_width"],
-            opts["extrude"],
+            curve, opts["m"], opts["offset"], opts["strip_width"], opts["extrude"],
             sampling=args.sampling,
-        )
-    flat = fit.flat_pattern  # layout + 3-D state, side B loops counter-clockwise
-    solid = None
-    if opts.get("solid"):  # built before any file is written: it can reject the widths
-        solid = thick_solid(fit.pattern, args.panel_thickness, args.crease_width)
-    # everything is valid: create the output
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    fold_kw = {}
-    if solid is not None:
-        fold_kw = {"panel_thickness": args.panel_thickness, "crease_width": args.crease_width}
-    written = [export(flat if flat is not None else fit.pattern, out / "strip.fold", **fold_kw)]
-    if flat is not None:
-        written.append(export(flat, out / "strip.svg"))
-    else:
-        (out / "strip.svg").write_text(_plan_view_svg(fit))
-        written.append(out / "strip.svg")
-    written.append(export(fit.pattern, out / "strip.stl"))
-    written.append(export(fit.pattern, out / "strip.obj"))
-    if solid is not None:
-        written.append(export(solid, out / "strip_solid.stl"))
-    if table is not None:
-        p_csv = out / "candidates.csv"
-        table.to_csv(p_csv, index=False)
-        written.append(p_csv)
-    summary = {
-        **fit.parameters,
-        **fit.errors,
-        "files": [str(w) for w in written],
-    }
+        )  # fmt: skip
+    written = export_strip_files(
+        fit,
+        args.output,
+        panel_thickness=args.panel_thickness,
+        crease_width=args.crease_width,
+        candidates=table,
+    )
+    summary = {**fit.parameters, **fit.errors, "files": [str(w) for w in written]}
     print(f"fitted m={fit.m} strip ({fit.pattern.n_vertices} nodes) to {fit.curve.name}")
     print(json.dumps(summary))
     return 0

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from holofold.cli._parallel import add_parallel_arguments, parallel_settings
-from holofold.design.scenarios import SCENARIO_NAMES
+from holofold.design import SCENARIO_NAMES
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -56,32 +56,15 @@ def _parse_ranges(items):
 def run(args) -> int:
     from pathlib import Path
 
-    from holofold.design.sampling import sample_designs
-    from holofold.design.scenarios import get_scenario
-    from holofold.design.store import build_database
-    from holofold.mechanics.status import failed_mask
+    from holofold.design import failed_mask, generate_database
 
-    scenario = get_scenario(args.scenario)
-    if args.samples < 1:
-        raise ValueError(f"--samples = {args.samples} must be >= 1")
     workers, scheduler = parallel_settings(args)
-    designs = sample_designs(
-        scenario, args.samples, seed=args.seed, method=args.method, ranges=_parse_ranges(args.range)
-    )
-    db = build_database(
-        scenario,
-        designs,
-        args.output,
-        chunk_size=args.chunk_size,
-        workers=workers,
-        meta={"seed": args.seed, "method": args.method, "ranges": args.range},
-        scheduler=scheduler,
-    )
-    if args.csv:
-        db.to_csv(Path(args.output) / "database.csv", index=False)
+    db = generate_database(
+        args.scenario, args.samples, args.output,
+        seed=args.seed, method=args.method, ranges=_parse_ranges(args.range),
+        chunk_size=args.chunk_size, workers=workers, scheduler=scheduler, csv=args.csv,
+    )  # fmt: skip
     failed = int(failed_mask(db["status"]).sum())
-    print(
-        f"{scenario.name}: {len(db)} designs in {Path(args.output) / 'database.parquet'} "
-        f"({failed} failed)"
-    )
+    where = Path(args.output) / "database.parquet"
+    print(f"{args.scenario}: {len(db)} designs in {where} ({failed} failed)")
     return 0

@@ -3,23 +3,27 @@
 from __future__ import annotations
 
 import argparse
-import json
-import logging
+import re
 import warnings
-from pathlib import Path
 
 __all__ = ["register", "run"]
 
-logger = logging.getLogger(__name__)
-
 _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+#: ForestRuleMiner parameter -> the option that sets it (for error messages)
+_FLAGS = {
+    "n_rules": "--rules",
+    "n_estimators": "--trees",
+    "max_depth": "--depth",
+    "precision_min": "--precision-min",
+    "min_support": "--min-support",
+    "beta": "--beta",
+    "max_overlap": "--max-overlap",
+    "n_jobs": "--jobs",
+}
 
 
 def _names(text: str | None) -> list[str] | None:
-    if text is None:
-        return None
-    items = [t for t in text.replace(",", " ").split() if t]
-    return items
+    return None if text is None else [t for t in text.replace(",", " ").split() if t]
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -90,128 +94,63 @@ def register(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def _check_output(path: str | None, what: str, suffixes=None) -> Path | None:
-    if path is None:
-        return None
-    p = Path(path)
-    if not p.parent.is_dir():
-        raise ValueError(f"{what} directory {p.parent} does not exist")
-    if suffixes and p.suffix.lower() not in suffixes:
-        raise ValueError(f"{what} {p.name}: unknown type, expected one of {', '.join(suffixes)}")
-    return p
+def _in_option_terms(exc: ValueError) -> ValueError:
+    """scikit-learn's parameter message, naming the command's option instead."""
+    m = re.match(r"The '(\w+)' parameter of \w+ (must be .*?)\. Got (.*) instead\.", str(exc))
+    if not m or m.group(1) not in _FLAGS:
+        return exc
+    return ValueError(f"{_FLAGS[m.group(1)]} {m.group(2)}, got {m.group(3)}")
 
 
 def run(args) -> int:
-    from holofold.design.database import column_roles, read_table
-    from holofold.design.evaluation import rule_scores, split_indices
-    from holofold.design.report import plot_rules, rules_to_records, rules_to_text
-    from holofold.design.rules import FewRulesWarning, ForestRuleMiner
-    from holofold.design.targets import parse_target
-    from holofold.mechanics.status import failed_mask
+    from holofold.design import (
+        FewRulesWarning,
+        check_output_path,
+        column_roles,
+        mine_rules,
+        mining_summary,
+        plot_rules,
+        read_table,
+        rules_to_records,
+        save_figure,
+        write_rules,
+    )
 
-    # ---- validate everything before any output --------------------------------------------
-    if args.rules < 1:
-        raise ValueError(f"--rules must be >= 1, got {args.rules}")
-    if not 0 < args.test_size < 1:
-        raise ValueError(f"--test-size must be in (0, 1), got {args.test_size}")
-    if args.trees < 1:
-        raise ValueError(f"--trees must be >= 1, got {args.trees}")
-    if args.depth < 1:
-        raise ValueError(f"--depth must be >= 1, got {args.depth}")
-    if not 0 <= args.precision_min <= 1:
-        raise ValueError(f"--precision-min must be in [0, 1], got {args.precision_min}")
-    if args.min_support < 1:
-        raise ValueError(f"--min-support must be >= 1, got {args.min_support}")
-    if args.beta <= 0:
-        raise ValueError(f"--beta must be > 0, got {args.beta}")
-    if args.max_overlap is not None and not 0 < args.max_overlap <= 1:
-        raise ValueError(f"--max-overlap must be in (0, 1], got {args.max_overlap}")
-    json_path = _check_output(args.json, "--json")
-    plot_path = _check_output(args.plot, "--plot", _PLOT_SUFFIXES)
-
+    json_path = args.json and check_output_path(args.json, "--json")
+    plot_path = args.plot and check_output_path(args.plot, "--plot", _PLOT_SUFFIXES)
     table = read_table(args.database, columns=_names(args.columns))
-    if "status" in table.columns:  # a holofold database: failed simulations have no outputs
-        failed = failed_mask(table["status"])
-        if failed.any():
-            print(f"note: {int(failed.sum())} failed simulation(s) left out")
-            table = table.loc[~failed].reset_index(drop=True)
-    columns = [str(c) for c in table.columns]
-    target = parse_target(args.target, columns=columns)
-    roles = column_roles(columns, args.database)
-    features = _names(args.features)
-    if features is None:
-        if roles is None:
-            raise ValueError(
-                "cannot tell design features from performance columns in "
-                f"{Path(args.database).name} ({', '.join(columns)}); list them with --features"
-            )
-        features = list(roles.features)
-    for f in features:
-        if f not in columns:
-            raise ValueError(f"feature {f!r} is not a column; columns: {', '.join(columns)}")
-    if len(set(features)) != len(features):
-        raise ValueError(f"--features lists a column twice: {', '.join(features)}")
-    performance = set(roles.performance) if roles is not None else set()
-    bad = [f for f in features if f in performance or f in target.columns]
-    if bad:
-        raise ValueError(
-            f"{bad[0]!r} is a performance column (or used by the target) and cannot be a feature"
-        )
-    cats = _names(args.categorical)
-    if cats is None:
-        cats = [c for c in (roles.categorical if roles else ()) if c in features]
-    for c in cats:
-        if c not in features:
-            raise ValueError(
-                f"categorical feature {c!r} is not among the features: {', '.join(features)}"
-            )
-
-    y = target.evaluate(table)
-    n_hit = int(y.sum())
-    if n_hit == 0 or n_hit == y.size:
-        raise ValueError(
-            f"the target {args.target!r} is met by {n_hit} of {y.size} rows; rules need both "
-            "designs that meet it and designs that do not"
-        )
-    X = table[features]
-    train, test = split_indices(len(table), test_size=args.test_size, random_state=args.seed)
-    if y[train].all() or not y[train].any():
-        raise ValueError("the training split holds only one class; change --seed or --test-size")
-
-    miner = ForestRuleMiner(
-        n_estimators=args.trees,
-        max_depth=args.depth,
-        precision_min=args.precision_min,
-        min_support=args.min_support,
-        beta=args.beta,
-        n_rules=args.rules,
-        max_overlap=args.max_overlap,
-        scoring=args.scoring,
-        ranking=args.ranking,
-        categorical_features=cats or None,
-        random_state=args.seed,
-        n_jobs=args.jobs,
-    )
-    with warnings.catch_warnings():
+    with warnings.catch_warnings():  # the summary says when fewer rules survive
         warnings.simplefilter("ignore", FewRulesWarning)
-        miner.fit(X.iloc[train], y[train])
-    scores = rule_scores(miner, X.iloc[test], y[test])
-
-    print(f"database: {args.database} ({len(table)} rows)")
-    print(f"target:   {target} (met by {n_hit} rows, {100 * n_hit / y.size:.1f} %)")
-    cat_note = f" (categorical: {', '.join(cats)})" if cats else ""
-    print(f"features: {', '.join(features)}{cat_note}")
-    print(
-        f"split:    {len(train)} train / {len(test)} test rows (seed {args.seed}); "
-        f"{miner.n_candidates_} candidate boxes, {len(miner.candidate_rules_)} pass the filters"
-    )
-    print(rules_to_text(miner, scores))
-
-    if json_path is not None:
-        json_path.write_text(json.dumps(rules_to_records(miner, scores), indent=2) + "\n")
+        try:
+            mined = mine_rules(
+                table,
+                args.target,
+                roles=column_roles(table.columns, args.database),
+                features=_names(args.features),
+                categorical=_names(args.categorical),
+                test_size=args.test_size,
+                seed=args.seed,
+                source=args.database,
+                n_estimators=args.trees,
+                max_depth=args.depth,
+                precision_min=args.precision_min,
+                min_support=args.min_support,
+                beta=args.beta,
+                n_rules=args.rules,
+                max_overlap=args.max_overlap,
+                scoring=args.scoring,
+                ranking=args.ranking,
+                n_jobs=args.jobs,
+            )
+        except ValueError as exc:
+            raise _in_option_terms(exc) from None
+    print(mining_summary(mined, args.database))
+    # the figure is drawn before any file is written: a failing plot leaves no JSON behind
+    fig = plot_path and plot_rules(mined.miner, mined.table[list(mined.features)])
+    if json_path:
+        write_rules(json_path, rules_to_records(mined.miner, mined.test_scores))
         print(f"wrote {json_path}")
-    if plot_path is not None:
-        fig = plot_rules(miner, X)
-        fig.savefig(plot_path, dpi=120)
+    if plot_path:
+        save_figure(fig, plot_path)
         print(f"wrote {plot_path}")
     return 0

@@ -42,9 +42,8 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 def _build(args):
-    from holofold.geometry.errors import ParameterError, check_range
-    from holofold.geometry.miura import miura_sheet
-    from holofold.geometry.tmp import tmp_sheet
+    """The pattern the arguments describe (checked in the options' own terms and units)."""
+    from holofold.geometry import ParameterError, check_range, miura_sheet, tmp_sheet
 
     check_range("--ext", args.ext, 0.0, 1.0, low_open=True)
     if args.kind == "miura":
@@ -53,8 +52,6 @@ def _build(args):
         check_range("--gamma", args.gamma, 0.0, 90.0, low_open=True, high_open=True)
         if args.size is None and (args.a is None or args.b is None):
             raise ParameterError("give --size, or both --a and --b, for a Miura sheet")
-        if args.size is not None and (args.a is not None or args.b is not None):
-            raise ParameterError("give either --size or --a/--b, not both")
         for name in ("a", "b", "size"):
             v = getattr(args, name)
             if v is not None:
@@ -65,52 +62,28 @@ def _build(args):
         )  # fmt: skip
     if args.size is None:
         raise ParameterError("--size (sheet size L, m) is required for a TMP sheet")
-    if args.m % 2:
-        raise ParameterError(f"--m = {args.m} must be even for a TMP sheet")
-    if args.n % 3:
-        raise ParameterError(f"--n = {args.n} must be a multiple of 3 for a TMP sheet")
     check_range("--size", args.size, 0.0, None, low_open=True)
     return tmp_sheet(args.m, args.n, args.size, args.ext)
 
 
 def run(args) -> int:
-    import sys
-    import warnings
-    from pathlib import Path
-
     import numpy as np
 
-    from holofold.geometry.errors import check_range
-    from holofold.geometry.export import export
-    from holofold.geometry.solid import SolidWarning, shrunk_panels, thick_solid
+    from holofold.geometry import check_range, export_pattern_files
 
     pattern = _build(args)
-    W = check_range("--crease-width", args.crease_width, 0.0, None)
-    solid = None
+    check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:
-        t = check_range("--thickness", args.thickness, 0.0, None, low_open=True)
-        shrunk_panels(pattern, W)  # a crease wider than a panel fails here, before any output
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", SolidWarning)
-            solid = thick_solid(pattern, t, W)
-        for w in caught:
-            print(f"holofold pattern: warning: {w.message}", file=sys.stderr)
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    written = [
-        export(pattern, out / "pattern.fold", crease_width=np.where(pattern.interior, W, 0.0)),
-        export(pattern, out / "pattern.svg"),
-        export(pattern, out / "folded.stl"),
-        export(pattern, out / "folded.obj"),
-    ]
-    if solid is not None:
-        written.append(export(solid, out / "thick.stl"))
+        check_range("--thickness", args.thickness, 0.0, None, low_open=True)
+    written = export_pattern_files(
+        pattern, args.output, thickness=args.thickness, crease_width=args.crease_width
+    )
     ext = np.ptp(pattern.coords, axis=0)
     print(
         f"{args.kind} {args.m}x{args.n} at ext {args.ext:g}: {pattern.n_vertices} vertices, "
         f"{int(pattern.interior.sum())} creases, {pattern.n_faces} panels, extent "
         f"{ext[0]:.4g} x {ext[1]:.4g} x {ext[2]:.4g} m; wrote "
         + ", ".join(p.name for p in written)
-        + f" to {out}"
+        + f" to {args.output}"
     )
     return 0

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from holofold.cli._parallel import add_parallel_arguments, parallel_settings
-from holofold.design.scenarios import SCENARIO_NAMES
+from holofold.design import SCENARIO_NAMES
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -31,55 +32,23 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 def run(args) -> int:
     import json
-    from contextlib import nullcontext
-    from pathlib import Path
 
-    from holofold.design.runner import dask_scheduler
-    from holofold.design.scenarios import get_scenario
-    from holofold.design.targets import parse_target
-    from holofold.design.verify import rule_ranges, verify_rule
+    from holofold.design import read_rules, verify_rules, write_verification
 
-    scenario = get_scenario(args.scenario)
-    parse_target(args.target, scenario.performance_names)
-    if args.samples < 1:
-        raise ValueError(f"--samples = {args.samples} must be >= 1")
     workers, scheduler = parallel_settings(args)
-    try:
-        rules = json.loads(Path(args.rules).read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{args.rules} is not valid JSON: {exc}") from None
-    if not isinstance(rules, list) or not all(isinstance(r, dict) and "bounds" in r for r in rules):
-        raise ValueError(f"{args.rules} is not a rules file of `holofold mine --json`")
-    rules = rules[: args.top] if args.top else rules
-    for r in rules:
-        rule_ranges(scenario, r["bounds"])  # all rules checked before simulating
-    out = Path(args.output) if args.output else None
-    report = []
-    # a local Dask cluster is started once for all rules
-    cluster = dask_scheduler(scheduler, workers) if scheduler else nullcontext()
-    with cluster as address:
-        for i, r in enumerate(rules, start=1):
-            v = verify_rule(
-                scenario,
-                r["bounds"],
-                args.target,
-                args.samples,
-                seed=args.seed + i,
-                workers=1 if address else workers,
-                scheduler=address,
-            )
-            s = v.summary()
-            lo, hi = s["precision_95ci"]
-            print(
-                f"rule {i}: {r.get('rule', '')}\n  fresh designs meeting the target: "
-                f"{s['meeting_target']}/{s['simulated']} = {s['precision']:.3f} "
-                f"(95 % CI {lo:.3f}-{hi:.3f}; {s['failed']} failed)"
-            )
-            report.append({"rank": i, "rule": r.get("rule"), "bounds": r["bounds"], **s})
-            if out is not None:
-                out.mkdir(parents=True, exist_ok=True)
-                v.designs.to_csv(out / f"verify_rule{i}.csv", index=False)
-    if out is not None:
-        (out / "verify.json").write_text(json.dumps(report, indent=2))
-    print(json.dumps([{k: d[k] for k in ("rank", "precision", "simulated")} for d in report]))
+    if args.top is not None and args.top < 1:
+        raise ValueError(f"--top = {args.top} must be >= 1")
+    if args.output is not None and Path(args.output).exists() and not Path(args.output).is_dir():
+        raise ValueError(f"--output {args.output!r} exists and is not a folder")
+    rules = read_rules(args.rules)[: args.top]
+    results = verify_rules(
+        args.scenario, rules, args.target, args.samples,
+        seed=args.seed, workers=workers, scheduler=scheduler,
+    )  # fmt: skip
+    for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
+        print(f"rule {i}: {r['rule']}\n  {v.describe()}")
+    if args.output is not None:
+        write_verification(args.output, rules, results)
+    print(json.dumps([{"rank": i, **{k: v.summary()[k] for k in ("precision", "simulated")}}
+                      for i, v in enumerate(results, start=1)]))  # fmt: skip
     return 0

@@ -1,9 +1,10 @@
-"""Reading performance databases, and what their columns mean.
+"""Tables of designs and performances: the one reader and writer, and what columns mean.
 
-Small and generic on purpose: ``read_table`` reads CSV / Parquet with a header, or the
-published headerless comma-separated ``.txt`` files of Zhu & Filipov (2022) whose column names
-live in a sibling ``dataN_FeatureName.txt``; ``column_roles`` tells design features from
-performance columns for the published column sets.
+:func:`read_table` reads CSV / Parquet with a header, or the published headerless
+comma-separated ``.txt`` files of Zhu & Filipov (2022) whose column names live in a sibling
+``dataN_FeatureName.txt``; :func:`write_table` writes CSV or Parquet atomically (a temporary
+file in the same folder, then a rename); :func:`column_roles` tells design features from
+performance columns (a holofold database's ``meta.json``, or the published column sets).
 """
 
 from __future__ import annotations
@@ -14,7 +15,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-__all__ = ["ColumnRoles", "PUBLISHED", "read_table", "column_roles", "feature_name_file"]
+from holofold.geometry.outputs import atomic_write, check_output_path
+
+__all__ = [
+    "ColumnRoles",
+    "PUBLISHED",
+    "TABLE_SUFFIXES",
+    "read_table",
+    "write_table",
+    "check_table_path",
+    "column_roles",
+    "feature_name_file",
+]
+
+#: suffixes :func:`write_table` writes (and :func:`read_table` reads, with .txt / .dat)
+TABLE_SUFFIXES = (".csv", ".parquet", ".pq")
 
 
 @dataclass(frozen=True)
@@ -163,6 +178,19 @@ def read_table(path, columns=None) -> pd.DataFrame:
             )
         frame = frame[list(columns)]
     return frame
+
+
+def check_table_path(path, what: str = "output") -> Path:
+    """``path`` as a Path if :func:`write_table` can write it (known suffix, existing folder)."""
+    return check_output_path(path, what, TABLE_SUFFIXES)
+
+
+def write_table(frame: pd.DataFrame, path) -> Path:
+    """Write ``frame`` as CSV (12 significant digits) or Parquet, by the suffix, atomically."""
+    path = check_table_path(path)
+    if path.suffix.lower() == ".csv":
+        return atomic_write(path, lambda tmp: frame.to_csv(tmp, index=False, float_format="%.12g"))
+    return atomic_write(path, lambda tmp: frame.to_parquet(tmp, index=False))
 
 
 def column_roles(columns, path=None) -> ColumnRoles | None:
