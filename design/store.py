@@ -85,7 +85,7 @@ def build_database(
         Extra metadata stored in ``meta.json`` (seed, sampling method, ...).
     scheduler : str, optional
         Simulate on a Dask cluster: a scheduler address (``tcp://host:8786``) or ``"local"``
-        (one local cluster for the whole run); see :func:`design.runner.evaluate_designs`.
+        (one local cluster for the whole run); see :func:`holofold.design.runner.evaluate_designs`.
         Every row of the missing chunks is submitted at once and each chunk is written as
         soon as its last row is done (chunks may be written out of order), so no worker
         waits for the slowest row of a chunk. The results are the same as without it.

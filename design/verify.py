@@ -116,7 +116,7 @@ def verify_rule(
     """Simulate ``n`` fresh designs inside a rule and count those meeting ``target``.
 
     ``workers``, ``progress`` and ``scheduler`` (a Dask scheduler address or ``"local"``) are
-    passed to :func:`design.runner.evaluate_designs`.
+    passed to :func:`holofold.design.runner.evaluate_designs`.
     """
     if isinstance(scenario, str):
         scenario = get_scenario(scenario)

@@ -65,7 +65,7 @@ def fit_auto(
 
     Parameters
     ----------
-    curve : PlanarCurve or anything :func:`fitting.curves.load_curve` accepts
+    curve : PlanarCurve or anything :func:`holofold.fitting.curves.load_curve` accepts
     tolerance : float
         Allowed closest-point error, metres (> 0); met if error <= tolerance (1 + 1e-9).
     m_range : iterable of int

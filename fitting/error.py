@@ -3,7 +3,7 @@
 Two measures:
 
 * :func:`paper_error` / :func:`index_matched_error`: the published error of Zhu & Filipov
-  (specs/scenarios.md 5.5). Each of the 2m centre-line segments is cut into ``seg = 10``
+  (docs/strip-fit.md §5.1). Each of the 2m centre-line segments is cut into ``seg = 10``
   sub-intervals; the end point of sub-interval j of segment i is compared with the curve point
   of the same parameter, and e is the mean distance. It is index-matched (not a closest-point
   distance) and, for the paper's half circle, depends only on (m, offset).
@@ -53,11 +53,11 @@ def index_matched_error(
 
 
 def paper_error(curve, m, offset, seg: int = SEG):
-    """Published fitting error e(m, l_o) of specs/scenarios.md 5.5 (paper sampling).
+    """Published fitting error e(m, l_o) of docs/strip-fit.md §5.1 (paper sampling).
 
     Parameters
     ----------
-    curve : PlanarCurve or spec accepted by :func:`fitting.curves.load_curve`
+    curve : PlanarCurve or spec accepted by :func:`holofold.fitting.curves.load_curve`
         The target (the paper: ``half-circle:radius=2``).
     m : int or array_like of int
         Number of Miura units (>= 1 here; the strip itself needs >= 2).

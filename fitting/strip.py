@@ -22,8 +22,8 @@ What holds and what does not (checked in tests/test_strip.py):
 * The quads are **not planar**: :func:`quad_warp` is, per panel, the distance between the
   two diagonals (shortest distance of the lines P_j-S_{j+1} and S_j-P_{j+1}) divided by the
   mean diagonal length (0 for a planar quad). Over the 3000 published designs the largest
-  warp of a design ranges 0.07 %-3.5 % (median 0.86 %); specs/scenarios.md 5.4 quotes
-  8-40 % with an unstated measure. The construction is kept as published; the mechanics
+  warp of a design ranges 0.07 %-3.5 % (median 0.86 %; docs/strip-fit.md §4.2). The
+  construction is kept as published; the mechanics
   model fans each panel from its centre node, so the as-built shape is its stress-free state.
 * The two panels of a segment have opposite vertex orientation (as in the reference), so
   the 3-D strip pattern has no flat layout.

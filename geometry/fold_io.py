@@ -9,7 +9,7 @@ inheriting the topology); otherwise the key frame is the 3-D ``foldedForm``. Phy
 under namespaced keys: ``edges_holofold:creaseWidth`` (m), ``edges_holofold:creaseThickness``
 (m), ``faces_holofold:thickness`` (m) and ``holofold:meta`` (the pattern's parameters).
 
-Reading checks the list of specs/ecosystem.md 1.7 and raises :class:`FormatError` naming the
+Reading checks the list of docs/bar-and-hinge.md §1.2 and raises :class:`FormatError` naming the
 first problem; soft problems (no ``file_spec``, custom keys without a colon, clockwise faces,
 which are reversed) are warnings. Files are parsed with :mod:`json` only.
 """

@@ -5,7 +5,7 @@ edge, exactly like the concentrated-hinge model of the mechanics layer. The mesh
 has the pattern's vertices first (ids kept) and one centre per panel after them
 (``nv + panel id``); triangle ``3k..`` belong to panel ``face_index[k]``. A fan of a warped
 (non-planar) quad is the same surface the simulator sees. Faces are oriented consistently
-(:func:`geometry.pattern.orient_faces`), so normals point to one side of the sheet.
+(:func:`holofold.geometry.pattern.orient_faces`), so normals point to one side of the sheet.
 
 STL, OBJ and PLY are written by trimesh (:func:`export_mesh`); nothing is written by hand.
 """

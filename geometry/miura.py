@@ -1,6 +1,6 @@
 """Miura-ori crease patterns folded rigidly to an extension ratio.
 
-The geometry is the reference simulator's Miura sheet (specs/scenarios.md 2.2): an m x n grid
+The geometry is the reference simulator's Miura sheet (docs/scenarios.md §2.1): an m x n grid
 of parallelogram panels with sides ``a`` (along y) and ``b`` and sector angle ``gamma``, folded
 so that the projected x-step ``b sin(theta)`` is ``ext`` times the flat one::
 
@@ -124,7 +124,7 @@ def miura_sheet(
     *,
     size: float | None = None,
 ) -> CreasePattern:
-    """Rigidly folded m x n Miura-ori sheet (specs/scenarios.md 2.2).
+    """Rigidly folded m x n Miura-ori sheet (docs/scenarios.md §2.1).
 
     Parameters
     ----------

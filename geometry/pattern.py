@@ -11,7 +11,7 @@ A :class:`CreasePattern` is the plain data every other layer consumes::
 
 Edge order matters: the reference simulator (SWOMPS) numbers creases by walking the panels in
 order and, within a panel with vertices C1..CN, the edges (C1, CN), (C1, C2), ..., (C_{N-1}, C_N)
-(specs/scenarios.md 1.1). :func:`reference_edges` computes exactly that order and
+(docs/bar-and-hinge.md §1.1). :func:`reference_edges` computes exactly that order and
 :meth:`CreasePattern.from_faces` uses it, so crease ``i`` of a generated pattern is the
 reference's crease ``i + 1`` (0-based here, 1-based there).
 

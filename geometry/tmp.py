@@ -1,6 +1,6 @@
 """Tachi-Miura polyhedron (TMP) sheets folded rigidly to an extension ratio.
 
-The geometry is the reference simulator's TMP sheet (specs/scenarios.md 3.2) for an L x L sheet
+The geometry is the reference simulator's TMP sheet (docs/scenarios.md §3.1) for an L x L sheet
 with m strips along x (m even) and n panels along y (n a multiple of 3); a = L/n, b = L/m::
 
     delta = b sqrt(1 - ext^2),  theta = atan(2 delta / a)
@@ -120,7 +120,7 @@ def tmp_faces(m: int, n: int) -> list[np.ndarray]:
 
 
 def tmp_sheet(m: int, n: int, L: float, ext: float) -> CreasePattern:
-    """Rigidly folded Tachi-Miura polyhedron sheet (specs/scenarios.md 3.2).
+    """Rigidly folded Tachi-Miura polyhedron sheet (docs/scenarios.md §3.1).
 
     Parameters
     ----------

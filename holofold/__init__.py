@@ -1,1 +1,89 @@
-"""holofold: holistic inverse design of origami, shape and function."""
+"""holofold: holistic inverse design of origami, shape and function.
+
+From a target (a curve to follow, a stiffness, a snap-through or not) to a design that can be
+fabricated. Four layers, each with its own public face, import one way only::
+
+    holofold.geometry   crease patterns, generators, meshes, fabrication files
+    holofold.fitting    curves and the Miura strip fitted to them
+    holofold.mechanics  bar-and-hinge simulation, electro-thermal actuation, modes
+    holofold.design     scenarios, databases, design rules, verification
+
+The names a user needs first are here too (imported on first use, so ``import holofold``
+is cheap). SI units throughout.
+
+Quickstart: fit the paper's arch to a half circle, simulate one design, build a small
+database and mine a rule from it.
+
+>>> import holofold as hf
+>>> fit = hf.fit_strip(hf.builtin_curve("half-circle", radius=2.0), m=12, offset=0.2,
+...                    strip_width=0.02, extrude=0.1)
+>>> fit.pattern.n_vertices, fit.pattern.n_faces, round(fit.index_error, 4)  # m
+(75, 48, 0.0972)
+>>> arch = hf.get_scenario("arch")
+>>> out = arch.evaluate({"m": 12, "tcrease": 8e-4, "tpanel": 3e-3, "W": 2e-3,
+...                      "offset": 0.2, "stripeWidth": 0.02, "extrude": 0.1})
+>>> str(out["status"]), round(out["Zstiff"], 1), round(out["Xstiff"], 1)  # N/m
+('converged', 92.3, 79.9)
+>>> sheet = hf.miura_sheet(4, 4, a=0.02, b=0.02, gamma=1.0, ext=0.6)  # m, rad
+>>> sheet.n_vertices, sheet.n_faces
+(25, 16)
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__all__ = [
+    # geometry
+    "CreasePattern",
+    "miura_sheet",
+    "tmp_sheet",
+    "export",
+    # fitting
+    "builtin_curve",
+    "load_curve",
+    "fit_strip",
+    "fit_auto",
+    # mechanics
+    "build_concentrated",
+    "secant_stiffness",
+    "PAPER",
+    # design
+    "get_scenario",
+    "evaluate_designs",
+    "generate_database",
+    "read_table",
+    "ForestRuleMiner",
+    "mine_rules",
+    "verify_rules",
+]
+
+_HOME = {
+    **dict.fromkeys(("CreasePattern", "miura_sheet", "tmp_sheet", "export"), "geometry"),
+    **dict.fromkeys(("builtin_curve", "load_curve", "fit_strip", "fit_auto"), "fitting"),
+    **dict.fromkeys(("build_concentrated", "secant_stiffness", "PAPER"), "mechanics"),
+    **dict.fromkeys(
+        (
+            "get_scenario",
+            "evaluate_designs",
+            "generate_database",
+            "read_table",
+            "ForestRuleMiner",
+            "mine_rules",
+            "verify_rules",
+        ),
+        "design",
+    ),  # fmt: skip
+}
+
+
+def __getattr__(name: str):
+    if name in _HOME:
+        value = getattr(importlib.import_module(f"holofold.{_HOME[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'holofold' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

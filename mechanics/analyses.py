@@ -1,6 +1,6 @@
 """Reusable analyses on a bar-and-hinge model: secant stiffness under a load group, snap checks.
 
-These are the measurements the paper's scenarios make (specs/scenarios.md 2.4, 3.4, 5.7):
+These are the measurements the paper's scenarios make (docs/scenarios.md §2.3, §3.3, §5.2-5.3):
 a group of nodes carries an equal share of a per-increment force in one direction, Newton-Raphson
 load control runs a few increments from the stress-free state, and the secant stiffness is the
 total force over the mean displacement of the group. :func:`snap_check_mgdcm` offers a path-

@@ -225,11 +225,11 @@ class AssemblyPattern:
         included.
     bar_slot : (36 nb,) int
         CSR data slot of every entry of the bar tangents in kernel layout (3, 3, 2, 2, nb)
-        (see :func:`mechanics.bars.bar_kernel`).
+        (see :func:`holofold.mechanics.bars.bar_kernel`).
     spring_slot, spring_slot_mirror : (90 ns,) int
         Slots of the ten distinct spring tangent blocks in kernel layout (3, 3, 10, ns) (see
-        :func:`mechanics.springs.spring_kernel`), and of their transposes (``nnz`` = discard,
-        for the diagonal blocks).
+        :func:`~holofold.mechanics.springs.spring_kernel`), and of their transposes (``nnz`` =
+        discard, for the diagonal blocks).
     bar_force_dofs, spring_force_dofs : (6 nb,), (12 ns,) int
         Global DOF of every entry of the kernels' force arrays ((3, 2, nb) and (3, 4, ns)).
     nnz : int
@@ -387,7 +387,8 @@ class Assembler:
     # ------------------------------------------------------------------ evaluation
     def element_response(self, U, spring_rest=None, *, tangent: bool = True):
         """Element-level bar and spring responses ``(bar, spring)`` in the kernels' layouts
-        (see :func:`mechanics.bars.bar_kernel` and :func:`mechanics.springs.spring_kernel`)."""
+        (see :func:`~holofold.mechanics.bars.bar_kernel` and
+        :func:`~holofold.mechanics.springs.spring_kernel`)."""
         UT = np.asarray(U, float).reshape(-1, 3).T
         if UT.shape[1] != self.X.shape[0]:
             raise ValueError(f"U must have shape ({self.X.shape[0]}, 3), got {np.shape(U)}")

@@ -1,4 +1,4 @@
-"""Bar element: St Venant-Kirchhoff material with Green-Lagrange strain (specs/mechanics.md 3).
+"""Bar element: St Venant-Kirchhoff material, Green-Lagrange strain (docs/bar-and-hinge.md §2.1).
 
 For a bar a-b with reference vector ``D0 = X_b - X_a``, rest length ``L0`` and displacement
 difference ``d = u_b - u_a`` (current vector ``x = D0 + d``)::

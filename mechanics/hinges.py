@@ -1,20 +1,21 @@
 """Bar-and-hinge models of a crease pattern: concentrated hinges and compliant creases.
 
-Two builders turn a :class:`~geometry.pattern.CreasePattern` (in its as-built 3-D state) and
-section/material data into a :class:`~mechanics.structure.Structure`:
+Two builders turn a :class:`~holofold.geometry.pattern.CreasePattern` (in its as-built 3-D
+state) and section/material data into a :class:`~holofold.mechanics.structure.Structure`:
 
 * :func:`build_concentrated` -- one rotational spring on every interior crease, panels fanned
-  from a centre node (specs/mechanics.md 2.3, specs/scenarios.md 1.2). Used by the single Miura,
+  from a centre node (docs/bar-and-hinge.md §3). Used by the single Miura,
   canopy and arch scenarios of the paper.
 * :func:`build_compliant` -- creases of finite width W: every panel is shrunk by W/2 next to its
   creases and each crease strip gets 3 nodes, 10 bars, 6 triangles and 8 springs on three spring
-  lines (specs/mechanics.md 2.2).
+  lines (docs/bar-and-hinge.md §4).
 
 Both use the reference simulator's numbering, so node and crease ids of the paper's scripts
-carry over (0-based here). Stiffnesses and areas follow specs/mechanics.md 2.4; the reference
-quirks are switched by a :class:`~mechanics.compat.Profile` (default :data:`PAPER`). Every spring
+carry over (0-based here). Stiffnesses and areas follow docs/bar-and-hinge.md §3.2 and §4.4;
+the reference quirks are switched by a :class:`~holofold.mechanics.compat.Profile` (default
+:data:`PAPER`). Every spring
 rest angle is the dihedral angle measured on the as-built geometry, so the model is exactly
-stress free in the state it was built in (specs/scenarios.md 1.4).
+stress free in the state it was built in (docs/bar-and-hinge.md §1.5).
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def _group_mean(values: np.ndarray, group: np.ndarray, sizes: np.ndarray) -> np.
 def orient_springs(
     x: np.ndarray, springs: np.ndarray, *, z_only: bool = True, where: np.ndarray | None = None
 ) -> np.ndarray:
-    """Polarity normalisation of specs/mechanics.md 2.2-E (returns a new (ns, 4) array).
+    """Polarity normalisation of docs/bar-and-hinge.md §2.5 (returns a new (ns, 4) array).
 
     Swaps i and l where the z component of ``(x_j - x_i) x (x_k - x_j)`` is positive, so that
     ``m = r_ij x r_kj`` points to +z (theta > pi when the wings rotate towards +z). With
@@ -209,7 +210,7 @@ def build_concentrated(
     coords=None,
     supports=None,
 ) -> Structure:
-    """Concentrated-hinge bar-and-hinge model (specs/mechanics.md 2.3-2.4).
+    """Concentrated-hinge bar-and-hinge model (docs/bar-and-hinge.md §3).
 
     Parameters
     ----------
@@ -230,7 +231,7 @@ def build_concentrated(
         the crease width (``profile.panel_spring_width_is_crease_width``, the paper's
         ``panelW = W``; the mean interior width if W varies) or the panel's mean spoke length.
     profile : Profile
-        Quirk switches (:data:`~mechanics.compat.PAPER` reproduces the published data).
+        Quirk switches (:data:`~holofold.mechanics.compat.PAPER` reproduces the published data).
     coords : (nv, 3) float, optional
         Other as-built vertex coordinates for the same faces (default ``pattern.coords``).
         Lets a sweep over fold states (extensions) reuse one validated pattern.
@@ -356,7 +357,7 @@ def build_compliant(
     split_factor: float = 0.5,
     profile: Profile = PAPER,
 ) -> Structure:
-    """Compliant-crease bar-and-hinge model of finite-width creases (specs/mechanics.md 2.2).
+    """Compliant-crease bar-and-hinge model of finite-width creases (docs/bar-and-hinge.md §4).
 
     Parameters
     ----------
@@ -622,7 +623,7 @@ def crease_rest_targets(structure: Structure, crease_angle, *, profile: Profile 
         border edges are ignored.
     profile : Profile, optional
         Defaults to the structure's. With ``reset_non_crease_rest_angles`` (the reference,
-        specs/mechanics.md 2.5) every other spring (panel, diagonal) is set to pi; otherwise it
+        docs/bar-and-hinge.md §4.5) every other spring (panel, diagonal) is set to pi; otherwise it
         keeps its current rest angle.
 
     Returns

@@ -1,4 +1,4 @@
-"""Lumped mass and natural frequencies (specs/mechanics.md 8.1, 8.3; scenarios.md 4.5).
+"""Lumped mass and natural frequencies (docs/electro-thermal.md §6; docs/scenarios.md §4.3).
 
 The eigenproblem is ``K phi = lambda M phi`` on the free DOFs, with ``K`` the tangent stiffness
 at the current state and ``M`` the diagonal lumped mass. ``lambda = omega^2``: the returned
@@ -39,10 +39,10 @@ def lumped_mass(
     centre_share : float
         Share of a panel triangle's mass given to its panel-centre vertex; the other two get
         ``(1 - centre_share)/2`` each. Crease triangles always split 1/3 each. 1/3 is the
-        data-era reference; later SWOMPS versions use 4/6 (mechanics.md 8.1).
+        data-era reference; later SWOMPS versions use 4/6 (docs/electro-thermal.md §6.1).
     skip_first : int
         Number of leading triangles that get no mass (data-era quirk: the number of pattern
-        panels, scenarios.md 4.5).
+        panels, docs/scenarios.md §4.3).
     """
     tri = structure.triangles
     nt = len(tri)

@@ -1,4 +1,4 @@
-"""Four-node rotational springs: dihedral angle, its gradient and Hessian (specs/mechanics.md 4).
+"""Four-node rotational springs: dihedral angle, gradient, Hessian (docs/bar-and-hinge.md §2.2-2.4).
 
 A spring (i, j, k, l) has its hinge on j-k; node i lies on one face and l on the other. With
 ``r_ij = x_i - x_j``, ``r_kj = x_k - x_j``, ``r_kl = x_k - x_l``, ``m = r_ij x r_kj``,
@@ -10,8 +10,9 @@ This is the reference simulator's angle (``mod(sign(m . r_kl) arccos(m.n / |m||n
 form that keeps full precision near the flat state. The builders order (i, j, k, l) so that ``m``
 points to +z on a flat xy pattern (the polarity rule); the angle then grows above pi when the
 wings rotate toward +z. The gradient and Hessian are those of Liu & Paulino (2017)
-(specs/mechanics.md 4), built as 3x3 blocks from batched outer products of a few stacked vectors
-(no loop over springs; checked against central finite differences in tests/test_springs.py).
+(docs/bar-and-hinge.md §2.2-2.4), built as 3x3 blocks from batched outer products of a few
+stacked vectors (no loop over springs; checked against central finite differences in
+tests/test_springs.py).
 The constitutive law is linear: ``M = k (theta - theta0)``, energy ``k (theta - theta0)^2 / 2``,
 force ``M grad``, tangent ``k grad grad' + M hess``.
 
@@ -160,7 +161,8 @@ def _first_order(P):
 
 def _add_hessian(out, scale, g, R, MN, d, ell, A, B):
     """``out[..., :9, :] += scale * H`` for the Hessian blocks ii, ij, ik, ll, lj, lk, jj, jk,
-    kk (each (..., 3, 3, ns); Liu & Paulino 2017, specs/mechanics.md 4). ``scale`` (..., ns)."""
+    kk (each (..., 3, 3, ns); Liu & Paulino 2017, docs/bar-and-hinge.md §2.3); ``scale``
+    (..., ns)."""
     # dA_j, dA_k, dB_j, dB_k as combinations of (r_ij, r_kj, r_kl)
     coef = (_TD0 + _TD1 * A[..., None, None, :] + _TD2 * B[..., None, None, :]) * (
         1.0 / d[..., 0, :]

@@ -1,7 +1,7 @@
 """The structural model: nodes, bars, rotational springs, triangles, supports (numpy arrays).
 
 A :class:`Structure` is what the element kernels, the assembly and the solvers consume. It is
-built from a crease pattern by :mod:`mechanics.hinges` (concentrated hinges or compliant
+built from a crease pattern by :mod:`holofold.mechanics.hinges` (concentrated hinges or compliant
 creases), but any code may build one directly::
 
     nodes          (nn, 3) float   reference coordinates X, metres

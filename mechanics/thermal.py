@@ -1,6 +1,6 @@
 """Electro-thermal actuation: steady heat conduction, bimorph curvature, thermal folding stage.
 
-Model (specs/mechanics.md 7, SWOMPS ``Thermal_*.m``):
+Model (docs/electro-thermal.md §1-5, SWOMPS ``Thermal_*.m``):
 
 * In-plane conduction: one linear 3-node element per mesh triangle (panel fans and crease
   triangles), ``K_pq = k t (e_p . e_q) / (4 A)`` with ``e_p`` the edge vector opposite node p.
@@ -140,7 +140,7 @@ def thermal_model(
     reference_geometry: bool = True,
     profile: Profile | None = None,
 ) -> ThermalModel:
-    """Thermal model of a compliant-crease :class:`~mechanics.structure.Structure`.
+    """Thermal model of a compliant-crease :class:`~holofold.mechanics.structure.Structure`.
 
     Triangles with ``tri_crease >= 0`` use ``crease_conductivity``, the others
     ``panel_conductivity`` (scalar or per panel, indexed by ``tri_panel``). Thicknesses are
@@ -296,8 +296,8 @@ def steady_temperature(
     """Steady nodal temperatures (nn,), °C, for nodal heat input ``q`` (nn,), W.
 
     Solves ``(K_cond + diag(G)) T = q + G RT`` with T = RT at ``room_temp_nodes`` (the exact
-    reduction of the layered air model, mechanics.md 7.3). ``K_cond`` and ``G`` may be passed
-    if already computed at ``x``.
+    reduction of the layered air model, docs/electro-thermal.md §3.2-3.3). ``K_cond`` and ``G``
+    may be passed if already computed at ``x``.
     """
     n = model.n_nodes
     q = np.asarray(q, float)
@@ -520,12 +520,12 @@ def electrothermal_stage(
     heat_matrix: sp.spmatrix | None = None,
     temp_matrix: sp.spmatrix | None = None,
 ):
-    """Add heat to the creases and fold quasi-statically (specs/mechanics.md 7.6).
+    """Add heat to the creases and fold quasi-statically (docs/electro-thermal.md §5.3).
 
-    For s = 1..steps: nodal heat ``q = state.q + (s/steps) H crease_heat``; steady temperatures
-    at the current shape; crease fold angles ``theta = theta_start + W kappa(dT)`` with dT
-    relative to the stage start; spring targets (:func:`mechanics.hinges.crease_rest_targets`);
-    one self-folding solve (``increments`` sub-increments, supports of ``structure``) keeping
+    For s = 1..steps: nodal heat ``q = state.q + (s/steps) H crease_heat``; steady temperatures at
+    the current shape; crease fold angles ``theta = theta_start + W kappa(dT)`` with dT relative to
+    the stage start; spring targets (:func:`~holofold.mechanics.hinges.crease_rest_targets`); one
+    self-folding solve (``increments`` sub-increments, supports of ``structure``) keeping
     ``state.force`` applied.
 
     Parameters

@@ -135,7 +135,7 @@ def test_compliant_areas_and_stiffness_formulas():
 
 
 def test_compliant_single_fold_stiffness():
-    """Two panels, one compliant crease: fold stiffness ~ E t^3 l / (12 W) (mechanics.md 12.4)."""
+    """Two panels, one compliant crease: fold stiffness ~ E t^3 l / (12 W) (bar-and-hinge §4.4)."""
     a, W, tc, tp = 0.01, 1e-3, 1e-4, 2e-3
     X = np.array([[0, 0, 0], [a, 0, 0], [a, a, 0], [0, a, 0], [2 * a, 0, 0], [2 * a, a, 0]])
     p = CreasePattern.from_faces(X, [[0, 1, 2, 3], [1, 4, 5, 2]])
@@ -297,7 +297,7 @@ def test_bad_parameters_raise():
 
 
 def test_compliant_gripper_numbering_matches_the_reference_scripts():
-    """Node ids the gripper scripts use (specs/scenarios.md 4.2-4.3), 1-based."""
+    """Node ids the gripper scripts use (docs/scenarios.md §4.2), 1-based."""
     gripper = pytest.importorskip("holofold.geometry.gripper")
     kw = dict(crease_width=2e-4, crease_thickness=1e-6, panel_thickness=1e-5, **MAT)
     s = build_compliant(gripper.miura_based_gripper(5e-3, 4e-3, 0.4), **kw)

@@ -1,4 +1,4 @@
-"""Miura-ori generator: spec formulas (scenarios.md 2.2), rigid folding, flat-foldability."""
+"""Miura-ori generator: spec formulas (docs/scenarios.md §2.1), rigid folding, flat-foldability."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ GAMMA70 = math.radians(70.0)
 
 
 def spec_miura(a, b, gamma, m, n, ext):
-    """Independent transcription of scenarios.md 2.2, 1-based ids, law-of-cosines beta."""
+    """Independent transcription of docs/scenarios.md §2.1, 1-based ids, law-of-cosines beta."""
     h = b * math.sin(gamma) * ext
     theta = math.asin(ext * math.sin(gamma))
     diag2 = (a + b * math.cos(gamma)) ** 2 + (b * math.sin(gamma)) ** 2

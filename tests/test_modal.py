@@ -95,7 +95,7 @@ def test_lumped_mass_totals_and_shares():
         lumped_mass(s, 1200.0, skip_first=len(s.triangles) + 1)
 
 
-# row 1 of each published gripper file (scenarios.md 0)
+# row 1 of each published gripper file (docs/scenarios.md §6)
 PUBLISHED = {
     "data2_MiuraBased_sample": 94.82475367,
     "data2_SplittedMiura_sample": 20.64866054,

@@ -112,7 +112,7 @@ def test_arch_model_supports_and_error():
     assert s.n_nodes == 6 * m + 3 + 4 * m
     assert np.flatnonzero(s.supports.all(1)).tolist() == [0, 16, 17, 33, 34, 50]
     assert apex == 8 and np.allclose(s.nodes[apex], [2, 0, 2])
-    assert err == pytest.approx(0.093679, abs=1e-6)  # specs/scenarios.md 5.5 test vector
+    assert err == pytest.approx(0.093679, abs=1e-6)  # docs/strip-fit.md §5.1 test vector
 
 
 @pytest.mark.parametrize(

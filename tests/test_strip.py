@@ -1,4 +1,4 @@
-"""The analytic Miura-like strip of specs/scenarios.md 5.3-5.4."""
+"""The analytic Miura-like strip of docs/strip-fit.md §3."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tachi-Miura polyhedron sheet generator: spec formulas (scenarios.md 3.2), rigid folding."""
+"""Tachi-Miura polyhedron sheet generator: spec formulas (docs/scenarios.md §3.1), rigid folding."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ def interior_vertices(p):
 
 
 def spec_tmp(m, n, L, ext):
-    """Independent transcription of scenarios.md 3.2 with the spec's 1-based ids."""
+    """Independent transcription of docs/scenarios.md §3.1 with the spec's 1-based ids."""
     a, b = L / n, L / m
     delta = b * math.sqrt(1 - ext**2)
     theta = math.atan(2 * delta / a)

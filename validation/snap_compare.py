@@ -1,8 +1,8 @@
 """Compare the paper's snap flag (NR, |U_z| > 1 m at 5 N) with an MGDCM limit-point check.
 
-Runs :func:`mechanics.analyses.snap_check_mgdcm` (path following, limit point below 5 N) on the
-arch rows of data3 that snap in the published data and on the non-snapping rows closest to the
-threshold (smallest Zstiff), and prints the confusion table.
+Runs :func:`~holofold.mechanics.analyses.snap_check_mgdcm` (path following, limit point below 5 N)
+on the arch rows of data3 that snap in the published data and on the non-snapping rows closest to
+the threshold (smallest Zstiff), and prints the confusion table.
 
     python validation/snap_compare.py [--near 100] [--workers 2]
 """

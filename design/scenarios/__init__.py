@@ -1,6 +1,6 @@
 """The paper's design scenarios (single Miura, canopy, arch, gripper), by command-line name.
 
-Each module defines ``SCENARIO`` (:class:`design.scenarios.base.Scenario`): feature and
+Each module defines ``SCENARIO`` (:class:`holofold.design.scenarios.base.Scenario`): feature and
 performance columns with units and the paper's sampling ranges, a validity check and an
 ``evaluate(row) -> dict`` that reproduces the published rows.
 """

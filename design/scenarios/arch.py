@@ -1,12 +1,12 @@
 """Scenario 4 of the paper: a Miura-like arch fitted to a half circle (data3).
 
-specs/scenarios.md 5: the strip of :mod:`fitting.strip` (m units, offset l_o, side shift W_s,
-half-width l_e) fitted to the half circle of radius 2 m, concentrated-hinge model (E = 2 GPa,
+docs/scenarios.md §5: the strip of :mod:`~holofold.fitting.strip` (m units, offset l_o, side shift
+W_s, half-width l_e) fitted to the half circle of radius 2 m, concentrated-hinge model (E = 2 GPa,
 nu = 0.3). The two end nodes of each of the three lines are pinned (6 nodes, all DOFs); the apex
-(node m) carries -1 N in z (Z case) or +1 N in x (X case) per increment; Newton-Raphson,
-5 increments, tol 1e-7 m, at most 29 iterations per increment, the last iterate accepted as in
-the reference. ``Zstiff = 5 / |U_z|``, ``Xstiff = 5 / |U_x|`` (N/m) and ``Zsnap = 1`` if
-``|U_z| > 1 m``; ``error`` is the index-matched fitting error (m).
+(node m) carries -1 N in z (Z case) or +1 N in x (X case) per increment; Newton-Raphson, 5
+increments, tol 1e-7 m, at most 29 iterations per increment, the last iterate accepted as in the
+reference. ``Zstiff = 5 / |U_z|``, ``Xstiff = 5 / |U_x|`` (N/m) and ``Zsnap = 1`` if ``|U_z| > 1
+m``; ``error`` is the index-matched fitting error (m).
 
 A snapping arch has no converged solution at 5 N: its Zstiff is the last (unconverged) iterate,
 as in the published data, and ``status`` names the increments that did not converge.

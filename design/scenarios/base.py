@@ -2,8 +2,8 @@
 
 A :class:`Scenario` names the feature columns (with units and the paper's sampling ranges), the
 categorical features, the performance columns, a physical-validity check and the function that
-simulates one design. The runner (:mod:`design.runner`) and the ``holofold evaluate`` command
-work from this description only.
+simulates one design. The runner (:mod:`~holofold.design.runner`) and the ``holofold evaluate``
+command work from this description only.
 
 ``evaluate(row)`` takes a mapping of feature name -> value (SI units) and returns a dict with one
 entry per performance column plus ``status``, a :class:`~holofold.mechanics.status.Status`:
@@ -27,7 +27,7 @@ def single_thread():
 
     The models' small dense solves get much slower (10x and more on a busy machine) when
     several BLAS threads contend for the cores, so every evaluation runs single-threaded;
-    parallelism comes from running rows on several processes (:mod:`design.runner`).
+    parallelism comes from running rows on several processes (:mod:`~holofold.design.runner`).
     """
     global _CONTROLLER
     if _CONTROLLER is None:

@@ -1,6 +1,6 @@
 """Scenario 2 of the paper: bending and axial stiffness of Miura and TMP canopy sheets.
 
-specs/scenarios.md 3 (data1) and 3.8 (data4): a 0.2 m x 0.2 m sheet, Miura-ori (pattern 1,
+docs/scenarios.md §3 (data1, and data4 in §3.2): a 0.2 m x 0.2 m sheet, Miura-ori (pattern 1,
 gamma = 70 deg, b = L/m, a = (L - b cot gamma)/n) or Tachi-Miura polyhedron (pattern 2, m even,
 n a multiple of 3), concentrated-hinge model, one stress-free model per extension 0.3, 0.6,
 0.9. The nodes at x = min are fixed; the nodes at x = max share 1 N per increment, in -z for

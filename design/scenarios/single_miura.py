@@ -1,6 +1,6 @@
 """Scenario 1 of the paper: axial stiffness of a single Miura-ori unit cell (data0).
 
-specs/scenarios.md 2: a 2 x 2 Miura cell of size L = 0.04 m (b = L/2, a = (L - b cot gamma)/2),
+docs/scenarios.md §2: a 2 x 2 Miura cell of size L = 0.04 m (b = L/2, a = (L - b cot gamma)/2),
 concentrated-hinge model (E = 2 GPa, nu = 0.3, panel springs scaled by the crease width), one
 stress-free model per extension Ext = 0.3, 0.6, 0.9. The nodes at x = 0 are fixed; the nodes at
 x = max carry +x forces of 1 N per increment in total; Newton-Raphson, 3 increments, tol 1e-7 m;

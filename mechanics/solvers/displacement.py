@@ -1,4 +1,4 @@
-"""Displacement control (specs/mechanics.md 6.3).
+"""Displacement control (docs/bar-and-hinge.md §6.3).
 
 The load ``F0 + lambda * load`` is scaled so that one chosen DOF ``d*`` follows the path; the
 corrector keeps ``d*`` fixed (``d_lambda = -u_r[d*] / u_p[d*]``), so the path passes load limit

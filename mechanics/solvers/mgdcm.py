@@ -1,4 +1,4 @@
-"""Modified generalised displacement control, MGDCM (specs/mechanics.md 6.2).
+"""Modified generalised displacement control, MGDCM (docs/bar-and-hinge.md §6.4).
 
 Path following that passes load limit points (snap-through). Each increment:
 

@@ -1,4 +1,4 @@
-"""Newton-Raphson load control with the reference simulator's semantics (specs/scenarios.md 1.5).
+"""Newton-Raphson load control, the reference simulator's semantics (docs/bar-and-hinge.md §6.2).
 
 At increment ``i = 1..increments`` the applied force is ``F0 + i * load`` (``load`` is a
 *per-increment* load; the total after the stage is ``increments * load``). Each increment

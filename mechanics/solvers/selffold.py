@@ -1,4 +1,4 @@
-"""Self-folding by rest-angle control (specs/mechanics.md 6.4).
+"""Self-folding by rest-angle control (docs/bar-and-hinge.md §6.5).
 
 The spring rest angles move linearly from ``start_rest`` to ``target_rest`` over the increments,
 ``theta0_i = (1 - i/n) start + (i/n) target``, and each increment runs Newton iterations on
