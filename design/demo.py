@@ -15,12 +15,15 @@ Everything lands in one folder, with ``summary.json`` describing what was done.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
 from holofold.design.mining import mine_rules
 from holofold.design.report import mining_summary, plot_rules, save_figure
 from holofold.design.rulefile import rules_to_records, write_rules
+from holofold.design.rules import FewRulesWarning
+from holofold.design.runner import check_workers
 from holofold.design.scenarios import get_scenario
 from holofold.design.store import generate_database
 from holofold.design.tables import column_roles
@@ -59,8 +62,6 @@ def run_demo(
         raise ValueError(f"--samples = {samples} must be >= 20 for rules to be mined")
     if verify < 1:
         raise ValueError(f"--verify = {verify} must be >= 1")
-    from holofold.design.runner import check_workers
-
     check_workers(workers)
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
@@ -91,10 +92,12 @@ def run_demo(
     db = generate_database(arch, samples, db_folder, seed=seed, workers=workers, csv=True)
 
     say(f"[4/5] mine design rules for: {target}")
-    mined = mine_rules(
-        db, target, roles=column_roles(db.columns, db_folder / "database.parquet"),
-        seed=seed, max_overlap=0.5, source=str(db_folder / "database.parquet"),
-    )  # fmt: skip
+    with warnings.catch_warnings():  # the summary says when fewer rules survive
+        warnings.simplefilter("ignore", FewRulesWarning)
+        mined = mine_rules(
+            db, target, roles=column_roles(db.columns, db_folder / "database.parquet"),
+            seed=seed, max_overlap=0.5, source=str(db_folder / "database.parquet"),
+        )  # fmt: skip
     say(mining_summary(mined, str(db_folder / "database.parquet")))
     records = rules_to_records(mined.miner, mined.test_scores)
     rules_dir = out / "3_rules"

@@ -33,48 +33,23 @@ from __future__ import annotations
 
 import importlib
 
-__all__ = [
-    # geometry
-    "CreasePattern",
-    "miura_sheet",
-    "tmp_sheet",
-    "export",
-    # fitting
-    "builtin_curve",
-    "load_curve",
-    "fit_strip",
-    "fit_auto",
-    # mechanics
-    "build_concentrated",
-    "secant_stiffness",
-    "PAPER",
-    # design
-    "get_scenario",
-    "evaluate_designs",
-    "generate_database",
-    "read_table",
-    "ForestRuleMiner",
-    "mine_rules",
-    "verify_rules",
-]
-
-_HOME = {
-    **dict.fromkeys(("CreasePattern", "miura_sheet", "tmp_sheet", "export"), "geometry"),
-    **dict.fromkeys(("builtin_curve", "load_curve", "fit_strip", "fit_auto"), "fitting"),
-    **dict.fromkeys(("build_concentrated", "secant_stiffness", "PAPER"), "mechanics"),
-    **dict.fromkeys(
-        (
-            "get_scenario",
-            "evaluate_designs",
-            "generate_database",
-            "read_table",
-            "ForestRuleMiner",
-            "mine_rules",
-            "verify_rules",
-        ),
-        "design",
-    ),  # fmt: skip
+#: layer -> the names this module offers from its face
+_FIRST_NAMES = {
+    "geometry": ("CreasePattern", "miura_sheet", "tmp_sheet", "export"),
+    "fitting": ("builtin_curve", "load_curve", "fit_strip", "fit_auto"),
+    "mechanics": ("build_concentrated", "secant_stiffness", "PAPER"),
+    "design": (
+        "get_scenario",
+        "evaluate_designs",
+        "generate_database",
+        "read_table",
+        "ForestRuleMiner",
+        "mine_rules",
+        "verify_rules",
+    ),
 }
+_HOME = {name: layer for layer, names in _FIRST_NAMES.items() for name in names}
+__all__ = list(_HOME)
 
 
 def __getattr__(name: str):

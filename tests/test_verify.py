@@ -5,6 +5,7 @@ import json
 import pytest
 
 from holofold.cli import main
+from holofold.design import run_demo, verify_rules, write_verification
 from holofold.design.scenarios import get_scenario
 from holofold.design.verify import rule_ranges, verify_rule
 
@@ -40,17 +41,30 @@ def test_verify_counts_designs_meeting_the_target():
 
 
 @pytest.mark.slow
-def test_demo_runs_end_to_end(tmp_path, capsys):
+def test_demo_runs_end_to_end(tmp_path):
     out = tmp_path / "demo"
-    assert main(["demo", "-o", str(out), "-n", "80", "--verify", "6", "--workers", "1"]) == 0
+    said = []
+    summary = run_demo(out, samples=80, verify=6, workers=1, say=said.append)
     files = "1_fit/strip.fold 1_fit/strip.stl 2_database/database.parquet 3_rules/rules.json"
     for f in (files + " 3_rules/rules.png 4_verify/verify.json summary.json").split():
         assert (out / f).is_file(), f
-    summary = json.loads((out / "summary.json").read_text())
+    assert json.loads((out / "summary.json").read_text()) == summary
     perf = summary["fitted_strip"]["performance"]
     assert perf["Zstiff"] > 0 and perf["error"] == pytest.approx(0.0972, abs=1e-3)
+    assert perf["status"] == "converged"
     assert summary["rules"] and summary["verification"][0]["simulated"] == 6
-    assert "done: best rule" in capsys.readouterr().out
+    assert [s[:5] for s in said[:1]] == ["[1/5]"] and "done: best rule" in said[-1]
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [(["-n", "5"], "must be >= 20"), (["--verify", "0"], "must be >= 1"),
+     (["--target", "Zstif > 1"], "unknown column"), (["--workers", "0"], "workers")],
+)  # fmt: skip
+def test_demo_refuses_bad_arguments_before_writing(tmp_path, capsys, argv, match):
+    out = tmp_path / "demo"
+    assert main(["demo", "-o", str(out), *argv]) == 2
+    assert match in capsys.readouterr().err and not out.exists()
 
 
 def test_verify_rejects_bad_rules_file(tmp_path):
@@ -61,3 +75,18 @@ def test_verify_rejects_bad_rules_file(tmp_path):
     assert main(["verify", "arch", "--rules", str(bad), "--target", "Zstiff > 1"]) == 2
     bad.write_text(json.dumps([{"bounds": {"m": {"in": [8]}}}]))
     assert main(["verify", "arch", "--rules", str(bad), "--target", "Zsniff > 1"]) == 2
+
+
+def test_verify_rules_checks_every_rule_first_and_writes_strict_json(tmp_path):
+    soft = {"tcrease": {"gt": None, "le": 0.6e-3}, "tpanel": {"gt": None, "le": 1.2e-3}}
+    rules = [{"rule": "soft", "bounds": soft}, {"rule": "bad", "bounds": {"W": {"gt": 1.0}}}]
+    with pytest.raises(ValueError, match="outside the scenario's range"):
+        verify_rules("single-miura", rules, "axialstiff60 < 6000", 3)
+    res = verify_rules("single-miura", rules[:1], "axialstiff60 < 6000", 3, seed=4)
+    assert len(res) == 1 and res[0].n_ok == 3
+    # rule i is sampled with seed + i, as verify_rule would be
+    alone = verify_rule("single-miura", soft, "axialstiff60 < 6000", 3, seed=5)
+    assert alone.designs["tcrease"].tolist() == res[0].designs["tcrease"].tolist()
+    report = write_verification(tmp_path / "v", rules[:1], res)
+    assert json.loads((tmp_path / "v" / "verify.json").read_text()) == report
+    assert (tmp_path / "v" / "verify_rule1.csv").is_file()
