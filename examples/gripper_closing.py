@@ -24,14 +24,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib import colors, ticker  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
-from shapely.geometry import Polygon  # noqa: E402
-from shapely.ops import unary_union  # noqa: E402
 
 from holofold.design.scenarios.gripper import (  # noqa: E402
     CLOSURE,
-    CLOSURE_PAIR,
     ROOM_T,
     GripperOptions,
+    gripper_model,
     simulate,
 )
 
@@ -51,24 +49,50 @@ DESIGNS = {
 }  # fmt: skip
 
 #: filled by :func:`main`: {pattern: {"name", "design", "closing_step", "finalQ", "Tmax",
-#: "stiff", "seconds", "png", "result" (GripperResult)}}
+#: "stiff", "seconds", "png", "result" (GripperResult), "tips" (2,) node ids}}
 RESULT: dict = {}
+
+
+def _design(pattern: int) -> dict:
+    return {k: v for k, v in DESIGNS[pattern].items() if k != "name"}
 
 
 def run(pattern: int):
     """Simulate one of :data:`DESIGNS` with history; returns (GripperResult, seconds)."""
-    row = {k: v for k, v in DESIGNS[pattern].items() if k != "name"}
     t0 = time.perf_counter()
-    res = simulate(row, GripperOptions(converged=True, keep_history=True))
+    res = simulate(_design(pattern), GripperOptions(converged=True, keep_history=True))
     return res, time.perf_counter() - t0
 
 
 def _outline(flat: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Outer boundary (k, 3) of the flat sheet (z = 0), without the small mesh holes."""
-    sheet = unary_union([Polygon(p) for p in flat[triangles, :2]]).buffer(1e-9)
-    if sheet.geom_type != "Polygon":
-        sheet = max(sheet.geoms, key=lambda g: g.area)
-    xy = np.asarray(sheet.exterior.coords)
+    """Outer boundary (k + 1, 3) of the flat sheet (z = 0), closed: the largest loop of the mesh
+    edges that belong to one triangle only (the small gaps where creases meet are loops too)."""
+    pairs = np.sort(triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    edges, count = np.unique(pairs, axis=0, return_counts=True)
+    nbr: dict[int, list[int]] = {}
+    for a, b in edges[count == 1].tolist():
+        nbr.setdefault(a, []).append(b)
+        nbr.setdefault(b, []).append(a)
+    if any(len(v) != 2 for v in nbr.values()):
+        raise ValueError("the sheet's boundary edges do not form simple loops")
+    loops, seen = [], set()
+    for start in nbr:
+        if start in seen:
+            continue
+        loop, prev, node = [start], start, nbr[start][0]
+        while node != start:
+            loop.append(node)
+            a, b = nbr[node]
+            prev, node = node, (b if a == prev else a)
+        seen.update(loop)
+        loops.append(np.array(loop))
+
+    def area(loop):
+        x, y = flat[loop, 0], flat[loop, 1]
+        return abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2
+
+    outer = max(loops, key=area)
+    xy = flat[np.append(outer, outer[0]), :2]
     return np.column_stack([xy, np.zeros(len(xy))])
 
 
@@ -80,8 +104,8 @@ def _title(pattern: int, res) -> str:
     )
 
 
-def _draw_shape(fig, ax, cax, pattern: int, res) -> None:
-    """Closed shape (mm) coloured by temperature, flat outline faint, tips marked."""
+def _draw_shape(fig, ax, cax, pattern: int, res, tips) -> None:
+    """Closed shape (mm) coloured by temperature, flat outline faint, ``tips`` (2,) marked."""
     flat = res.nodes * 1e3
     x = (res.nodes + res.displacement) * 1e3
     tri = res.triangles
@@ -100,9 +124,7 @@ def _draw_shape(fig, ax, cax, pattern: int, res) -> None:
         Poly3DCollection(flat[tri], facecolors="#9e9e9e", edgecolors="none", alpha=0.12)
     )
     ax.plot(*_outline(flat, tri).T, color="#6e6e6e", lw=1.0, alpha=0.8)
-    a, b = (i - 1 for i in CLOSURE_PAIR[pattern])
-    tips = x[[a, b]]
-    ax.plot(*tips.T, color="#1f77b4", lw=1.5, marker="o", ms=4, zorder=10)
+    ax.plot(*x[tips].T, color="#1f77b4", lw=1.5, marker="o", ms=4, zorder=10)
     lo = np.minimum(flat.min(axis=0), x.min(axis=0))
     hi = np.maximum(flat.max(axis=0), x.max(axis=0))
     ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], hi[1]), zlim=(lo[2], hi[2]))
@@ -146,14 +168,14 @@ def _draw_history(ax, res) -> None:
 
 
 def draw(results: dict, png: Path) -> None:
-    """One figure: a row per gripper (``results``: {pattern: GripperResult})."""
+    """One figure: a row per gripper (``results``: {pattern: (GripperResult, tips)})."""
     fig = plt.figure(figsize=SIZE_IN, dpi=DPI)
     subfigs = fig.subfigures(len(results), 1, hspace=0.02)
-    for sub, (pattern, res) in zip(np.atleast_1d(subfigs), results.items(), strict=True):
+    for sub, (pattern, (res, tips)) in zip(np.atleast_1d(subfigs), results.items(), strict=True):
         sub.suptitle(_title(pattern, res), fontsize=12, fontweight="bold")
         ax3 = sub.add_axes((-0.05, -0.06, 0.6, 1.04), projection="3d")
         cax = sub.add_axes((0.53, 0.16, 0.012, 0.66))
-        _draw_shape(sub, ax3, cax, pattern, res)
+        _draw_shape(sub, ax3, cax, pattern, res, tips)
         _draw_history(sub.add_axes((0.645, 0.14, 0.3, 0.72)), res)
     png.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(png, dpi=DPI)
@@ -169,10 +191,11 @@ def main(png: str | Path = DEFAULT) -> dict:
         res, sec = run(pattern)
         if res.closing_step is None:
             raise RuntimeError(f"pattern {pattern} did not close: {res.status}")
-        results[pattern] = res
+        tips = gripper_model(_design(pattern)).nodes.tips  # the closure pair, by name
+        results[pattern] = res, tips
         RESULT[pattern] = dict(
             name=DESIGNS[pattern]["name"],
-            design={k: v for k, v in DESIGNS[pattern].items() if k != "name"},
+            design=_design(pattern),
             closing_step=res.closing_step,
             finalQ=res.finalQ,
             Tmax=res.Tmax,
@@ -180,6 +203,7 @@ def main(png: str | Path = DEFAULT) -> dict:
             seconds=sec,
             png=png,
             result=res,
+            tips=tips,
         )
         print(
             f"pattern {pattern} ({DESIGNS[pattern]['name']}): closed at heating step "

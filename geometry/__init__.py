@@ -16,6 +16,7 @@ from holofold.geometry.fold_io import FoldWarning, export_fold, fold_dict, load_
 from holofold.geometry.gripper import (
     DEFAULT_RANGE,
     GRIPPER_NAMES,
+    GripperPattern,
     gripper_pattern,
     miura_based_gripper,
     splitted_miura_gripper,
@@ -48,6 +49,7 @@ __all__ = [
     "tmp_sheet",
     "tmp_nodes",
     "tmp_faces",
+    "GripperPattern",
     "gripper_pattern",
     "miura_based_gripper",
     "splitted_miura_gripper",

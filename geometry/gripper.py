@@ -1,36 +1,28 @@
 """The three electro-thermal gripper patterns of Zhu & Filipov (2022), flat, in metres.
 
 Each generator takes the arm length ``L1``, arm width ``L2``, the tip-segment fraction ``rate``
-and the gap ``range`` between the two arms' roots, and returns a flat
-:class:`~geometry.pattern.CreasePattern` whose vertex ids, face order and face vertex order are
-exactly those of the reference scripts (specs/scenarios.md 4.2), so that the reference crease
-enumeration gives the published crease numbers: ``pattern.edges[c - 1]`` is the scripts' crease
-``c``. Node ids are 0-based here (reference id - 1).
+and the gap ``range`` between the two arms' roots, and returns a :class:`GripperPattern`: the
+flat :class:`~geometry.pattern.CreasePattern` plus the data the paper's scripts attach to it
+(active creases, their bimorph signs and heated lengths). Vertex ids, face order and face vertex
+order are exactly those of the reference scripts, so that the reference crease enumeration gives
+the published crease numbers: ``pattern.edges[c - 1]`` is the scripts' crease ``c``. Ids are
+0-based here (reference number - 1).
 
 The scripts give each active (compliant, bimorph-coated) crease the sign of its layers'
 thermal-expansion mismatch, but that sign is relative to the orientation of the reference
 simulator's rotational springs, which that (2022) simulator did not normalise: a positive sign
 folds crease c toward +z exactly when its raw spring orientation is the normalised one. The
 physical fold direction is therefore ``fold_sign = alpha_sign * orientation``, where
-``orientation`` is -1 when the raw spring ``[N11, c, p1, N21]`` of the compliant mesh
-(mechanics.md 2.2-B: N11 is the earlier panel's copy of the crease end listed first in
-that panel) has a positive
-z component of ``(x_j - x_i) x (x_k - x_j)``. Active creases carry assignment ``V`` where they
-fold toward +z when heated and ``M`` where they fold toward -z; all fold angles are 0 (flat).
-``meta`` holds
-
-``gripper``        1 Miura-based, 2 splitted Miura, 3 two-panel
-``active``         (na,) int, 0-based ids of the compliant creases, increasing
-``alpha_sign``     (na,) float, +1 / -1, the scripts' expansion-mismatch sign (raw orientation)
-``fold_sign``      (na,) float, +1 / -1, physical fold direction (+1 toward +z)
-``heat_length``    (na,) float, metres: the crease length the scripts multiply by the heating
-                   rate (W/m per step) for each active crease, "as coded" (4.7)
-``range``, ``L1``, ``L2``, ``rate``   the inputs.
+``orientation`` is -1 when the raw spring ``[N11, c, p1, N21]`` of the compliant mesh (N11: the
+earlier panel's copy of the crease end listed first in that panel) has a positive z component of
+``(x_j - x_i) x (x_k - x_j)``. Active creases carry assignment ``V`` where they fold toward +z
+when heated and ``M`` where they fold toward -z; all fold angles are 0 (flat).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -38,6 +30,7 @@ from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.pattern import CreasePattern
 
 __all__ = [
+    "GripperPattern",
     "miura_based_gripper",
     "splitted_miura_gripper",
     "two_panel_gripper",
@@ -46,9 +39,52 @@ __all__ = [
     "GRIPPER_NAMES",
 ]
 
-#: default gap between the arm roots ("range"), metres, per pattern 1/2/3 (scenarios.md 4.2)
+#: default gap between the arm roots ("range"), metres, per pattern 1/2/3
 DEFAULT_RANGE = {1: 2e-3, 2: 1e-3, 3: 2e-3}
 GRIPPER_NAMES = {1: "miura-based", 2: "splitted-miura", 3: "two-panel"}
+
+
+@dataclass(frozen=True, eq=False)
+class GripperPattern:
+    """A flat gripper pattern and what the reference scripts attach to it.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+        The flat pattern (z = 0), numbered as in the reference scripts.
+    kind : int
+        1 Miura-based, 2 splitted Miura, 3 two-panel.
+    L1, L2 : float
+        Arm length and arm width, m.
+    rate : float
+        Tip-segment fraction of ``L1``.
+    range : float
+        Gap between the two arms' roots, m.
+    active : (na,) int
+        Edge ids of the compliant (bimorph) creases, increasing.
+    alpha_sign : (na,) float
+        +1 / -1: the scripts' expansion-mismatch sign (raw spring orientation).
+    fold_sign : (na,) float
+        +1 / -1: the physical fold direction (+1 toward +z).
+    heat_length : (na,) float
+        Length of each active crease as the scripts multiply it by the heating rate, m.
+    """
+
+    pattern: CreasePattern
+    kind: int
+    L1: float
+    L2: float
+    rate: float
+    range: float
+    active: np.ndarray
+    alpha_sign: np.ndarray
+    fold_sign: np.ndarray
+    heat_length: np.ndarray
+
+    @property
+    def name(self) -> str:
+        """``miura-based``, ``splitted-miura`` or ``two-panel``."""
+        return GRIPPER_NAMES[self.kind]
 
 
 def _check(L1, L2, rate, range_):
@@ -85,7 +121,7 @@ def _raw_orientation(pat: CreasePattern, creases: np.ndarray) -> np.ndarray:
     return out
 
 
-def _build(coords2d, faces1, active1, signs, heat_length, meta) -> CreasePattern:
+def _build(kind, coords2d, faces1, active1, signs, heat_length, L1, L2, rate, r):
     coords2d = np.asarray(coords2d, float)
     faces = [np.asarray(f, np.int64) - 1 for f in faces1]
     pat = CreasePattern.from_faces(
@@ -100,19 +136,30 @@ def _build(coords2d, faces1, active1, signs, heat_length, meta) -> CreasePattern
     signs = np.asarray(signs, float)
     fold = signs * _raw_orientation(pat, active)
     asg[active] = np.where(fold > 0, "V", "M")
-    meta = dict(meta)
-    meta.update(
+    flat = CreasePattern(
+        pat.coords,
+        pat.faces,
+        pat.edges,
+        asg,
+        np.zeros(len(pat.edges)),
+        flat=coords2d,
+        meta={"kind": f"{GRIPPER_NAMES[kind]} gripper"},
+    )
+    return GripperPattern(
+        pattern=flat,
+        kind=kind,
+        L1=L1,
+        L2=L2,
+        rate=rate,
+        range=r,
         active=active,
         alpha_sign=signs,
         fold_sign=fold,
         heat_length=np.asarray(heat_length, float),
     )
-    return CreasePattern(
-        pat.coords, pat.faces, pat.edges, asg, np.zeros(len(pat.edges)), flat=coords2d, meta=meta
-    )
 
 
-def miura_based_gripper(L1: float, L2: float, rate: float, range_: float = 2e-3) -> CreasePattern:
+def miura_based_gripper(L1: float, L2: float, rate: float, range_: float = 2e-3) -> GripperPattern:
     """Pattern 1, the Miura-based gripper (12 vertices, 10 panels, 21 edges, 13 active creases).
 
     Arms along +-x. Requires ``(1 - rate) L1 > L2 / 2`` (the arm's root fold line must lie
@@ -144,13 +191,12 @@ def miura_based_gripper(L1: float, L2: float, rate: float, range_: float = 2e-3)
     sq = math.sqrt(2) * L2 / 2
     lengths = {1: r, 2: diag, 3: diag, 4: diag, 5: diag, 6: arm_root, 14: arm_root,
                8: sq, 9: sq, 15: sq, 17: sq, 12: tip, 19: tip}  # fmt: skip
-    meta = dict(gripper=1, L1=L1, L2=L2, rate=rate, range=r)
-    return _build(xy, faces, active, signs, [lengths[c] for c in active], meta)
+    return _build(1, xy, faces, active, signs, [lengths[c] for c in active], L1, L2, rate, r)
 
 
 def splitted_miura_gripper(
     L1: float, L2: float, rate: float, range_: float = 1e-3
-) -> CreasePattern:
+) -> GripperPattern:
     """Pattern 2, the splitted-Miura gripper (24 vertices, 15 panels, 22 active creases).
 
     Arms along +-y. Requires ``(1 - rate) L1 > L2 / 2``.
@@ -186,11 +232,10 @@ def splitted_miura_gripper(
     lengths.update({c: s2 for c in (6, 7, 8, 10, 13, 17, 26, 30)})
     lengths.update({c: (1 - rate) * L1 for c in (11, 14, 27, 29)})
     lengths.update({c: rate * L1 for c in (19, 21, 34, 36)})
-    meta = dict(gripper=2, L1=L1, L2=L2, rate=rate, range=r)
-    return _build(xy, faces, active, signs, [lengths[c] for c in active], meta)
+    return _build(2, xy, faces, active, signs, [lengths[c] for c in active], L1, L2, rate, r)
 
 
-def two_panel_gripper(L1: float, L2: float, rate: float, range_: float = 2e-3) -> CreasePattern:
+def two_panel_gripper(L1: float, L2: float, rate: float, range_: float = 2e-3) -> GripperPattern:
     """Pattern 3, the two-panel gripper (12 vertices, 5 panels, 4 active creases).
 
     Arms along +-y, each of a root panel and a tip panel.
@@ -205,8 +250,7 @@ def two_panel_gripper(L1: float, L2: float, rate: float, range_: float = 2e-3) -
     ]  # fmt: skip
     faces = [[1, 2, 4, 3], [3, 4, 6, 5], [5, 6, 8, 7], [9, 10, 2, 1], [11, 12, 10, 9]]
     active = [2, 4, 7, 12]
-    meta = dict(gripper=3, L1=L1, L2=L2, rate=rate, range=r)
-    return _build(xy, faces, active, [1.0] * 4, [L2] * 4, meta)
+    return _build(3, xy, faces, active, [1.0] * 4, [L2] * 4, L1, L2, rate, r)
 
 
 _GENERATORS = {1: miura_based_gripper, 2: splitted_miura_gripper, 3: two_panel_gripper}
@@ -214,7 +258,7 @@ _GENERATORS = {1: miura_based_gripper, 2: splitted_miura_gripper, 3: two_panel_g
 
 def gripper_pattern(
     pattern: int, L1: float, L2: float, rate: float, range_: float | None = None
-) -> CreasePattern:
+) -> GripperPattern:
     """Pattern ``pattern`` (1, 2 or 3) with its default ``range`` unless one is given."""
     try:
         p = int(pattern)

@@ -1,8 +1,8 @@
 """Modelling profiles: every reference-simulator quirk behind one named switch.
 
 The published databases of Zhu & Filipov (2022) were computed with the MATLAB simulator SWOMPS,
-which has a few slips that move the numbers by up to a few per cent (specs/mechanics.md 10,
-specs/scenarios.md 1.3 and 7.2). A :class:`Profile` names each of them:
+which has a few slips that move the numbers by up to a few per cent (docs/bar-and-hinge.md §8,
+docs/electro-thermal.md §7, docs/scenarios.md §7). A :class:`Profile` names each of them:
 
 * :data:`PAPER` keeps every quirk: it reproduces the published rows (to ~1e-6) and is what the
   paper's scenarios (:mod:`design.scenarios`) use.
@@ -11,13 +11,29 @@ specs/scenarios.md 1.3 and 7.2). A :class:`Profile` names each of them:
 
 Which value of each switch is physically right is stated in the field's description below.
 Build your own mix with ``dataclasses.replace(PAPER, edge_bar_area_last_panel=False)``.
+
+The gripper scripts also report their outputs through closed-form formulas with slips of their
+own; :func:`gripper_final_q`, :func:`gripper_closing_step`, :func:`gripper_air_gap` and
+:func:`gripper_prying_stiffness` reproduce them (patterns 1 Miura-based, 2 splitted Miura,
+3 two-panel; lengths in m).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-__all__ = ["Profile", "PAPER", "PHYSICAL"]
+import numpy as np
+
+__all__ = [
+    "Profile",
+    "PAPER",
+    "PHYSICAL",
+    "gripper_final_q",
+    "gripper_closing_step",
+    "gripper_air_gap",
+    "gripper_prying_stiffness",
+]
 
 
 @dataclass(frozen=True)
@@ -45,7 +61,7 @@ class Profile:
         right angles). Physically right (False): ``(W1 v2 + W2 v1) / (2 sin beta)``, which
         puts the corner at distance ``W/2`` from both crease lines.
     polarity_z_only : bool
-        Spring orientation (specs/mechanics.md 2.2-E): the reference swaps i and l when the z
+        Spring orientation (docs/bar-and-hinge.md §2.5): the reference swaps i and l when the z
         component of ``(x_j - x_i) x (x_k - x_j)`` is positive and leaves springs with a zero z
         component unchanged. False adds the fallback to the y, then the x component (springs
         on vertical panels get a defined orientation). Neither changes any mechanics (the
@@ -112,3 +128,92 @@ PHYSICAL = Profile(
     dissipation_pi_314=False,
     published_gripper_stiffness=False,
 )
+
+
+# --------------------------------------------------------------------------- gripper formulas
+#: heating steps lost to the gripper scripts' heating ramp, per pattern (see gripper_final_q)
+_RAMP_OFFSET = {1: 17.0, 2: 26.5, 3: 0.0}
+
+
+def gripper_final_q(kind: int, L1, L2, step, range_: float, *, rate: float = 0.1):
+    """finalQ, W: the heating power the gripper scripts report for closure at ``step``.
+
+    ``L1``, ``L2`` (arm length and width, m) and ``step`` (closing heating step, 1-based)
+    broadcast; ``range_`` is the gap between the arm roots, m; ``rate`` the heating per metre of
+    crease and step, W/m. The scripts write the power in closed form: ``rate`` x the summed
+    active-crease length x the cumulative ramp factor, ``step - 17`` for pattern 1 (10 steps at
+    0.1, 10 at 0.2, then 1 per step), ``step - 26.5`` for pattern 2 (10 steps each at 0.05, 0.1
+    and 0.2) and ``step`` for pattern 3 (no ramp). Pattern 1's sum counts the four
+    base-diagonal creases (sqrt(r^2 + L2^2) / 2 each) once instead of twice, so its finalQ is
+    short of the power applied. Kept: the published finalQ column is this formula (every
+    published row decodes to a whole heating step).
+    """
+    r = float(range_)
+    L1, L2, step = (np.asarray(v, float) for v in (L1, L2, step))
+    s2 = np.sqrt(2.0)
+    if kind == 1:
+        return rate * (r + 2 * L1 + np.hypot(r, L2) + 2 * s2 * L2) * (step - 17)
+    if kind == 2:
+        return rate * (4 * L1 + 2 * s2 * L2 + 2 * L2 + 2 * r) * (step - 26.5)
+    if kind == 3:
+        return rate * 4 * L2 * step
+    raise ValueError(f"gripper kind = {kind!r}; allowed: 1, 2, 3")
+
+
+def gripper_closing_step(kind: int, L1, L2, final_q, range_: float, *, rate: float = 0.1):
+    """Inverse of :func:`gripper_final_q`: the (real-valued) closing heating step of a
+    published ``final_q`` (W); arrays broadcast. Whole numbers for the published rows."""
+    unit = gripper_final_q(kind, L1, L2, 1.0, range_, rate=rate) - gripper_final_q(
+        kind, L1, L2, 0.0, range_, rate=rate
+    )
+    return np.asarray(final_q, float) / unit + _RAMP_OFFSET[kind]
+
+
+def gripper_air_gap(kind: int, L1: float, L2: float, range_: float) -> float:
+    """Thickness of the air layer between a gripper and the room-temperature sink, m.
+
+    The scripts' ``t2RT``: 1.5 x the mean active-crease length, from the summed length of
+    :func:`gripper_final_q` over the 13 (pattern 1) or 22 (pattern 2) active creases, and
+    1.5 L2 for pattern 3. Pattern 1's sum carries the same single count of the base diagonals;
+    kept because the published temperatures were computed with it.
+    """
+    r = range_
+    if kind == 1:
+        return 1.5 * (r + 2 * L1 + math.hypot(r, L2) + 2 * math.sqrt(2) * L2) / 13
+    if kind == 2:
+        return 1.5 * (4 * L1 + 2 * math.sqrt(2) * L2 + 2 * L2 + 2 * r) / 22
+    if kind == 3:
+        return 1.5 * L2
+    raise ValueError(f"gripper kind = {kind!r}; allowed: 1, 2, 3")
+
+
+def gripper_prying_stiffness(
+    kind: int,
+    du: float,
+    *,
+    force: float,
+    increments: int,
+    run_increments: int,
+    nodes: int = 2,
+    profile: Profile = PAPER,
+) -> float:
+    """Prying stiffness of a closed gripper, N/m, as the gripper scripts report it.
+
+    ``du`` (m) is the displacement of the probe node along the arm axis over ``increments``
+    load increments of ``force`` (N on each of the ``nodes`` loaded nodes of an arm) of a
+    Newton run of ``run_increments`` increments. The plain secant stiffness is
+    ``increments * nodes * force / du``. With ``profile.published_gripper_stiffness`` the
+    scripts' formulas instead, kept because the published stiff column is theirs:
+
+    * pattern 1 divides the force of all ``run_increments`` (5) increments by the displacement
+      after ``increments`` (3): 5/3 of the secant stiffness;
+    * pattern 3 counts the force of one node, not of the arm's two: half of it;
+    * pattern 2 is the secant stiffness (its run has 3 increments).
+    """
+    if kind not in (1, 2, 3):
+        raise ValueError(f"gripper kind = {kind!r}; allowed: 1, 2, 3")
+    if profile.published_gripper_stiffness and kind == 1:
+        return run_increments * nodes * force / du
+    if profile.published_gripper_stiffness and kind == 3:
+        return increments * force / du
+    return increments * nodes * force / du

@@ -273,13 +273,17 @@ class Structure:
         """(nf,) int: DOFs that are not supported."""
         return np.flatnonzero(~self.supports.ravel())
 
-    def vertex_nodes(self, vertices) -> np.ndarray:
+    def vertex_nodes(self, vertices, panel: int | None = None) -> np.ndarray:
         """Ids of the nodes standing for the pattern vertices ``vertices`` (every copy of a
-        vertex in a compliant model, the vertex itself in a concentrated one), ascending."""
+        vertex in a compliant model, the vertex itself in a concentrated one), ascending;
+        with ``panel``, only the copies in that panel's triangles."""
         v = np.atleast_1d(np.asarray(vertices, np.intp))
-        if self.node_vertex is None:
-            return np.unique(v)
-        return np.flatnonzero(np.isin(self.node_vertex, v))
+        nodes = np.unique(v) if self.node_vertex is None else np.flatnonzero(
+            np.isin(self.node_vertex, v)
+        )  # fmt: skip
+        if panel is None:
+            return nodes
+        return np.intersect1d(nodes, self.triangles[self.tri_panel == panel])
 
     # ------------------------------------------------------------------ changed copies
     def with_supports(self, supports) -> Structure:

@@ -9,7 +9,15 @@ import pytest
 
 from holofold.design.scenarios.single_miura import EXTENSIONS, cell_models
 from holofold.mechanics.analyses import secant_stiffness
-from holofold.mechanics.compat import PAPER, PHYSICAL, Profile
+from holofold.mechanics.compat import (
+    PAPER,
+    PHYSICAL,
+    Profile,
+    gripper_air_gap,
+    gripper_closing_step,
+    gripper_final_q,
+    gripper_prying_stiffness,
+)
 
 FIELDS = {
     "edge_bar_area_last_panel",
@@ -46,8 +54,8 @@ def _stiffness(row, profile):
 
 
 def test_edge_area_quirk_moves_data0_row1_as_documented(reference_data):
-    """specs/scenarios.md 1.3: accumulating the edge areas gives 5870.5 / 11683.2 / 70595.0
-    for data0 row 1 instead of the published 6004.7 / 11762.5 / 71445.7."""
+    """docs/bar-and-hinge.md §8.2: accumulating the edge areas gives 5870.5 / 11683.2 /
+    70595.0 for data0 row 1 instead of the published 6004.7 / 11762.5 / 71445.7."""
     d = reference_data.load("data0_SingleMiura")
     row = d.iloc[0][["tcrease", "tpanel", "W", "gama"]].to_numpy()
     published = d.iloc[0][["axialstiff30", "axialstiff60", "axialstiff90"]].to_numpy()
@@ -108,3 +116,63 @@ def test_arccos_dihedral_matches_exact_angle_and_rounds_near_flat():
     _, f_acos, _ = Assembler(s_acos).evaluate(U)
     ratio = (t_acos - s.spring_rest[0]) / (t_exact - s.spring_rest[0])
     np.testing.assert_allclose(f_acos[9:], ratio * f_exact[9:], rtol=1e-9)
+
+
+# ---------------------------------------------------------------- gripper reporting formulas
+# values of the formulas as the gripper scenario computed them before they moved here (exact)
+GRIPPER_L1, GRIPPER_L2 = 5.2e-3, 2.9e-3
+GRIPPER_RANGE = {1: 2e-3, 2: 1e-3, 3: 2e-3}
+FINAL_Q_AT_120 = {1: 0.24848978302101427, 2: 0.344102801487493, 3: 0.1392}
+AIR_GAP = {1: 0.002783679421445268, 2: 0.002509257181483906, 3: 0.00435}
+
+
+@pytest.mark.parametrize("kind", [1, 2, 3])
+def test_gripper_final_q_closing_step_and_air_gap_keep_their_values(kind):
+    r = GRIPPER_RANGE[kind]
+    q = gripper_final_q(kind, GRIPPER_L1, GRIPPER_L2, 120, r)
+    assert float(q) == FINAL_Q_AT_120[kind]
+    step = gripper_closing_step(kind, GRIPPER_L1, GRIPPER_L2, q, r)
+    assert step == pytest.approx(120, abs=1e-12)
+    assert gripper_air_gap(kind, GRIPPER_L1, GRIPPER_L2, r) == AIR_GAP[kind]
+    # arrays broadcast; the step offsets are the cumulative heating ramp (17 / 26.5 / 0 steps)
+    steps = np.array([30.0, 31.0])
+    q2 = gripper_final_q(kind, GRIPPER_L1, GRIPPER_L2, steps, r)
+    offset = {1: 17.0, 2: 26.5, 3: 0.0}[kind]
+    np.testing.assert_allclose(q2 / (steps - offset), q2[0] / (30 - offset), rtol=1e-14)
+    np.testing.assert_allclose(gripper_closing_step(kind, GRIPPER_L1, GRIPPER_L2, q2, r), steps)
+
+
+def test_gripper_final_q_undercounts_the_pattern_1_base_diagonals():
+    """Pattern 1's length sum has sqrt(r^2 + L2^2) once; the four base diagonals applied are
+    twice that (each half of it)."""
+    r, L1, L2 = 2e-3, GRIPPER_L1, GRIPPER_L2
+    applied = r + 4 * 0.5 * np.hypot(r, L2) + 2 * L1 + 2 * np.sqrt(2) * L2
+    per_step = gripper_final_q(1, L1, L2, 18, r) - gripper_final_q(1, L1, L2, 17, r)
+    assert per_step == pytest.approx(0.1 * (applied - np.hypot(r, L2)), rel=1e-14)
+    assert gripper_air_gap(1, L1, L2, r) == pytest.approx(1.5 * per_step / 0.1 / 13, rel=1e-14)
+    with pytest.raises(ValueError, match="kind"):
+        gripper_final_q(4, L1, L2, 18, r)
+
+
+def test_gripper_prying_stiffness_published_and_plain():
+    du = 3.7e-6
+    pattern12 = dict(force=1e-8, increments=3)
+    pattern3 = dict(force=1e-10, increments=49, run_increments=50)
+    # published formulas (values of the scenario before the move, exact)
+    assert gripper_prying_stiffness(1, du, **pattern12, run_increments=5) == 0.027027027027027025
+    assert gripper_prying_stiffness(2, du, **pattern12, run_increments=3) == 0.016216216216216217
+    assert gripper_prying_stiffness(3, du, **pattern3) == 0.0013243243243243243
+    # the plain secant stiffness: total force of an arm's two nodes over du
+    plain = dataclasses.replace(PAPER, published_gripper_stiffness=False)
+    assert PHYSICAL.published_gripper_stiffness is False
+    k1 = gripper_prying_stiffness(1, du, **pattern12, run_increments=5, profile=plain)
+    k3 = gripper_prying_stiffness(3, du, **pattern3, profile=plain)
+    assert k1 == 0.016216216216216217 and k3 == 0.0026486486486486487
+    assert k1 == pytest.approx(3 * 2 * 1e-8 / du, rel=1e-15)
+    # pattern 1 publishes 5/3 and pattern 3 1/2 of it; pattern 2 is the plain one
+    assert gripper_prying_stiffness(1, du, **pattern12, run_increments=5) == pytest.approx(
+        5 / 3 * k1, rel=1e-15
+    )
+    assert gripper_prying_stiffness(3, du, **pattern3) == pytest.approx(k3 / 2, rel=1e-15)
+    k2 = gripper_prying_stiffness(2, du, **pattern12, run_increments=3, profile=plain)
+    assert k2 == gripper_prying_stiffness(2, du, **pattern12, run_increments=3)

@@ -31,7 +31,7 @@ RECORDED_GRIPPERS = {3: (155, 2.0807132979735573e-04, 337.41693604377355),
 
 @pytest.mark.slow
 def test_gripper_closing_example(tmp_path, monkeypatch):
-    from holofold.design.scenarios.gripper import CLOSURE_PAIR, published_q
+    from holofold.design.scenarios.gripper import gripper_model, published_q
 
     png = tmp_path / "gripper.png"
     monkeypatch.setattr(sys, "argv", ["gripper_closing.py", str(png)])
@@ -58,6 +58,6 @@ def test_gripper_closing_example(tmp_path, monkeypatch):
         assert row["Tmax"] == pytest.approx(tmax0, rel=1e-9)
         # the drawn shape is the closed one: arms lifted off the plane, tips within 1 mm
         x = sim.nodes + sim.displacement
-        a, b = (i - 1 for i in CLOSURE_PAIR[pattern])
+        a, b = gripper_model(d).nodes.tips
         assert np.linalg.norm(x[a] - x[b]) == pytest.approx(sim.tip_distance[-1], rel=1e-12)
         assert sim.triangles.max() < len(x) and x[:, 2].max() > 1e-3

@@ -1,4 +1,4 @@
-"""The three gripper patterns: crease numbering (scenarios.md 4.2) and meshed node ids (4.3)."""
+"""The three gripper patterns: crease numbering and meshed node ids of the reference scripts."""
 
 from __future__ import annotations
 
@@ -7,6 +7,9 @@ import pytest
 
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.gripper import (
+    DEFAULT_RANGE,
+    GRIPPER_NAMES,
+    GripperPattern,
     gripper_pattern,
     miura_based_gripper,
     splitted_miura_gripper,
@@ -16,7 +19,7 @@ from holofold.mechanics.hinges import build_compliant
 
 L1, L2, RATE, W = 5.2e-3, 2.9e-3, 0.37, 180e-6
 
-# interior creases as (reference number, vertex a, vertex b), 1-based, from scenarios.md 4.2
+# interior creases as (reference number, vertex a, vertex b), 1-based, as the scripts number them
 CREASES = {
     1: [(1, 1, 2), (2, 1, 3), (3, 2, 3), (4, 1, 4), (5, 2, 4), (6, 2, 6), (8, 5, 6), (9, 6, 7),
         (12, 6, 8), (14, 1, 10), (15, 9, 10), (17, 10, 11), (19, 10, 12)],
@@ -33,7 +36,7 @@ MINUS = {1: {4, 6, 12, 17}, 2: {27, 29}, 3: set()}
 def _mesh(p):
     pat = gripper_pattern(p, L1, L2, RATE)
     s = build_compliant(
-        pat,
+        pat.pattern,
         crease_width=W,
         crease_thickness=1e-6,
         panel_thickness=20e-6,
@@ -48,20 +51,21 @@ def _mesh(p):
 @pytest.mark.parametrize("p", [1, 2, 3])
 def test_reference_crease_numbers(p):
     pat = gripper_pattern(p, L1, L2, RATE)
-    assert pat.n_edges == N_EDGES[p]
-    got = [(i + 1, a + 1, b + 1) for i, (a, b) in enumerate(pat.edges) if pat.interior[i]]
+    assert pat.pattern.n_edges == N_EDGES[p]
+    edges, interior = pat.pattern.edges, pat.pattern.interior
+    got = [(i + 1, a + 1, b + 1) for i, (a, b) in enumerate(edges) if interior[i]]
     assert got == CREASES[p]
-    active = pat.meta["active"] + 1
+    active = pat.active + 1
     assert active.tolist() == [c for c, _, _ in CREASES[p]]
-    minus = {int(c) for c, s in zip(active, pat.meta["alpha_sign"], strict=True) if s < 0}
+    minus = {int(c) for c, s in zip(active, pat.alpha_sign, strict=True) if s < 0}
     assert minus == MINUS[p]
-    assert np.all(pat.coords[:, 2] == 0)
+    assert np.all(pat.pattern.coords[:, 2] == 0)
 
 
 def test_heat_lengths_as_coded():
     r = 2e-3
     pat = miura_based_gripper(L1, L2, RATE)
-    h = dict(zip((pat.meta["active"] + 1).tolist(), pat.meta["heat_length"], strict=True))
+    h = dict(zip((pat.active + 1).tolist(), pat.heat_length, strict=True))
     assert h[1] == pytest.approx(r)
     assert h[3] == pytest.approx(0.5 * np.hypot(r, L2))
     assert h[6] == h[14] == pytest.approx((1 - RATE) * L1 - L2 / 2)
@@ -69,8 +73,8 @@ def test_heat_lengths_as_coded():
     # the coded lengths are the true crease lengths for patterns 2 and 3
     for p in (2, 3):
         pat = gripper_pattern(p, L1, L2, RATE)
-        true = pat.edge_lengths[pat.meta["active"]]
-        np.testing.assert_allclose(pat.meta["heat_length"], true, rtol=1e-12)
+        true = pat.pattern.edge_lengths[pat.active]
+        np.testing.assert_allclose(pat.heat_length, true, rtol=1e-12)
 
 
 @pytest.mark.parametrize("p,nn,nb", [(1, 83, 198), (2, 141, 340), (3, 37, 80)])
@@ -79,7 +83,7 @@ def test_mesh_sizes(p, nn, nb):
     assert (s.n_nodes, len(s.bars)) == (nn, nb)
 
 
-# (meshed id, pattern vertex id), 1-based, scenarios.md 4.3
+# (meshed id, pattern vertex id), 1-based, as the scripts use them
 NODE_IDS = {
     1: [(1, 1), (4, 1), (3, 2), (5, 2), (2, 3), (8, 3), (24, 3), (6, 4), (14, 4), (27, 4),
         (16, 8), (19, 8), (29, 12), (32, 12)],
@@ -102,7 +106,7 @@ def test_meshed_node_ids(p):
         for c, node, tip in ((12, 59, 8), (19, 71, 12)):
             p1, p2 = s.creases.nodes[cid.index(c - 1), 4:6]
             assert p1 == node - 1
-            d1, d2 = np.linalg.norm(s.nodes[[p1, p2]] - pat.coords[tip - 1], axis=1)
+            d1, d2 = np.linalg.norm(s.nodes[[p1, p2]] - pat.pattern.coords[tip - 1], axis=1)
             assert d1 < 4 * W < d2
 
 
@@ -113,16 +117,16 @@ def test_fold_sign_matches_raw_mesh_orientation(p):
     X = s.nodes
     n11, _, n21, _, p1, _, c = s.creases.nodes.T
     z = np.cross(X[c] - X[n11], X[p1] - X[c])[:, 2]
-    order = np.searchsorted(pat.meta["active"], s.creases.ids)
-    expect = pat.meta["alpha_sign"][order] * np.where(z > 0, -1.0, 1.0)
-    np.testing.assert_array_equal(pat.meta["fold_sign"][order], expect)
-    asg = pat.assignment[pat.meta["active"]]
-    np.testing.assert_array_equal(asg == "V", pat.meta["fold_sign"] > 0)
+    order = np.searchsorted(pat.active, s.creases.ids)
+    expect = pat.alpha_sign[order] * np.where(z > 0, -1.0, 1.0)
+    np.testing.assert_array_equal(pat.fold_sign[order], expect)
+    asg = pat.pattern.assignment[pat.active]
+    np.testing.assert_array_equal(asg == "V", pat.fold_sign > 0)
 
 
 def test_two_panel_is_mirror_symmetric_in_folding():
     pat = two_panel_gripper(L1, L2, RATE)
-    assert np.all(pat.meta["fold_sign"] > 0)
+    assert np.all(pat.fold_sign > 0)
 
 
 def test_bad_parameters():
@@ -134,3 +138,17 @@ def test_bad_parameters():
         miura_based_gripper(-1.0, L2, RATE)
     with pytest.raises(ParameterError, match="pattern"):
         gripper_pattern(4, L1, L2, RATE)
+
+
+@pytest.mark.parametrize("p", [1, 2, 3])
+def test_gripper_pattern_fields(p):
+    """Explicit fields instead of meta keys."""
+    grip = gripper_pattern(p, L1, L2, RATE)
+    assert isinstance(grip, GripperPattern) and grip.kind == p and grip.name == GRIPPER_NAMES[p]
+    assert (grip.L1, grip.L2, grip.rate, grip.range) == (L1, L2, RATE, DEFAULT_RANGE[p])
+    na = len(grip.active)
+    assert grip.alpha_sign.shape == grip.fold_sign.shape == grip.heat_length.shape == (na,)
+    assert np.all(np.diff(grip.active) > 0) and np.all(grip.heat_length > 0)
+    assert grip.pattern.meta == {"kind": f"{GRIPPER_NAMES[p]} gripper"}
+    assert grip.pattern.interior[grip.active].all()
+    assert gripper_pattern(p, L1, L2, RATE, 1.5e-3).range == 1.5e-3

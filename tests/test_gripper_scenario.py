@@ -8,20 +8,27 @@ import math
 import numpy as np
 import pytest
 
-from holofold.design.scenarios import get_scenario
+from holofold.design.scenarios import get_scenario, gripper
 from holofold.design.scenarios.gripper import (
     SCENARIO,
     STATUS_NO_CLOSURE,
     GripperOptions,
     check,
     decode_closing_step,
+    gripper_model,
     published_q,
+    run_frequency,
+    run_heating,
+    run_prebias,
+    run_prying,
     simulate,
 )
 from holofold.mechanics.compat import PAPER
+from holofold.mechanics.status import Outcome, Status
+from holofold.mechanics.structure import support_mask
 
 STEMS = ["data2_MiuraBased_sample", "data2_SplittedMiura_sample", "data2_TwoPanel_sample"]
-STEP_RANGE = {1: (67, 387), 2: (72, 398), 3: (41, 298)}  # scenarios.md 4.7
+STEP_RANGE = {1: (67, 387), 2: (72, 398), 3: (41, 298)}  # of the published rows
 
 
 @pytest.mark.parametrize("stem", STEMS)
@@ -176,3 +183,147 @@ def test_scenario_columns():
     assert SCENARIO.feature_names == ["Pattern", "L1", "L2", "t1", "t2", "tpanel", "rate", "W"]
     assert SCENARIO.performance_names == ["freqFinal", "finalQ", "Tmax", "stiff"]
     assert [c.unit for c in SCENARIO.performance] == ["rad/s", "W", "degC", "N/m"]
+
+
+# ---------------------------------------------------------------- named node sets
+ALL = "xyz"
+#: the scenario's former tables of 1-based meshed node ids, as the reference scripts list them
+FREQ_SUPPORTS = {
+    1: [(n, ALL) for n in (1, 3, 4, 5, 74, 75)],
+    2: [(n, ALL) for n in (1, 2, 3, 4)],
+    3: [(n, ALL) for n in (1, 2, 3, 4)],
+}
+PREBIAS_SUPPORTS = {
+    1: [(1, "xy"), (3, "xy"), (4, "x"), (5, "x"), (74, "xz"), (75, "xz")],
+    2: [(n, ALL) for n in (1, 2, 3, 4)],
+}
+PREBIAS_SUPPORTS_7CD7ABC = [(1, "xy"), (3, "xy"), (4, "x"), (5, "x"), (74, "z"), (75, "z")]
+PREBIAS_LOADS = {  # (nodes, axis, sign)
+    1: [((2, 6, 8, 24), 2, -1.0), ((14, 27), 2, 1.0)],
+    2: [((15, 24, 38, 46), 2, -1.0), ((31, 32, 53, 54), 2, 1.0)],
+}
+THERMAL_SUPPORTS = {
+    1: [(1, "xy"), (4, "xy"), (4, "x"), (5, "x"), (74, "xz"), (75, "xz")],
+    2: [(n, ALL) for n in (1, 2, 3, 4)],
+    3: [(n, ALL) for n in (1, 2, 3, 4)],
+}
+STIFF_SUPPORTS = {
+    1: [(1, "xy"), (3, "xy"), (4, "x"), (5, "x"), (74, "xz"), (75, "xz")],
+    2: [(n, ALL) for n in (1, 2, 3, 4)],
+    3: [(n, ALL) for n in (1, 2, 3, 4)],
+}
+STIFF_LOADS = {
+    1: [((29, 32), 0, -1.0), ((16, 19), 0, 1.0)],
+    2: [((31, 32), 1, 1.0), ((53, 54), 1, -1.0)],
+    3: [((17, 18), 1, -1.0), ((11, 12), 1, 1.0)],
+}
+CLOSURE_PAIR = {1: (59, 71), 2: (32, 53), 3: (12, 17)}
+STIFF_PROBE = {1: (16, 0), 2: (31, 1), 3: (11, 1)}  # (node, axis) whose displacement is measured
+DESIGN = dict(L1=5.2e-3, L2=2.9e-3, t1=0.2e-6, t2=0.8e-6, tpanel=20e-6, rate=0.37, W=180e-6)
+
+
+def _entries(groups):
+    """[(1-based node, dofs), ...] of ((nodes, dofs), ...) support groups, in order."""
+    return [(int(i) + 1, dofs) for nodes, dofs in groups for i in nodes]
+
+
+def _loads(groups):
+    """{(node, axis): sign} of ((nodes, axis, sign), ...) load groups."""
+    return {(int(i), axis): sign for nodes, axis, sign in groups for i in nodes}
+
+
+@pytest.mark.parametrize("P", [1, 2, 3])
+def test_named_node_sets_are_the_reference_scripts_ids(P):
+    """Every support and load of the scenario, now chosen by name, is the node list the
+    reference scripts use (including pattern 1's thermal list: node 4 twice, node 3 never)."""
+    model = gripper_model(DESIGN | {"Pattern": P})
+    n, nn = model.nodes, model.structure.n_nodes
+    assert _entries(n.clamp) == FREQ_SUPPORTS[P]
+    assert _entries(n.hold) == STIFF_SUPPORTS[P]
+    assert _entries(n.hold_heating) == THERMAL_SUPPORTS[P]
+    if P in PREBIAS_SUPPORTS:
+        assert _entries(n.hold) == PREBIAS_SUPPORTS[P]
+        seven = PREBIAS_SUPPORTS_7CD7ABC if P == 1 else PREBIAS_SUPPORTS[P]
+        assert _entries(n.hold_7cd7abc) == seven
+        got = [(n.prebias_down + 1, 2, -1.0), (n.prebias_up + 1, 2, 1.0)]
+        assert _loads(got) == _loads(PREBIAS_LOADS[P])
+        assert [tuple(g[0]) for g in got] == [g[0] for g in PREBIAS_LOADS[P]]  # same order
+    else:
+        assert len(n.prebias_down) == len(n.prebias_up) == 0
+    got = [(n.pry_plus + 1, n.arm_axis, 1.0), (n.pry_minus + 1, n.arm_axis, -1.0)]
+    assert _loads(got) == _loads(STIFF_LOADS[P])
+    assert tuple(n.tips + 1) == CLOSURE_PAIR[P]
+    assert (n.probe + 1, n.arm_axis) == STIFF_PROBE[P]
+    # the support masks the solvers see
+    for groups, table in ((n.clamp, FREQ_SUPPORTS[P]), (n.hold_heating, THERMAL_SUPPORTS[P])):
+        mask = support_mask(nn, [(np.array([i - 1]), d) for i, d in table])
+        np.testing.assert_array_equal(model.structure.fixed(groups).supports, mask)
+
+
+@pytest.mark.parametrize("P", [1, 2, 3])
+def test_named_node_sets_are_what_their_names_say(P):
+    """The base holds the root, the tips and the pried nodes lie at the arms' ends."""
+    model = gripper_model(DESIGN | {"Pattern": P})
+    n, X = model.nodes, model.structure.nodes
+    ax = n.arm_axis
+    reach = np.abs(X[:, ax]).max()
+    assert np.all(np.abs(X[n.base, ax]) < 0.5 * reach)  # near the middle
+    assert np.all(X[n.pry_plus, ax] > 0.9 * reach) and np.all(X[n.pry_minus, ax] < -0.9 * reach)
+    a, b = X[n.tips]
+    assert a[ax] > 0.8 * reach and b[ax] < -0.8 * reach
+    assert n.probe in n.pry_plus
+
+
+# ---------------------------------------------------------------- the step functions
+def test_step_functions_compose_to_simulate(reference_data):
+    """Two-panel row 12 (closing step 103): the four steps, run one after the other, give
+    exactly the outputs of simulate; each carries its own Status."""
+    df = reference_data.load("data2_TwoPanel_sample")
+    row = _row(df, 11)
+    opt = GripperOptions()
+    model = gripper_model(row)
+    a = run_frequency(model)
+    b = run_prebias(model, opt)
+    c = run_heating(model, b.state, opt)
+    d = run_prying(model, c.state, opt)
+    for step in (a, b, c, d):
+        assert isinstance(step.status, Status)
+    assert a.status.converged and b.status.converged and b.run is None  # no pre-bias here
+    assert c.closing_step == 103 and len(c.tip_distance) == 103 and c.status.converged
+    assert c.tip_distance[-1] < gripper.CLOSURE <= c.tip_distance[-2]
+    assert len(d.runs) == 1 and d.status == d.runs[0].status
+    res = simulate(row)
+    assert (a.freqFinal, c.Tmax, d.stiff) == (res.freqFinal, res.Tmax, res.stiff)
+    assert res.finalQ == float(published_q(3, row["L1"], row["L2"], 103))
+    # the pattern's own step cap: no closure is a failed heating status, Tmax undefined
+    c5 = run_heating(model, b.state, GripperOptions(step_cap=5))
+    assert c5.closing_step is None and c5.status == STATUS_NO_CLOSURE and math.isnan(c5.Tmax)
+    np.testing.assert_array_equal(c5.tip_distance, c.tip_distance[:5])
+
+
+def test_prebias_step_status(reference_data, monkeypatch):
+    """Pattern 2's pre-bias: converged with the scripts' tolerance, not converged (and saying
+    so) with one no solve can meet; its forces stay applied."""
+    df = reference_data.load("data2_SplittedMiura_sample")
+    model = gripper_model(_row(df, 0))
+    b = run_prebias(model, GripperOptions())
+    assert b.status.converged and b.run.n_increments == gripper.PREBIAS_INCREMENTS
+    n = model.nodes
+    np.testing.assert_allclose(b.state.force[n.prebias_down, 2], -10 * gripper.PREBIAS_FORCE)
+    np.testing.assert_allclose(b.state.force[n.prebias_up, 2], 10 * gripper.PREBIAS_FORCE)
+    monkeypatch.setattr(gripper, "PREBIAS_TOL", 1e-30)
+    tight = run_prebias(model, GripperOptions())
+    assert tight.status.outcome is Outcome.NOT_CONVERGED
+    assert "increments above tol" in str(tight.status)
+
+
+def test_unconverged_prebias_is_reported_in_the_row_status(reference_data, monkeypatch):
+    """A pre-bias that misses its tolerance does not go unnoticed: the row (which still closes
+    and has every output) is not converged and names the pre-bias."""
+    df = reference_data.load("data2_SplittedMiura_sample")
+    monkeypatch.setattr(gripper, "PREBIAS_TOL", 1e-30)
+    res = simulate(_row(df, 0))
+    assert res.closing_step is not None
+    assert res.status.outcome is Outcome.NOT_CONVERGED
+    assert str(res.status).startswith("not converged: pre-bias: 10 of 10 increments above tol")
+    assert np.isfinite([res.freqFinal, res.finalQ, res.Tmax, res.stiff]).all()

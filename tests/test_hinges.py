@@ -300,7 +300,7 @@ def test_compliant_gripper_numbering_matches_the_reference_scripts():
     """Node ids the gripper scripts use (docs/scenarios.md §4.2), 1-based."""
     gripper = pytest.importorskip("holofold.geometry.gripper")
     kw = dict(crease_width=2e-4, crease_thickness=1e-6, panel_thickness=1e-5, **MAT)
-    s = build_compliant(gripper.miura_based_gripper(5e-3, 4e-3, 0.4), **kw)
+    s = build_compliant(gripper.miura_based_gripper(5e-3, 4e-3, 0.4).pattern, **kw)
     assert (s.n_nodes, len(s.bars)) == (83, 198)
     assert (s.creases.ids + 1).tolist() == [1, 2, 3, 4, 5, 6, 8, 9, 12, 14, 15, 17, 19]
     nv = s.node_vertex
@@ -314,10 +314,10 @@ def test_compliant_gripper_numbering_matches_the_reference_scripts():
     assert (s.panel_centres[:2] + 1).tolist() == [74, 75]
     cid = s.creases.ids.tolist()
     assert s.creases.nodes[[cid.index(11), cid.index(18)], 4].tolist() == [58, 70]
-    s2 = build_compliant(gripper.splitted_miura_gripper(5e-3, 4e-3, 0.4), **kw)
+    s2 = build_compliant(gripper.splitted_miura_gripper(5e-3, 4e-3, 0.4).pattern, **kw)
     assert (s2.n_nodes, len(s2.bars), len(s2.creases.ids)) == (141, 340, 22)
     assert (s2.panel_centres[0] + 1) == 127
-    s3 = build_compliant(gripper.two_panel_gripper(5e-3, 4e-3, 0.4), **kw)
+    s3 = build_compliant(gripper.two_panel_gripper(5e-3, 4e-3, 0.4).pattern, **kw)
     assert (s3.n_nodes, len(s3.bars)) == (37, 80)
     assert (s3.creases.ids + 1).tolist() == [2, 4, 7, 12]
 
@@ -339,3 +339,11 @@ def test_supports_and_vertex_nodes_by_name():
         c.fixed([0], "w")
     with pytest.raises(ValueError, match="outside"):
         c.fixed([99])
+
+
+def test_vertex_copies_per_panel():
+    p = four_vertex()
+    s = build_compliant(p, crease_width=0.1, crease_thickness=1e-3, panel_thickness=1e-2, **MAT)
+    per_panel = [s.vertex_nodes(4, panel=f) for f in range(p.n_faces)]
+    assert all(len(n) == 1 for n in per_panel)
+    np.testing.assert_array_equal(np.sort(np.concatenate(per_panel)), s.vertex_nodes(4))

@@ -58,7 +58,7 @@ def test_eigenvalues_match_direct_generalised_solve():
 
 
 def _structure():
-    pat = two_panel_gripper(4.1e-3, 3.1e-3, 0.49)
+    pat = two_panel_gripper(4.1e-3, 3.1e-3, 0.49).pattern
     s = build_compliant(pat, crease_width=150e-6, crease_thickness=1.2e-6, panel_thickness=27e-6,
                         E_panel=2e9, E_crease=2e9, nu_panel=0.3, nu_crease=0.3)  # fmt: skip
     return pat, s

@@ -85,7 +85,7 @@ def test_fin_matches_analytic_cosh_profile():
 
 
 def _gripper_structure():
-    pat = two_panel_gripper(4.1e-3, 3.1e-3, 0.49)
+    pat = two_panel_gripper(4.1e-3, 3.1e-3, 0.49).pattern
     s = build_compliant(
         pat,
         crease_width=150e-6,

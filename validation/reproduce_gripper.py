@@ -15,7 +15,7 @@ Usage (from the repository root)::
 
 For each pattern and performance column it prints the median, 90th and 99th percentile and
 maximum of |ours - published| / |published|, the closure-step agreement (the published finalQ
-decoded to its heating step with the formulas of specs/scenarios.md 4.7) and, for every pattern,
+decoded to its heating step by ``compat.gripper_closing_step``) and, for every pattern,
 the quartiles of finalQ, Tmax and stiff of ours and the published rows (the acceptance view for
 the Miura-based pattern, whose closure the spec did not expect to reproduce). ``--random N``
 instead simulates N fresh designs per pattern drawn as the paper did (4.1, with the re-draw
@@ -35,11 +35,9 @@ import numpy as np
 import pandas as pd
 from reproduce import load, reference_folder
 
-from holofold.design.scenarios.gripper import (
-    GripperOptions,
-    decode_closing_step,
-    simulate,
-)
+from holofold.design.scenarios.gripper import QLOAD, GripperOptions, simulate
+from holofold.geometry.gripper import DEFAULT_RANGE
+from holofold.mechanics.compat import gripper_closing_step
 
 STEMS = {1: "data2_MiuraBased_sample", 2: "data2_SplittedMiura_sample", 3: "data2_TwoPanel_sample"}
 NAMES = {1: "Miura-based", 2: "splitted Miura", 3: "two-panel"}
@@ -53,6 +51,13 @@ def with_arccos(options: GripperOptions, arccos: bool) -> GripperOptions:
     return replace(options, profile=replace(options.profile, arccos_dihedral=arccos))
 
 
+def published_step(P: int, ref: pd.DataFrame) -> np.ndarray:
+    """The closing heating step of each published row of ``ref`` (pattern ``P``), decoded from
+    its finalQ (whole numbers)."""
+    L1, L2 = ref["L1"].to_numpy(), ref["L2"].to_numpy()
+    return gripper_closing_step(P, L1, L2, ref["finalQ"], DEFAULT_RANGE[P], rate=QLOAD)
+
+
 def emit(text: str = "") -> None:
     sys.stdout.write(text + "\n")
     sys.stdout.flush()
@@ -64,7 +69,7 @@ def _run(row: dict, perturb: float = 0.0, options: GripperOptions = DEFAULT) -> 
         row = row | {"L1": row["L1"] * (1.0 + perturb)}
     try:
         r = simulate(row, options)
-        out = r.as_row() | {"step": r.closing_step or np.nan}
+        out = r.as_row() | {"status": str(r.status), "step": r.closing_step or np.nan}
     except Exception as exc:  # noqa: BLE001 - report and go on
         out = {c: np.nan for c in OUTPUTS} | {"status": f"failed: {exc}", "step": np.nan}
     out["seconds"] = time.perf_counter() - t
@@ -160,9 +165,7 @@ def ensemble_report(
 ) -> None:
     """Published values against an ensemble: ``steps``, ``stiff`` (n, K) member results of the
     n rows of ``ref``; ``groups`` maps a label to the member columns to test together."""
-    pub_step = np.rint(
-        decode_closing_step(P, ref["L1"].to_numpy(), ref["L2"].to_numpy(), ref["finalQ"])
-    )
+    pub_step = np.rint(published_step(P, ref))
     pub_stiff = ref["stiff"].to_numpy(float)
     for name, cols in groups.items():
         emit(f"  members {name} ({len(cols)} runs per row):")
@@ -225,7 +228,7 @@ def sensitivity(P: int, ref: pd.DataFrame, ours: pd.DataFrame, other: pd.DataFra
         f"stiff change median {np.nanmedian(ds):.2e}, p90 {np.nanpercentile(ds, 90):.2e}; "
         f"robust rows (same step, stiff within 1e-4): {robust.sum()} / {len(ref)}"
     )
-    pub_step = decode_closing_step(P, ref["L1"].to_numpy(), ref["L2"].to_numpy(), ref["finalQ"])
+    pub_step = published_step(P, ref)
     same = np.abs(ours["step"].to_numpy() - pub_step) < 1e-6
     emit(
         f"  robust rows: same closing step as published {(same & robust).sum()} / "
@@ -260,7 +263,7 @@ def quartiles(x) -> str:
 def report(P: int, ref: pd.DataFrame, ours: pd.DataFrame) -> None:
     emit(f"== pattern {P} ({NAMES[P]}): {len(ref)} rows")
     closed = ours["step"].notna().to_numpy()
-    pub_step = decode_closing_step(P, ref["L1"].to_numpy(), ref["L2"].to_numpy(), ref["finalQ"])
+    pub_step = published_step(P, ref)
     same = closed & (np.abs(ours["step"].to_numpy() - pub_step) < 1e-6)
     emit(
         f"  closed {closed.sum()} / {len(ref)};  same closing step as published: "
@@ -307,7 +310,7 @@ def status_summary(status: pd.Series) -> str:
 
 
 def random_designs(P: int, n: int, rng: np.random.Generator) -> list[dict]:
-    """Designs drawn as in specs/scenarios.md 4.1 (uniform ranges, re-draw rules for rate)."""
+    """Designs drawn as in the paper (uniform ranges, re-draw rules for rate)."""
     rows = []
     for _ in range(n):
         L1 = rng.uniform(3e-3, 7e-3)

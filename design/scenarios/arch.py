@@ -142,5 +142,4 @@ SCENARIO = Scenario(
     check=check,
     evaluate=evaluate,
     categorical=("m",),
-    reference_files=("data3_ShapeFit",),
 )

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 __all__ = ["Column", "Scenario", "single_thread"]
 
@@ -104,8 +104,6 @@ class Scenario:
         simulation.
     evaluate : callable(row) -> dict
         Simulates one row; returns every performance column and ``status``.
-    reference_files : tuple of str
-        Stems of the published files this scenario reproduces.
     """
 
     name: str
@@ -115,7 +113,6 @@ class Scenario:
     check: Callable[[Mapping[str, float]], list[str]]
     evaluate: Callable[[Mapping[str, float]], dict]
     categorical: tuple[str, ...] = ()
-    reference_files: tuple[str, ...] = field(default_factory=tuple)
 
     @property
     def feature_names(self) -> list[str]:

@@ -178,10 +178,4 @@ SCENARIO = Scenario(
     check=check,
     evaluate=evaluate,
     categorical=("pattern", "m", "n"),
-    reference_files=(
-        "data1_MiuraSheet_sample",
-        "data1_TMPSheet_sample",
-        "data4_MiuraSheetMat_sample",
-        "data4_TMPSheetMat_sample",
-    ),
 )

@@ -116,5 +116,4 @@ SCENARIO = Scenario(
     performance=PERFORMANCE,
     check=check,
     evaluate=evaluate,
-    reference_files=("data0_SingleMiura",),
 )
