@@ -9,48 +9,25 @@
 docs/strip-fit.md. Imports only from holofold.geometry.
 """
 
-from holofold.fitting.auto import DEFAULT_M_RANGE, AutoFit, FitNotFoundError, fit_auto
-from holofold.fitting.curves import (
-    BUILTIN_CURVES,
-    CurveError,
-    PlanarCurve,
-    builtin_curve,
-    load_curve,
-    parse_curve_spec,
-    read_points_csv,
-    read_svg_curve,
-)
-from holofold.fitting.error import (
-    ClosestPointError,
-    closest_point_error,
-    index_matched_error,
-    paper_error,
-)
-from holofold.fitting.strip import SAMPLINGS, StripGeometry, strip_geometry
-from holofold.fitting.strip_files import export_strip_files
-from holofold.fitting.strip_fit import StripFit, fit_strip
+import lazy_loader
 
-__all__ = [
-    "BUILTIN_CURVES",
-    "CurveError",
-    "PlanarCurve",
-    "builtin_curve",
-    "load_curve",
-    "parse_curve_spec",
-    "read_points_csv",
-    "read_svg_curve",
-    "ClosestPointError",
-    "closest_point_error",
-    "index_matched_error",
-    "paper_error",
-    "SAMPLINGS",
-    "StripGeometry",
-    "strip_geometry",
-    "StripFit",
-    "fit_strip",
-    "AutoFit",
-    "FitNotFoundError",
-    "fit_auto",
-    "DEFAULT_M_RANGE",
-    "export_strip_files",
-]
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "auto": ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"],
+        "curves": [
+            "BUILTIN_CURVES",
+            "CurveError",
+            "PlanarCurve",
+            "builtin_curve",
+            "load_curve",
+            "parse_curve_spec",
+            "read_points_csv",
+            "read_svg_curve",
+        ],
+        "error": ["ClosestPointError", "closest_point_error", "index_matched_error", "paper_error"],
+        "strip": ["SAMPLINGS", "StripGeometry", "strip_geometry"],
+        "strip_files": ["export_strip_files"],
+        "strip_fit": ["StripFit", "fit_strip"],
+    },
+)

@@ -29,36 +29,23 @@ database and mine a rule from it.
 (25, 16)
 """
 
-from __future__ import annotations
+import lazy_loader
 
-import importlib
-
-#: layer -> the names this module offers from its face
-_FIRST_NAMES = {
-    "geometry": ("CreasePattern", "miura_sheet", "tmp_sheet", "export"),
-    "fitting": ("builtin_curve", "load_curve", "fit_strip", "fit_auto"),
-    "mechanics": ("build_concentrated", "secant_stiffness", "PAPER"),
-    "design": (
-        "get_scenario",
-        "evaluate_designs",
-        "generate_database",
-        "read_table",
-        "ForestRuleMiner",
-        "mine_rules",
-        "verify_rules",
-    ),
-}
-_HOME = {name: layer for layer, names in _FIRST_NAMES.items() for name in names}
-__all__ = list(_HOME)
-
-
-def __getattr__(name: str):
-    if name in _HOME:
-        value = getattr(importlib.import_module(f"holofold.{_HOME[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'holofold' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+#: the names a user needs first, by the layer whose face offers them (imported on first use)
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "geometry": ["CreasePattern", "miura_sheet", "tmp_sheet", "export"],
+        "fitting": ["builtin_curve", "load_curve", "fit_strip", "fit_auto"],
+        "mechanics": ["build_concentrated", "secant_stiffness", "PAPER"],
+        "design": [
+            "get_scenario",
+            "evaluate_designs",
+            "generate_database",
+            "read_table",
+            "ForestRuleMiner",
+            "mine_rules",
+            "verify_rules",
+        ],
+    },
+)

@@ -36,6 +36,7 @@ Displacements are ``(nn, 3)`` arrays relative to ``nodes``.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, replace
 from enum import IntEnum
 from functools import cached_property
@@ -287,8 +288,15 @@ class Structure:
 
     # ------------------------------------------------------------------ changed copies
     def with_supports(self, supports) -> Structure:
-        """A copy with another (nn, 3) bool support mask."""
-        return replace(self, supports=np.asarray(supports, bool))
+        """A copy with another (nn, 3) bool support mask (the other arrays are shared, not
+        checked again: only the supports change)."""
+        sup = np.asarray(supports, bool)
+        if sup.shape != (self.n_nodes, 3):
+            raise ValueError(f"supports must have shape ({self.n_nodes}, 3), got {sup.shape}")
+        new = copy.copy(self)
+        object.__setattr__(new, "supports", sup)
+        new.__dict__.pop("free_dofs", None)  # the one cached property that depends on them
+        return new
 
     def fixed(self, nodes, dofs: str = "xyz") -> Structure:
         """A copy with the ``dofs`` (any of "x", "y", "z") of ``nodes`` fixed, nothing else.
@@ -296,7 +304,7 @@ class Structure:
         ``nodes``: node ids, or a sequence of ``(nodes, dofs)`` pairs when the directions
         differ per node group (``dofs`` is then ignored).
         """
-        return replace(self, supports=support_mask(self.n_nodes, nodes, dofs))
+        return self.with_supports(support_mask(self.n_nodes, nodes, dofs))
 
     def with_rest_angles(self, spring_rest) -> Structure:
         """A copy with other spring rest angles (ns,), rad."""

@@ -29,3 +29,10 @@ def test_unknown_subcommand_exits_nonzero():
     )
     assert proc.returncode == 2
     assert "invalid choice" in proc.stderr
+
+
+def test_demo_default_target_is_the_library_one():
+    from holofold.cli import demo
+    from holofold.design import DEMO_TARGET
+
+    assert demo.TARGET == DEMO_TARGET

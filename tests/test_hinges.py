@@ -347,3 +347,15 @@ def test_vertex_copies_per_panel():
     per_panel = [s.vertex_nodes(4, panel=f) for f in range(p.n_faces)]
     assert all(len(n) == 1 for n in per_panel)
     np.testing.assert_array_equal(np.sort(np.concatenate(per_panel)), s.vertex_nodes(4))
+
+
+def test_with_supports_changes_only_the_supports():
+    s = build_concentrated(four_vertex(), crease_width=1e-3, crease_thickness=1e-3,
+                           panel_thickness=1e-3)  # fmt: skip
+    assert s.free_dofs.size == s.n_dof
+    f = s.fixed([0, 1])
+    assert f.free_dofs.size == s.n_dof - 6 and s.free_dofs.size == s.n_dof  # not shared
+    assert f.nodes is s.nodes and f.creases is s.creases and f.profile is s.profile
+    np.testing.assert_array_equal(f.bar_dofs, s.bar_dofs)
+    with pytest.raises(ValueError, match="supports must have shape"):
+        s.with_supports(np.zeros((2, 3), bool))

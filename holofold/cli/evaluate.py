@@ -16,14 +16,13 @@ from holofold.cli._parallel import add_parallel_arguments, parallel_settings
 from holofold.design import (
     SCENARIO_NAMES,
     check_table_path,
-    converged_mask,
     evaluate_designs,
-    failed_mask,
     get_scenario,
     read_table,
     validate_designs,
     write_table,
 )
+from holofold.mechanics import converged_mask, failed_mask
 
 __all__ = ["register", "run"]
 

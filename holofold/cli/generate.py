@@ -56,7 +56,8 @@ def _parse_ranges(items):
 def run(args) -> int:
     from pathlib import Path
 
-    from holofold.design import failed_mask, generate_database
+    from holofold.design import generate_database
+    from holofold.mechanics import failed_mask
 
     workers, scheduler = parallel_settings(args)
     db = generate_database(

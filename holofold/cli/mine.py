@@ -105,7 +105,6 @@ def _in_option_terms(exc: ValueError) -> ValueError:
 def run(args) -> int:
     from holofold.design import (
         FewRulesWarning,
-        check_output_path,
         column_roles,
         mine_rules,
         mining_summary,
@@ -115,6 +114,7 @@ def run(args) -> int:
         save_figure,
         write_rules,
     )
+    from holofold.geometry import check_output_path
 
     json_path = args.json and check_output_path(args.json, "--json")
     plot_path = args.plot and check_output_path(args.plot, "--plot", _PLOT_SUFFIXES)
