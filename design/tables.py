@@ -51,6 +51,9 @@ class ColumnRoles:
     categorical: tuple[str, ...] = ()
 
 
+#: the canopy sheets' performance columns (data1 and data4)
+_SHEET_PERFORMANCE = tuple(f"{k}stiff{e}" for k in ("bend", "axial") for e in (30, 60, 90))
+
 PUBLISHED: dict[str, ColumnRoles] = {
     "data0": ColumnRoles(
         ("tcrease", "tpanel", "W", "gama"),
@@ -58,14 +61,7 @@ PUBLISHED: dict[str, ColumnRoles] = {
     ),
     "data1": ColumnRoles(
         ("pattern", "m", "n", "tcrease", "tpanel", "W"),
-        (
-            "bendstiff30",
-            "bendstiff60",
-            "bendstiff90",
-            "axialstiff30",
-            "axialstiff60",
-            "axialstiff90",
-        ),
+        _SHEET_PERFORMANCE,
         ("pattern", "m", "n"),
     ),
     "data2": ColumnRoles(
@@ -80,14 +76,7 @@ PUBLISHED: dict[str, ColumnRoles] = {
     ),
     "data4": ColumnRoles(
         ("pattern", "m", "n", "tcrease", "tpanel", "W", "creaseE", "panelE"),
-        (
-            "bendstiff30",
-            "bendstiff60",
-            "bendstiff90",
-            "axialstiff30",
-            "axialstiff60",
-            "axialstiff90",
-        ),
+        _SHEET_PERFORMANCE,
         ("pattern", "m", "n"),
     ),
 }

@@ -1,4 +1,4 @@
-"""``holofold demo``: the whole loop on the paper's arch, end to end, in about a minute."""
+"""``holofold demo``: the whole loop on the paper's arch, end to end, in about 15 seconds."""
 
 from __future__ import annotations
 
