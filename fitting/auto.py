@@ -20,8 +20,14 @@ import pandas as pd
 
 from holofold.fitting.curves import load_curve
 from holofold.fitting.error import closest_point_error, index_matched_error
-from holofold.fitting.strip import _check_m, side_line, strip_samples, zigzag_centre_line
-from holofold.fitting.strip_fit import StripFit, _check_sampling, fit_strip
+from holofold.fitting.strip import (
+    check_m,
+    check_sampling,
+    side_line,
+    strip_samples,
+    zigzag_centre_line,
+)
+from holofold.fitting.strip_fit import StripFit, fit_strip
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 
 __all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"]
@@ -101,7 +107,7 @@ def fit_auto(
         raise ParameterError(f"metric must be 'max' or 'mean', got {metric!r}")
     if prefer not in ("largest-offset", "smallest-error"):
         raise ParameterError(f"prefer must be 'largest-offset' or 'smallest-error', got {prefer!r}")
-    ms = sorted({_check_m(m) for m in m_range})
+    ms = sorted({check_m(m) for m in m_range})
     if not ms:
         raise ParameterError("m_range is empty")
     if offsets is None:
@@ -118,7 +124,7 @@ def fit_auto(
         if extrude is None
         else check_range("extrude", extrude, 0.0, None, low_open=True)
     )
-    sampling = _check_sampling(sampling, curve)
+    sampling = check_sampling(sampling, curve)
     col = "closest_max" if metric == "max" else "closest_mean"
 
     rows: list[dict] = []

@@ -60,6 +60,8 @@ __all__ = [
     "quad_warp",
     "sector_angle_development",
     "SAMPLINGS",
+    "check_m",
+    "check_sampling",
 ]
 
 SAMPLINGS = ("paper", "arclength")
@@ -128,7 +130,8 @@ class StripGeometry:
 
 
 # ---------------------------------------------------------------------- validation
-def _check_m(m) -> int:
+def check_m(m) -> int:
+    """``m`` as an int if it is an integer >= 2 (the number of Miura units)."""
     try:
         mf = float(m)
     except (TypeError, ValueError):
@@ -138,10 +141,18 @@ def _check_m(m) -> int:
     return int(mf)
 
 
+def check_sampling(sampling: str | None, curve: PlanarCurve) -> str:
+    """``sampling``, or the curve's default when None, if it is one of :data:`SAMPLINGS`."""
+    s = curve.default_sampling if sampling is None else sampling
+    if s not in SAMPLINGS:
+        raise ParameterError(f"sampling must be one of {SAMPLINGS}, got {sampling!r}")
+    return s
+
+
 # ---------------------------------------------------------------------- construction steps
 def strip_samples(curve: PlanarCurve, m: int, sampling: str = "paper"):
     """Parameters t (2m+1,) and points (2m+1, 2) of the on-curve samples (step 1)."""
-    n = 2 * _check_m(m)
+    n = 2 * check_m(m)
     if sampling == "paper":
         t = np.arange(n + 1) / n
         return t, curve(t)
@@ -217,7 +228,7 @@ def strip_nodes(P: np.ndarray, S: np.ndarray, extrude: float) -> np.ndarray:
 
 def strip_faces(m: int) -> np.ndarray:
     """Panels (4m, 4), 0-based, in the published order (two panels per segment)."""
-    m = _check_m(m)
+    m = check_m(m)
     j = np.arange(2 * m)
     a = np.stack([j, 2 * m + 1 + j, 2 * m + 2 + j, j + 1], axis=1)
     b = np.stack([j, 4 * m + 2 + j, 4 * m + 3 + j, j + 1], axis=1)
@@ -296,7 +307,7 @@ def strip_geometry(
     ParameterError, DegenerateGeometryError
         Invalid values, or a centre line that does not turn (the side line is unbounded).
     """
-    m = _check_m(m)
+    m = check_m(m)
     offset = check_range("offset", offset, 0.0, None, low_open=True)
     strip_width = check_range("strip_width", strip_width, 0.0, None, low_open=True)
     extrude = check_range("extrude", extrude, 0.0, None, low_open=True)

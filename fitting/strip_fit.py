@@ -17,13 +17,13 @@ import numpy as np
 from holofold.fitting.curves import PlanarCurve, load_curve
 from holofold.fitting.error import ClosestPointError, closest_point_error, index_matched_error
 from holofold.fitting.strip import (
-    SAMPLINGS,
     StripGeometry,
+    check_sampling,
     quad_warp,
     sector_angle_development,
     strip_geometry,
 )
-from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError, ParameterError
+from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError
 from holofold.geometry.pattern import CreasePattern
 
 __all__ = ["StripFit", "fit_strip"]
@@ -154,13 +154,6 @@ class StripFit:
         }
 
 
-def _check_sampling(sampling: str | None, curve: PlanarCurve) -> str:
-    s = curve.default_sampling if sampling is None else sampling
-    if s not in SAMPLINGS:
-        raise ParameterError(f"sampling must be one of {SAMPLINGS}, got {sampling!r}")
-    return s
-
-
 def fit_strip(
     curve,
     m: int,
@@ -194,7 +187,7 @@ def fit_strip(
     StripFit
     """
     curve = load_curve(curve)
-    sampling = _check_sampling(sampling, curve)
+    sampling = check_sampling(sampling, curve)
     g = strip_geometry(curve, m, offset, strip_width, extrude, sampling)
     meta = {
         "m": g.m,

@@ -10,6 +10,7 @@ import pytest
 
 from holofold.design.runner import DesignTableError, evaluate_designs, validate_designs
 from holofold.design.scenarios import Column, Scenario, get_scenario
+from holofold.mechanics.status import Status
 
 
 def _toy_check(row):
@@ -105,3 +106,24 @@ def test_optional_columns_default():
     assert row["creaseE"] == row["panelE"] == 2e9
     df["creaseE"] = [np.nan]
     assert validate_designs(sc, df).rows[0]["creaseE"] == 2e9
+
+
+def _inf_or_missing(row):
+    if row["a"] == 2:
+        return {"double": float("inf"), "status": "converged"}
+    if row["a"] == 3:
+        return {"status": "converged"}  # an output left out
+    if row["a"] == 4:
+        return {"double": 8.0}  # no status at all
+    return {"double": 2 * row["a"], "status": Status.not_converged("kept as is")}
+
+
+def test_a_non_finite_or_missing_output_is_never_converged():
+    sc = Scenario("toy2", "", TOY.features, TOY.performance, _toy_check, _inf_or_missing)
+    res = evaluate_designs(sc, pd.DataFrame({"a": [2.0, 3.0, 4.0, 5.0]}))
+    assert res["status"].tolist() == [
+        "not converged: non-finite output: double",
+        "not converged: non-finite output: double",
+        "failed: the evaluator returned no status",
+        "not converged: kept as is",
+    ]

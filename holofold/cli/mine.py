@@ -9,16 +9,18 @@ import warnings
 __all__ = ["register", "run"]
 
 _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
-#: ForestRuleMiner parameter -> the option that sets it (for error messages)
-_FLAGS = {
-    "n_rules": "--rules",
-    "n_estimators": "--trees",
-    "max_depth": "--depth",
-    "precision_min": "--precision-min",
-    "min_support": "--min-support",
-    "beta": "--beta",
-    "max_overlap": "--max-overlap",
-    "n_jobs": "--jobs",
+#: ForestRuleMiner parameter -> the argument that sets it (--trees sets n_estimators, ...)
+_MINER_ARGS = {
+    "n_estimators": "trees",
+    "max_depth": "depth",
+    "precision_min": "precision_min",
+    "min_support": "min_support",
+    "beta": "beta",
+    "n_rules": "rules",
+    "max_overlap": "max_overlap",
+    "scoring": "scoring",
+    "ranking": "ranking",
+    "n_jobs": "jobs",
 }
 
 
@@ -97,9 +99,10 @@ def register(subparsers) -> argparse.ArgumentParser:
 def _in_option_terms(exc: ValueError) -> ValueError:
     """scikit-learn's parameter message, naming the command's option instead."""
     m = re.match(r"The '(\w+)' parameter of \w+ (must be .*?)\. Got (.*) instead\.", str(exc))
-    if not m or m.group(1) not in _FLAGS:
+    if not m or m.group(1) not in _MINER_ARGS:
         return exc
-    return ValueError(f"{_FLAGS[m.group(1)]} {m.group(2)}, got {m.group(3)}")
+    flag = "--" + _MINER_ARGS[m.group(1)].replace("_", "-")
+    return ValueError(f"{flag} {m.group(2)}, got {m.group(3)}")
 
 
 def run(args) -> int:
@@ -131,16 +134,7 @@ def run(args) -> int:
                 test_size=args.test_size,
                 seed=args.seed,
                 source=args.database,
-                n_estimators=args.trees,
-                max_depth=args.depth,
-                precision_min=args.precision_min,
-                min_support=args.min_support,
-                beta=args.beta,
-                n_rules=args.rules,
-                max_overlap=args.max_overlap,
-                scoring=args.scoring,
-                ranking=args.ranking,
-                n_jobs=args.jobs,
+                **{param: getattr(args, arg) for param, arg in _MINER_ARGS.items()},
             )
         except ValueError as exc:
             raise _in_option_terms(exc) from None
