@@ -17,6 +17,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
         "demo": ["run_demo", "DEMO_TARGET"],
+        "loop": ["run_design", "DesignOutcome", "refine_designs", "choose_design"],
         "evaluation": [
             "holdout",
             "repeated_holdout",
@@ -26,6 +27,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "HoldoutResult",
         ],
         "mining": ["mine_rules", "MinedRules"],
+        "report_page": ["write_report_page", "report_page_html"],
         "report": [
             "rules_to_text",
             "mining_summary",
@@ -33,6 +35,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "plot_rule_boxes",
             "plot_rule_scatter",
             "plot_feature_importance",
+            "plot_target_scatter",
+            "plot_folded_design",
             "save_figure",
         ],
         "rulefile": ["rules_to_records", "write_rules", "read_rules", "RulesFileError"],
@@ -46,10 +50,26 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "dask_scheduler",
         ],
         "sampling": ["sample_designs", "METHODS"],
-        "scenarios": ["Scenario", "Column", "SCENARIO_NAMES", "get_scenario"],
+        "scenarios": [
+            "Scenario",
+            "Column",
+            "SCENARIO_NAMES",
+            "get_scenario",
+            "load_scenario",
+            "read_scenario",
+            "shipped_scenarios",
+            "shipped_text",
+            "ScenarioFileError",
+        ],
         "store": ["build_database", "generate_database", "load_database"],
         "tables": ["read_table", "write_table", "check_table_path", "column_roles", "ColumnRoles"],
         "targets": ["parse_target", "Target", "TargetError"],
-        "verify": ["verify_rule", "verify_rules", "write_verification", "Verification"],
+        "verify": [
+            "verify_rule",
+            "verify_rules",
+            "write_verification",
+            "Verification",
+            "rule_mask",
+        ],
     },
 )

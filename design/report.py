@@ -9,11 +9,14 @@ plotting functions (Agg backend when none is set), so importing this module cost
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pandas as pd
 
 from holofold.design.rules import ForestRuleMiner, format_rule, level_value
+from holofold.design.targets import Target, parse_target
 from holofold.geometry.outputs import atomic_write
 
 __all__ = [
@@ -25,6 +28,8 @@ __all__ = [
     "save_figure",
     "plot_rule_scatter",
     "plot_feature_importance",
+    "plot_target_scatter",
+    "plot_folded_design",
 ]
 
 
@@ -310,4 +315,207 @@ def plot_feature_importance(miner: ForestRuleMiner, *, ax=None):
     ax.set_yticks(np.arange(len(names)))
     ax.set_yticklabels([names[i] for i in order])
     ax.set_xlabel("mean impurity importance")
+    return fig
+
+
+_NAME = r"(?:[A-Za-z_][A-Za-z0-9_.]*|`[^`]+`)"
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_SIMPLE = re.compile(rf"^({_NAME}|{_NUMBER})((?:\s*(?:<=|>=|<|>)\s*(?:{_NAME}|{_NUMBER}))+)$")
+_LINK = re.compile(rf"\s*(<=|>=|<|>)\s*({_NAME}|{_NUMBER})")
+
+
+def _target_thresholds(target: Target) -> list[tuple[str, float]]:
+    """``(column, value)`` of each ``col < value`` / ``value < col`` condition of an and-target.
+
+    Read from the target's canonical text (``str(target)``); a target with ``|`` or brackets
+    gives none; a comparison between two columns or with ``==`` / ``!=`` is skipped.
+    """
+    text = str(target)
+    if "|" in text or "(" in text:
+        return []
+    found = []
+    for part in text.split(" & "):
+        m = _SIMPLE.match(part.strip())
+        if m is None:
+            continue
+        operands = [m.group(1)] + [g[1] for g in _LINK.findall(m.group(2))]
+        names = [o for o in operands if re.fullmatch(_NAME, o) and not re.fullmatch(_NUMBER, o)]
+        if len(names) != 1:
+            continue
+        col = names[0].strip("`")
+        found += [(col, float(o)) for o in operands if re.fullmatch(_NUMBER, o)]
+    return found
+
+
+def _axis_label(name: str, units: Mapping) -> str:
+    u = units.get(name)
+    return f"{name} [{u}]" if u and u != "-" else name
+
+
+def plot_target_scatter(
+    table: pd.DataFrame,
+    target,
+    x: str,
+    y: str,
+    *,
+    chosen: Mapping | None = None,
+    units: Mapping | None = None,
+    ax=None,
+):
+    """Scatter of a database in the (x, y) plane: rows meeting the target coloured, others grey.
+
+    Parameters
+    ----------
+    table : DataFrame
+        The database (features and performance, SI units); rows with a non-finite x or y are
+        left out.
+    target : Target or str
+        The design target; a string is parsed against ``table``'s columns.
+    x, y : str
+        Columns for the two axes.
+    chosen : mapping, optional
+        The chosen design (values of at least ``x`` and ``y``), drawn as a large star.
+    units : mapping, optional
+        Unit per column for the axis labels, e.g. ``{"offset": "m"}``.
+    ax : matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Dashed lines mark the target's thresholds ``x < value`` / ``y > value`` where the
+        target is a conjunction of such simple comparisons; an axis whose values are all
+        positive and span more than two decades is logarithmic.
+    """
+    plt = _pyplot()
+    if isinstance(target, str):
+        target = parse_target(target, table.columns)
+    for c in (x, y):
+        if c not in table.columns:
+            raise ValueError(f"column {c!r} is not in the table ({', '.join(map(str, table))})")
+    units = units or {}
+    meets = target.evaluate(table)
+    xs = table[x].to_numpy(dtype=float)
+    ys = table[y].to_numpy(dtype=float)
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    hit, miss = ok & meets, ok & ~meets
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6, 4.5))
+    else:
+        fig = ax.figure
+    ax.scatter(xs[miss], ys[miss], s=8, c="0.72", lw=0, label=f"other designs ({miss.sum()})")
+    ax.scatter(xs[hit], ys[hit], s=14, c="tab:red", lw=0, label=f"meets the target ({hit.sum()})")
+    if chosen is not None:
+        ax.scatter(
+            [float(chosen[x])],
+            [float(chosen[y])],
+            s=260,
+            marker="*",
+            c="gold",
+            edgecolors="black",
+            linewidths=0.8,
+            zorder=5,
+            label="chosen design",
+        )
+    for col, value in _target_thresholds(target):
+        if col == x:
+            ax.axvline(value, color="tab:red", ls="--", lw=1)
+        if col == y:
+            ax.axhline(value, color="tab:red", ls="--", lw=1)
+    for values, set_scale in ((xs[ok], ax.set_xscale), (ys[ok], ax.set_yscale)):
+        if values.size and values.min() > 0 and values.max() / values.min() > 100:
+            set_scale("log")
+    ax.set_xlabel(_axis_label(x, units))
+    ax.set_ylabel(_axis_label(y, units))
+    ax.set_title(f"target: {target}", fontsize=9)
+    ax.legend(fontsize=8, loc="best")
+    return fig
+
+
+def _face_normals(polygons: Sequence[np.ndarray]) -> np.ndarray:
+    """Unit normals of planar-ish polygons (Newell's method); zero for degenerate ones."""
+    normals = np.zeros((len(polygons), 3))
+    for i, p in enumerate(polygons):
+        q = np.roll(p, -1, axis=0)
+        n = np.array(
+            [
+                np.sum((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])),
+                np.sum((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])),
+                np.sum((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1])),
+            ]
+        )
+        length = np.linalg.norm(n)
+        normals[i] = n / length if length > 0 else 0.0
+    return normals
+
+
+def plot_folded_design(
+    vertices: np.ndarray,
+    faces: Sequence,
+    *,
+    creases: np.ndarray | None = None,
+    title: str = "",
+    ax=None,
+):
+    """3D view of a folded design: shaded panels, thin panel edges, creases as lines.
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (n, 3)
+        Node coordinates in m (shown in mm).
+    faces : sequence of index arrays
+        Panels as vertex indices (triangles or polygons).
+    creases : ndarray of shape (k, 2) of int, optional
+        Node pairs of the creases.
+    title : str, default=""
+    ax : 3D matplotlib Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Orthographic view, equal aspect, seen from the front and a little above: suited to a
+        strip arch whose curve lies in the x-z plane and whose width runs along y.
+    """
+    from matplotlib.ticker import MaxNLocator
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    plt = _pyplot()
+    v = np.asarray(vertices, dtype=float)
+    if v.ndim != 2 or v.shape[1] != 3 or not len(v):
+        raise ValueError(f"vertices must have shape (n, 3), got {v.shape}")
+    mm = v * 1e3
+    polygons = [mm[np.asarray(f, dtype=int)] for f in faces]
+    if ax is None:
+        fig = plt.figure(figsize=(7, 4.5))
+        ax = fig.add_subplot(projection="3d")
+        fig.subplots_adjust(left=0.0, right=0.95, bottom=0.0, top=0.9)
+    else:
+        fig = ax.figure
+    light = np.array([-0.3, -0.6, 0.75])
+    light /= np.linalg.norm(light)
+    shade = 0.45 + 0.55 * np.abs(_face_normals(polygons) @ light)
+    base = np.array([0.55, 0.72, 0.9])
+    colours = np.column_stack([np.clip(shade[:, None] * base, 0, 1), np.ones(len(polygons))])
+    ax.add_collection3d(
+        Poly3DCollection(polygons, facecolors=colours, edgecolors="0.3", linewidths=0.25)
+    )
+    if creases is not None and len(creases):
+        c = np.asarray(creases, dtype=int).reshape(-1, 2)
+        ax.add_collection3d(Line3DCollection(mm[c], colors="tab:red", linewidths=0.7))
+    lo, hi = mm.min(axis=0), mm.max(axis=0)
+    span = hi - lo
+    pad = 1e-3 * max(span.max(), 1e-9)
+    span = np.maximum(span, pad)
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_zlim(lo[2] - pad, hi[2] + pad)
+    ax.set_box_aspect(tuple(span + 2 * pad), zoom=1.0)
+    ax.set_proj_type("ortho")
+    ax.view_init(elev=20, azim=-70)
+    for axis, s in zip((ax.xaxis, ax.yaxis, ax.zaxis), span, strict=True):
+        axis.set_major_locator(MaxNLocator(nbins=max(1, round(6 * s / span.max()))))
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.set_zlabel("z [mm]")
+    if title:
+        ax.set_title(title, fontsize=10)
     return fig

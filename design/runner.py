@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.scenarios.base import single_thread
 from holofold.mechanics.status import Status
 
@@ -388,8 +388,8 @@ def evaluate_designs(
     DataFrame
         The input rows in the same order, then the performance columns and ``status``.
     """
-    if isinstance(scenario, str):
-        scenario = get_scenario(scenario)
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     workers = check_workers(workers)
     if scheduler is not None:
         scheduler = check_scheduler(scheduler)

@@ -15,7 +15,6 @@ row is submitted at once and a chunk is written as soon as its rows are done, in
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 from contextlib import closing
@@ -35,8 +34,9 @@ from holofold.design.runner import (
     validate_designs,
 )
 from holofold.design.sampling import sample_designs
-from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.tables import write_table
+from holofold.geometry.outputs import write_json
 
 __all__ = ["build_database", "generate_database", "load_database"]
 
@@ -96,8 +96,8 @@ def build_database(
         All rows in order with performance columns and ``status``; also written to
         ``database.parquet``.
     """
-    if isinstance(scenario, str):
-        scenario = get_scenario(scenario)
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     chunk_size = int(chunk_size)
     if chunk_size < 1:
         raise ValueError(f"chunk_size = {chunk_size} must be >= 1")
@@ -126,6 +126,7 @@ def build_database(
         write_table(designs, dpath)
         info = {
             "scenario": scenario.name,
+            "scenario_file": scenario.source or None,
             "features": {c.name: c.unit for c in scenario.features},
             "performance": {c.name: c.unit for c in scenario.performance},
             "categorical": list(scenario.categorical),
@@ -134,7 +135,7 @@ def build_database(
             "holofold_version": _version(),
             **(meta or {}),
         }
-        (folder / "meta.json").write_text(json.dumps(info, indent=2))
+        write_json(folder / "meta.json", info)
     n_chunks = (len(designs) + chunk_size - 1) // chunk_size
     todo = [k for k in range(n_chunks) if not (chunks / f"part-{k:05d}.parquet").exists()]
     if len(todo) < n_chunks:
@@ -230,8 +231,8 @@ def generate_database(
     and are recorded in ``meta.json``; the rest to :func:`build_database`. ``csv`` also
     writes ``database.csv``. Returns the database.
     """
-    if isinstance(scenario, str):
-        scenario = get_scenario(scenario)
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     if int(n) < 1:
         raise ValueError(f"n = {n} designs must be >= 1")
     designs = sample_designs(scenario, int(n), seed=seed, method=method, ranges=ranges)

@@ -218,6 +218,49 @@ def _eval(node, frame) -> np.ndarray:
     return result
 
 
+def _operand(o, frame) -> np.ndarray | float:
+    return np.asarray(frame[o.name], dtype=float) if isinstance(o, _Column) else o.value
+
+
+def _text(o) -> str:
+    if isinstance(o, _Column):
+        return o.name if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.]*", o.name) else f"`{o.name}`"
+    return f"{o.value:g}"
+
+
+def _pairs(node):
+    """The comparisons of a chain, one (left, op, right) per operator."""
+    return [(node.operands[k], op, node.operands[k + 1]) for k, op in enumerate(node.ops)]
+
+
+def _pair_margin(a, op, b, frame) -> np.ndarray:
+    """Signed margin of ``a op b``, normalised by the threshold (>= 0 where it holds)."""
+    va, vb = _operand(a, frame), _operand(b, frame)
+    if op in ("==", "!="):
+        holds = np.asarray(_OPS[op](va, vb), bool)
+        return np.where(holds, np.inf, -np.inf)
+    ref = vb if isinstance(b, _Number) or not isinstance(a, _Number) else va
+    scale = np.abs(np.asarray(ref, dtype=float))
+    scale = np.where(scale > 0, scale, 1.0)
+    diff = (va - vb) if op in (">", ">=") else (vb - va)
+    return np.asarray(diff / scale, dtype=float)
+
+
+def _margin(node, frame) -> np.ndarray:
+    if isinstance(node, _BoolOp):
+        parts = [_margin(a, frame) for a in node.args]
+        return (np.minimum if node.op == "&" else np.maximum).reduce(parts)
+    return np.minimum.reduce([_pair_margin(a, op, b, frame) for a, op, b in _pairs(node)])
+
+
+def _conditions(node, out: list) -> None:
+    if isinstance(node, _BoolOp):
+        for a in node.args:
+            _conditions(a, out)
+    else:
+        out.extend(_pairs(node))
+
+
 def _render(node) -> str:
     if isinstance(node, _BoolOp):
         inner = f" {node.op} ".join(
@@ -276,6 +319,30 @@ class Target:
 
     def __str__(self) -> str:
         return _render(self._tree)
+
+    @property
+    def conditions(self) -> tuple[str, ...]:
+        """The single comparisons of the target, as text (``"Zstiff > 100"``), in order."""
+        out: list = []
+        _conditions(self._tree, out)
+        return tuple(f"{_text(a)} {op} {_text(b)}" for a, op, b in out)
+
+    def margins(self, frame) -> dict[str, np.ndarray]:
+        """Per condition, the signed margin of every row, normalised by its threshold.
+
+        ``col > t`` gives ``(col - t) / |t|``, ``col < t`` gives ``(t - col) / |t|`` (|t| = 1
+        for t = 0): >= 0 where the condition holds, the fraction by which it could change
+        before it fails. ``==`` / ``!=`` give +inf where they hold and -inf where not.
+        """
+        self.evaluate(frame)  # checks the columns
+        out: list = []
+        _conditions(self._tree, out)
+        return {f"{_text(a)} {op} {_text(b)}": _pair_margin(a, op, b, frame) for a, op, b in out}
+
+    def margin(self, frame) -> np.ndarray:
+        """(n_rows,) worst-case margin: the minimum over ``&``, the maximum over ``|``."""
+        self.evaluate(frame)
+        return np.asarray(_margin(self._tree, frame), dtype=float)
 
 
 def parse_target(expr: str, columns=None) -> Target:

@@ -14,17 +14,25 @@ from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from holofold.design.runner import dask_scheduler, evaluate_designs
 from holofold.design.sampling import sample_designs
-from holofold.design.scenarios import Scenario, get_scenario
+from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.tables import write_table
 from holofold.design.targets import parse_target
 from holofold.geometry.outputs import write_json
 from holofold.mechanics.status import failed_mask
 
-__all__ = ["rule_ranges", "verify_rule", "verify_rules", "write_verification", "Verification"]
+__all__ = [
+    "rule_ranges",
+    "rule_mask",
+    "verify_rule",
+    "verify_rules",
+    "write_verification",
+    "Verification",
+]
 
 
 def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
@@ -53,6 +61,21 @@ def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
     return out
 
 
+def rule_mask(table: pd.DataFrame, bounds: Mapping[str, Mapping]) -> np.ndarray:
+    """(n,) bool: the rows of ``table`` inside the box ``bounds`` (a rule record's)."""
+    inside = np.ones(len(table), bool)
+    for name, b in bounds.items():
+        col = table[name].to_numpy(dtype=float)
+        if "in" in b:
+            inside &= np.isin(col, np.asarray(b["in"], dtype=float))
+            continue
+        if b.get("gt") is not None:
+            inside &= col > float(b["gt"])
+        if b.get("le") is not None:
+            inside &= col <= float(b["le"])
+    return inside
+
+
 @dataclass(frozen=True)
 class Verification:
     """Fresh designs inside a rule and how many meet the target.
@@ -66,6 +89,18 @@ class Verification:
     n_failed: int
     n_meeting: int
 
+    @classmethod
+    def of(cls, results: pd.DataFrame, target) -> Verification:
+        """Count the simulated ``results`` (with ``status``) meeting ``target`` (a Target)."""
+        res = results.copy()
+        failed = pd.Series(failed_mask(res["status"]), index=res.index)
+        meets = pd.Series(False, index=res.index)
+        ok = res.loc[~failed]
+        if len(ok):
+            meets.loc[~failed] = target.evaluate(ok)
+        res["meets_target"] = meets
+        return cls(res, int((~failed).sum()), int(failed.sum()), int(meets.sum()))
+
     @property
     def precision(self) -> float:
         return self.n_meeting / self.n_ok if self.n_ok else float("nan")
@@ -77,7 +112,9 @@ class Verification:
             return (float("nan"), float("nan"))
         centre = (p + z * z / (2 * n)) / (1 + z * z / n)
         half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-        return (centre - half, centre + half)
+        lo = 0.0 if self.n_meeting == 0 else max(0.0, centre - half)
+        hi = 1.0 if self.n_meeting == n else min(1.0, centre + half)
+        return (lo, hi)  # exact at p = 0 and p = 1 (no round-off past the estimate)
 
     def summary(self) -> dict:
         """JSON-ready counts, precision and interval (None where no design simulated)."""
@@ -118,20 +155,14 @@ def verify_rule(
     ``workers``, ``progress`` and ``scheduler`` (a Dask scheduler address or ``"local"``) are
     passed to :func:`holofold.design.runner.evaluate_designs`.
     """
-    if isinstance(scenario, str):
-        scenario = get_scenario(scenario)
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     tgt = parse_target(target, scenario.performance_names)
     designs = sample_designs(scenario, n, seed=seed, ranges=rule_ranges(scenario, bounds))
     res = evaluate_designs(
         scenario, designs, workers=workers, progress=progress, scheduler=scheduler
     )
-    failed = pd.Series(failed_mask(res["status"]), index=res.index)
-    meets = pd.Series(False, index=res.index)
-    ok = res.loc[~failed]
-    if len(ok):
-        meets.loc[~failed] = tgt.evaluate(ok)
-    res["meets_target"] = meets
-    return Verification(res, int((~failed).sum()), int(failed.sum()), int(meets.sum()))
+    return Verification.of(res, tgt)
 
 
 def verify_rules(
@@ -151,8 +182,8 @@ def verify_rules(
     (1-based) samples with seed ``seed + i``. A local Dask cluster (``scheduler="local"``) is
     started once for all rules.
     """
-    if isinstance(scenario, str):
-        scenario = get_scenario(scenario)
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
     parse_target(target, scenario.performance_names)
     if int(n) < 1:
         raise ValueError(f"n = {n} designs per rule must be >= 1")

@@ -206,6 +206,13 @@ class PlanarCurve:
         curve = cls.from_points(xy, name=name, degree=1, source=source or "svg path")
         return cls(curve.func, name=name, kind="svg", params={"d": d[:200], **curve.params})
 
+    def __getstate__(self) -> dict:
+        """Pickled without the dense polyline and its KD-tree (recomputed on first use, ~1 ms)."""
+        state = dict(self.__dict__)
+        state.pop("_dense", None)
+        state.pop("_tree", None)
+        return state
+
     def __repr__(self) -> str:
         return f"PlanarCurve(name={self.name!r}, kind={self.kind!r}, params={self.params!r})"
 

@@ -34,5 +34,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "solid": ["thick_solid", "panel_solids", "shrunk_panels", "SolidWarning"],
         "svg": ["export_svg", "load_svg", "polylines_svg"],
         "tmp": ["tmp_sheet", "tmp_nodes", "tmp_faces"],
+        "units": ["LENGTH_UNITS", "length_factor"],
     },
 )

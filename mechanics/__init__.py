@@ -18,6 +18,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "analyses": [
             "LoadGroup",
             "load_group",
+            "load_along",
             "secant_stiffness",
             "StiffnessResult",
             "snap_check_mgdcm",

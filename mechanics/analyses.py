@@ -22,6 +22,7 @@ __all__ = [
     "LoadGroup",
     "StiffnessResult",
     "load_group",
+    "load_along",
     "secant_stiffness",
     "SnapCheck",
     "snap_check_mgdcm",
@@ -39,20 +40,36 @@ class LoadGroup:
     nodes : (k,) int
         Loaded node ids.
     axis : int
-        0, 1, 2 for x, y, z.
+        0, 1, 2 for x, y, z; -1 for an oblique ``vector``.
     sign : float
-        +1 or -1 (direction of the force).
+        +1 or -1 (direction of the force along ``axis``).
+    vector : (3,) float or None
+        Unit direction of an oblique load (``axis = -1``); None for an axis load.
     """
 
     nodes: np.ndarray
     axis: int
     sign: float
+    vector: np.ndarray | None = None
 
     def load(self, n_nodes: int, force: float) -> np.ndarray:
         """(n_nodes, 3) load array: ``force`` (N) shared equally by the group's nodes."""
         F = np.zeros((n_nodes, 3))
-        F[self.nodes, self.axis] = self.sign * force / len(self.nodes)
+        if self.vector is None:
+            F[self.nodes, self.axis] = self.sign * force / len(self.nodes)
+        else:
+            F[self.nodes] = (force / len(self.nodes)) * self.vector
         return F
+
+    def displacements(self, U: np.ndarray) -> np.ndarray:
+        """Displacement of each loaded node along the load direction, (..., k) m.
+
+        ``U`` is (n_nodes, 3) or a history (steps, n_nodes, 3).
+        """
+        u = U[..., self.nodes, :]
+        if self.vector is None:
+            return self.sign * u[..., self.axis]
+        return u @ self.vector
 
 
 def load_group(nodes, direction: str) -> LoadGroup:
@@ -64,6 +81,24 @@ def load_group(nodes, direction: str) -> LoadGroup:
     if len(d) != 2 or d[0] not in "+-" or d[1] not in _AXES:
         raise ParameterError(f"direction = {direction!r}; allowed: +x, -x, +y, -y, +z, -z")
     return LoadGroup(nodes, _AXES[d[1]], 1.0 if d[0] == "+" else -1.0)
+
+
+def load_along(nodes, direction) -> LoadGroup:
+    """A :class:`LoadGroup` along a 3-vector ``direction`` (any length > 0).
+
+    An axis-aligned direction gives the same group as :func:`load_group` (so the same
+    numbers, bit for bit); any other is normalised to a unit vector.
+    """
+    nodes = np.atleast_1d(np.asarray(nodes, dtype=np.intp))
+    if nodes.size == 0:
+        raise ParameterError("a load group needs at least one node")
+    d = np.asarray(direction, dtype=float)
+    if d.shape != (3,) or not np.isfinite(d).all() or not np.any(d):
+        raise ParameterError(f"direction = {direction!r} must be a finite non-zero 3-vector")
+    nz = np.flatnonzero(d)
+    if nz.size == 1:
+        return LoadGroup(nodes, int(nz[0]), 1.0 if d[nz[0]] > 0 else -1.0)
+    return LoadGroup(nodes, -1, 1.0, d / np.linalg.norm(d))
 
 
 @dataclass(frozen=True)
@@ -123,7 +158,7 @@ def secant_stiffness(
     res = solve_newton(
         structure, load, increments=increments, tol=tol, max_iter=max_iter, assembler=assembler
     )
-    u = float(np.mean(np.abs(res.U[group.nodes, group.axis])))
+    u = float(np.mean(np.abs(group.displacements(res.U))))
     total = force_per_increment * len(res.load_factor)
     k = total / u if u > 0 else float("inf")
     return StiffnessResult(stiffness=k, displacement=u, result=res)
@@ -230,7 +265,10 @@ def snap_check_mgdcm(
         results.append(res)
         lam = np.asarray(res.load_factor, float)
         done += len(lam)
-        u_all += list(res.U_history[:, group.nodes, group.axis].mean(axis=1))
+        if group.vector is None:
+            u_all += list(res.U_history[:, group.nodes, group.axis].mean(axis=1))
+        else:
+            u_all += list(group.displacements(res.U_history).mean(axis=1))
         full = np.concatenate([lam_all, lam])
         falling = np.flatnonzero(np.diff(full) < 0)
         lam_all = list(full)

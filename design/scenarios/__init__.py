@@ -1,4 +1,5 @@
-"""The paper's design scenarios (single Miura, canopy, arch, gripper), by command-line name.
+"""The paper's design scenarios (single Miura, canopy, arch, gripper), by command-line name,
+and scenario files (:mod:`~holofold.design.scenarios.files`): a designer's own problem in TOML.
 
 Each module defines ``SCENARIO`` (:class:`holofold.design.scenarios.base.Scenario`): feature and
 performance columns with units and the paper's sampling ranges, a validity check and an
@@ -8,8 +9,25 @@ performance columns with units and the paper's sampling ranges, a validity check
 from __future__ import annotations
 
 from holofold.design.scenarios.base import Column, Scenario
+from holofold.design.scenarios.config import ScenarioFileError
+from holofold.design.scenarios.files import (
+    load_scenario,
+    read_scenario,
+    shipped_scenarios,
+    shipped_text,
+)
 
-__all__ = ["Column", "Scenario", "SCENARIO_NAMES", "get_scenario"]
+__all__ = [
+    "Column",
+    "Scenario",
+    "SCENARIO_NAMES",
+    "get_scenario",
+    "load_scenario",
+    "read_scenario",
+    "shipped_scenarios",
+    "shipped_text",
+    "ScenarioFileError",
+]
 
 #: command-line name -> module (its ``SCENARIO``) or ``module:ATTRIBUTE``
 _MODULES = {
@@ -28,6 +46,9 @@ def get_scenario(name: str) -> Scenario:
 
     key = str(name).strip().lower().replace("_", "-")
     if key not in _MODULES:
-        raise ValueError(f"unknown scenario {name!r}; allowed: {', '.join(SCENARIO_NAMES)}")
+        raise ValueError(
+            f"unknown scenario {name!r}; allowed: {', '.join(SCENARIO_NAMES)} "
+            "or a scenario file (.toml)"
+        )
     module, _, attr = _MODULES[key].partition(":")
     return getattr(importlib.import_module(module), attr or "SCENARIO")

@@ -14,24 +14,19 @@ as in the published data, and ``status`` names the increments that did not conve
 
 from __future__ import annotations
 
-from functools import lru_cache
-
-from holofold.design.scenarios.base import (
-    Column,
-    Scenario,
-    integer,
-    positive,
-    single_thread,
+from holofold.design.scenarios.base import Scenario
+from holofold.design.scenarios.strip import (
+    STRIP_FEATURES,
+    StripLoad,
+    StripSetting,
+    check_strip,
+    strip_model,
+    strip_scenario,
 )
-from holofold.fitting import builtin_curve, index_matched_error, strip_geometry
-from holofold.geometry.pattern import CreasePattern
-from holofold.mechanics.analyses import load_group, secant_stiffness
-from holofold.mechanics.assembly import Assembler
+from holofold.fitting import builtin_curve
 from holofold.mechanics.compat import PAPER
-from holofold.mechanics.hinges import build_concentrated
-from holofold.mechanics.status import Outcome, Status
 
-__all__ = ["SCENARIO", "evaluate", "check", "arch_model", "SNAP_DISPLACEMENT"]
+__all__ = ["SCENARIO", "SETTING", "evaluate", "check", "arch_model", "SNAP_DISPLACEMENT"]
 
 E = 2e9
 NU = 0.3
@@ -40,41 +35,26 @@ TOL = 1e-7
 RADIUS = 2.0  #: radius of the target half circle, m
 SNAP_DISPLACEMENT = 1.0  #: |U_z| above which the paper flags a snap, m
 
-FEATURES = (
-    Column("m", "-", "number of Miura units (even)", choices=(8.0, 12.0, 16.0, 24.0)),
-    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3),
-    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3),
-    Column("W", "m", "crease width", 1e-3, 4e-3),
-    Column("offset", "m", "zigzag offset l_o of the middle vertices", 0.10, 0.30),
-    Column("stripeWidth", "m", "side-line shift W_s", 0.01, 0.04),
-    Column("extrude", "m", "half-width l_e of the strip", 0.05, 0.25),
+#: the paper's arch as a strip setting (the shipped ``arch.toml`` says the same)
+SETTING = StripSetting(
+    curve=builtin_curve("half-circle", radius=RADIUS),
+    loads=(
+        StripLoad("Z", 0.5, (0.0, 0.0, -1.0), 5.0, INCREMENTS, SNAP_DISPLACEMENT),
+        StripLoad("X", 0.5, (1.0, 0.0, 0.0), 5.0, INCREMENTS),
+    ),
+    E=E,
+    nu=NU,
+    tol=TOL,
+    curve_label="half circle, radius 2 m",
 )
-PERFORMANCE = (
-    Column("Zstiff", "N/m", "vertical secant stiffness at the apex under 5 N"),
-    Column("Zsnap", "-", "1 if the apex moves more than 1 m under 5 N (snap-through)"),
-    Column("Xstiff", "N/m", "horizontal secant stiffness at the apex under 5 N"),
-    Column("error", "m", "mean index-matched distance of the centre line to the half circle"),
-)
-
-
-@lru_cache(maxsize=1)
-def _curve():
-    return builtin_curve("half-circle", radius=RADIUS)
-
-
-@lru_cache(maxsize=16)
-def _topology(m: int) -> CreasePattern:
-    """A strip with the right faces, validated once per m (coordinates are replaced per design)."""
-    g = strip_geometry(_curve(), m, 0.2, 0.02, 0.15)
-    return CreasePattern.from_faces(g.nodes, list(g.faces))
+FEATURES = STRIP_FEATURES
 
 
 def check(row) -> list[str]:
-    """Physical validity of one design (empty if valid)."""
-    errs = integer(row, "m", 2)
+    """Physical validity of one design (empty if valid): the strip's, and an even m."""
+    errs = check_strip(SETTING, row)
     if not errs and int(row["m"]) % 2:
         errs.append(f"m = {row['m']:g} must be even (the apex must be a centre-line vertex)")
-    errs += positive(row, ("tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"))
     return errs
 
 
@@ -89,47 +69,13 @@ def arch_model(row, *, profile=PAPER):
     error : float
         Fitting error e, m.
     """
-    m = int(row["m"])
-    g = strip_geometry(
-        _curve(), m, float(row["offset"]), float(row["stripeWidth"]), float(row["extrude"])
-    )
-    s = build_concentrated(
-        _topology(m),
-        coords=g.nodes,
-        crease_width=row["W"],
-        crease_thickness=row["tcrease"],
-        panel_thickness=row["tpanel"],
-        E_panel=E,
-        E_crease=E,
-        nu_panel=NU,
-        nu_crease=NU,
-        profile=profile,
-    ).fixed(g.ends)
-    return s, g.apex, index_matched_error(_curve(), g.centre_line, g.t)
+    s, g, err = strip_model(SETTING, row, profile=profile)
+    return s, g.apex, err
 
 
-def evaluate(row) -> dict:
-    """Zstiff, Zsnap, Xstiff (N/m), error (m) and a status."""
-    s, apex, err = arch_model(row)
-    asm = Assembler(s)  # one sparse pattern and reduction for both load cases
-    with single_thread():
-        z = secant_stiffness(
-            s, load_group([apex], "-z"), increments=INCREMENTS, tol=TOL, assembler=asm
-        )
-        x = secant_stiffness(
-            s, load_group([apex], "+x"), increments=INCREMENTS, tol=TOL, assembler=asm
-        )
-    snap = z.displacement > SNAP_DISPLACEMENT
-    z_case = "Z case (snap-through)" if snap else "Z case"
-    cases = {z_case: z.result.status, "X case": x.result.status}
-    return {
-        "Zstiff": z.stiffness,
-        "Zsnap": 1.0 if snap else 0.0,
-        "Xstiff": x.stiffness,
-        "error": err,
-        "status": Status.gather(cases, worst=Outcome.NOT_CONVERGED),
-    }
-
+_STRIP = strip_scenario("arch", "", SETTING, FEATURES, extras=False)
+#: Zstiff, Zsnap, Xstiff (N/m), error (m) and a status
+evaluate = _STRIP.evaluate
 
 SCENARIO = Scenario(
     name="arch",
@@ -138,7 +84,7 @@ SCENARIO = Scenario(
         "5 N, snap flag and fitting error (Zhu & Filipov 2022, data3)."
     ),
     features=FEATURES,
-    performance=PERFORMANCE,
+    performance=_STRIP.performance,
     check=check,
     evaluate=evaluate,
     categorical=("m",),

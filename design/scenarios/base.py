@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 __all__ = ["Column", "Scenario", "single_thread"]
 
@@ -104,6 +104,17 @@ class Scenario:
         simulation.
     evaluate : callable(row) -> dict
         Simulates one row; returns every performance column and ``status``.
+    kind : str
+        ``"strip"``, ``"sheet"`` or ``"gripper"`` for scenarios of those kinds (docs/scenarios.md
+        §6), else ``""``.
+    setting : mapping
+        The fixed setting in words and numbers (curve, material, supports, loads), for reports.
+    source : str
+        The scenario file it was read from, or ``""``.
+    shape : callable(row) -> CreasePattern, optional
+        The design's stress-free folded pattern (for pictures and files).
+    write_files : callable(row, folder) -> dict, optional
+        Writes the design's fabrication files into ``folder``; returns label -> path.
     """
 
     name: str
@@ -113,6 +124,11 @@ class Scenario:
     check: Callable[[Mapping[str, float]], list[str]]
     evaluate: Callable[[Mapping[str, float]], dict]
     categorical: tuple[str, ...] = ()
+    kind: str = ""
+    setting: Mapping = field(default_factory=dict)
+    source: str = ""
+    shape: Callable | None = None
+    write_files: Callable | None = None
 
     @property
     def feature_names(self) -> list[str]:

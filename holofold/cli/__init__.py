@@ -29,7 +29,7 @@ import warnings
 __all__ = ["main", "build_parser"]
 
 # preferred order in --help; modules not listed here follow alphabetically
-_ORDER = ["demo", "pattern", "fit", "evaluate", "generate", "mine", "verify"]
+_ORDER = ["demo", "design", "scenarios", "pattern", "fit", "evaluate", "generate", "mine", "verify"]
 
 
 def _command_modules():

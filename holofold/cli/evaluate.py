@@ -1,4 +1,4 @@
-"""``holofold evaluate``: simulate a table of designs with one of the paper's scenarios.
+"""``holofold evaluate``: simulate a table of designs with a scenario (a name or a .toml file).
 
 Reads CSV or Parquet (header = feature names of the published files, SI units) or a published
 headerless ``data*_*.txt`` (column names from the ``*_FeatureName.txt`` next to it), checks every
@@ -18,6 +18,7 @@ from holofold.design import (
     check_table_path,
     evaluate_designs,
     get_scenario,
+    load_scenario,
     read_table,
     validate_designs,
     write_table,
@@ -40,7 +41,10 @@ def register(subparsers) -> argparse.ArgumentParser:
         epilog=_epilog(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("scenario", choices=SCENARIO_NAMES, help="scenario to simulate")
+    p.add_argument(
+        "scenario",
+        help="scenario to simulate: " + ", ".join(SCENARIO_NAMES) + ", or a scenario file .toml",
+    )
     p.add_argument("designs", type=Path, help="design table (.csv, .parquet or published .txt)")
     p.add_argument(
         "-o", "--output", type=Path, required=True, help="result table (.csv or .parquet)"
@@ -73,7 +77,7 @@ def _epilog() -> str:
 
 
 def run(args) -> int:
-    scenario = get_scenario(args.scenario)
+    scenario = load_scenario(args.scenario)
     check_table_path(args.output)
     workers, scheduler = parallel_settings(args)
     table = read_table(args.designs)

@@ -18,7 +18,9 @@ def register(subparsers) -> argparse.ArgumentParser:
             "interrupted run without losing or duplicating rows)."
         ),
     )
-    p.add_argument("scenario", help="scenario: " + ", ".join(SCENARIO_NAMES))
+    p.add_argument(
+        "scenario", help="scenario: " + ", ".join(SCENARIO_NAMES) + ", or a scenario file .toml"
+    )
     p.add_argument("-n", "--samples", type=int, required=True, help="number of designs")
     p.add_argument("-o", "--output", required=True, help="database folder")
     p.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")

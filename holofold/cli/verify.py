@@ -19,7 +19,9 @@ def register(subparsers) -> argparse.ArgumentParser:
             "fraction meeting the target, with a 95 % Wilson interval."
         ),
     )
-    p.add_argument("scenario", help="scenario: " + ", ".join(SCENARIO_NAMES))
+    p.add_argument(
+        "scenario", help="scenario: " + ", ".join(SCENARIO_NAMES) + ", or a scenario file .toml"
+    )
     p.add_argument("--rules", required=True, help="rules.json from `holofold mine --json`")
     p.add_argument("--target", required=True, help="target expression, as given to mine")
     p.add_argument("-n", "--samples", type=int, default=50, help="designs per rule (default 50)")

@@ -1,0 +1,182 @@
+"""Reading the tables of a scenario file: checked values, one clear line per problem.
+
+A scenario file (docs/scenarios.md §6) is TOML, parsed with :mod:`tomllib` and never executed.
+Each kind (:mod:`~holofold.design.scenarios.strip`, ``sheet``, ``gripper``) reads its tables
+with these helpers, so every refusal has the same form::
+
+    my_arch.toml: [load] 2: at = 1.5 is outside [0, 1]
+
+naming the file, the table, the key and the allowed values, before anything is simulated.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from holofold.design.scenarios.base import Column
+
+__all__ = ["ScenarioFileError", "Section", "read_features"]
+
+
+class ScenarioFileError(ValueError):
+    """A scenario file that cannot be used (the message names file, table and key)."""
+
+
+@dataclass
+class Section:
+    """One table of a scenario file, read key by key; :meth:`done` refuses unknown keys.
+
+    Attributes
+    ----------
+    data : mapping
+        The table as parsed.
+    where : str
+        ``"file.toml: [table]"``, the prefix of every message.
+    base : Path
+        Folder of the file (relative paths are relative to it).
+    """
+
+    data: Mapping
+    where: str
+    base: Path
+    _used: set | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.data, Mapping):
+            raise ScenarioFileError(f"{self.where} must be a table, got {self.data!r}")
+        self._used = set()
+
+    def error(self, text: str) -> ScenarioFileError:
+        return ScenarioFileError(f"{self.where}: {text}")
+
+    def sub(self, key: str, required: bool = False) -> Section:
+        """The sub-table ``key`` (an empty one if absent and not ``required``)."""
+        if key not in self.data and required:
+            raise self.error(f"missing table [{key}]")
+        self._used.add(key)
+        head = self.where.rsplit(":", 1)[0]
+        return Section(self.data.get(key, {}), f"{head}: [{key}]", self.base)
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def raw(self, key: str, default=None):
+        self._used.add(key)
+        return self.data.get(key, default)
+
+    def number(
+        self,
+        key: str,
+        default: float | None = None,
+        *,
+        low: float | None = None,
+        high: float | None = None,
+        low_open: bool = False,
+        integer: bool = False,
+    ) -> float | None:
+        """A finite number in [low, high] (``(low, ...`` if ``low_open``), or ``default``."""
+        self._used.add(key)
+        if key not in self.data:
+            if default is None:
+                return None
+            return default
+        v = self.data[key]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise self.error(f"{key} = {v!r} must be a finite number")
+        if integer and v != int(v):
+            raise self.error(f"{key} = {v!r} must be an integer")
+        too_low = low is not None and (v <= low if low_open else v < low)
+        if too_low or (high is not None and v > high):
+            lo = "(" if low_open else "["
+            a = "-inf" if low is None else f"{low:g}"
+            b = "inf" if high is None else f"{high:g}"
+            rng = f"{lo}{a}, {b}]"
+            raise self.error(f"{key} = {v!r} is outside {rng}")
+        return int(v) if integer else float(v)
+
+    def choice(self, key: str, allowed: Sequence[str], default: str | None = None) -> str | None:
+        """A string among ``allowed`` (or ``default`` if absent)."""
+        self._used.add(key)
+        if key not in self.data:
+            return default
+        v = self.data[key]
+        if v not in allowed:
+            raise self.error(f"{key} = {v!r} is not allowed; allowed: {', '.join(allowed)}")
+        return v
+
+    def string(self, key: str, default: str | None = None) -> str | None:
+        self._used.add(key)
+        v = self.data.get(key, default)
+        if v is not None and not isinstance(v, str):
+            raise self.error(f"{key} = {v!r} must be a string")
+        return v
+
+    def path(self, key: str) -> Path:
+        """An existing file named by ``key``, relative to the scenario file's folder."""
+        v = self.string(key)
+        file = v.partition("#")[0]
+        p = Path(file) if Path(file).is_absolute() else self.base / file
+        if not p.is_file():
+            raise self.error(f"{key} = {v!r}: no such file {str(p)!r}")
+        return p
+
+    def done(self, allowed: Sequence[str] | None = None) -> None:
+        """Refuse any key that was not read (naming it and the allowed keys)."""
+        unknown = [k for k in self.data if k not in self._used]
+        if unknown:
+            names = sorted(self._used if allowed is None else allowed)
+            raise self.error(f"unknown key {unknown[0]!r}; allowed: {', '.join(names)}")
+
+
+def read_features(section: Section, defaults: Sequence[Column]) -> tuple[Column, ...]:
+    """The design features of a ``[features]`` table over the kind's ``defaults``.
+
+    ``name = [low, high]`` sets a continuous range, ``name = {choices = [...]}`` the levels of a
+    categorical feature, ``name = value`` fixes it (a range of one value); a feature not named
+    keeps its default. Returns the columns in the defaults' order.
+    """
+    by_name = {c.name: c for c in defaults}
+    out = dict(by_name)
+    for name, spec in section.data.items():
+        if name not in by_name:
+            raise section.error(f"unknown feature {name!r}; allowed: {', '.join(by_name)}")
+        section._used.add(name)
+        base = by_name[name]
+        where = f"{name} = {spec!r}"
+        if isinstance(spec, Mapping):
+            if set(spec) != {"choices"}:
+                raise section.error(f"{where}: a table here must be {{choices = [...]}}")
+            levels = spec["choices"]
+            if (
+                not isinstance(levels, list)
+                or not levels
+                or not all(_finite(v) for v in levels)
+                or len(set(levels)) != len(levels)
+            ):
+                raise section.error(f"{where}: choices must be distinct finite numbers")
+            out[name] = replace(base, low=None, high=None, choices=tuple(float(v) for v in levels))
+        elif isinstance(spec, list):
+            if len(spec) != 2 or not all(_finite(v) for v in spec):
+                raise section.error(f"{where}: a range is [low, high] of two finite numbers")
+            lo, hi = (float(v) for v in spec)
+            if not lo < hi:
+                raise section.error(f"{where}: low must be < high (fix a value as {name} = v)")
+            if base.choices:
+                raise section.error(f"{where}: {name} is categorical; give {{choices = [...]}}")
+            out[name] = replace(base, low=lo, high=hi, choices=())
+        elif _finite(spec):
+            v = float(spec)
+            if base.choices:
+                out[name] = replace(base, low=None, high=None, choices=(v,))
+            else:
+                out[name] = replace(base, low=v, high=v, choices=())
+        else:
+            raise section.error(f"{where}: give [low, high], {{choices = [...]}} or a number")
+    return tuple(out[c.name] for c in defaults)
+
+
+def _finite(v) -> bool:
+    return not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(v)

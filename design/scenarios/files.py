@@ -1,0 +1,93 @@
+"""Scenario files: a designer's own problem in TOML, and the paper's problems shipped as such.
+
+docs/scenarios.md §6. A file names its ``kind`` (``strip``, ``sheet`` or ``gripper``), the
+fixed setting (curve, material, supports, loads) and the design features with their ranges or
+choices. It is parsed with :mod:`tomllib` and never executed; every problem (an unknown key, a
+range with low >= high, a missing file, an unknown unit, a load outside the curve) is refused
+with one line naming the file, the table and the key, before anything is simulated.
+
+:func:`load_scenario` is what every command calls: a :class:`Scenario` is returned as is, a
+path to a ``.toml`` file is read, and a name is one of the paper's scenarios.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import tomllib
+from dataclasses import replace
+from pathlib import Path
+
+from holofold.design.scenarios.base import Scenario
+from holofold.design.scenarios.config import ScenarioFileError, Section
+
+__all__ = [
+    "KINDS",
+    "read_scenario",
+    "load_scenario",
+    "shipped_scenarios",
+    "shipped_text",
+    "ScenarioFileError",
+]
+
+#: kind -> module with ``from_config(doc, name, description) -> Scenario``
+KINDS = {
+    "strip": "holofold.design.scenarios.strip",
+    "sheet": "holofold.design.scenarios.sheet",
+    "gripper": "holofold.design.scenarios.gripper_kind",
+}
+_SHIPPED = Path(__file__).with_name("shipped")
+
+
+def read_scenario(path: str | os.PathLike) -> Scenario:
+    """The :class:`Scenario` described by a TOML file (relative paths inside are relative to it)."""
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except OSError as exc:
+        why = exc.strerror or exc
+        raise ScenarioFileError(f"cannot read scenario file {str(path)!r}: {why}") from None
+    except UnicodeDecodeError:
+        raise ScenarioFileError(f"{path.name}: not a UTF-8 text file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioFileError(f"{path.name}: not valid TOML: {exc}") from None
+    doc = Section(data, f"{path.name}: top level", path.resolve().parent)
+    kind = doc.choice("kind", tuple(KINDS))
+    if kind is None:
+        raise doc.error(f"missing key 'kind'; allowed: {', '.join(KINDS)}")
+    name = doc.string("name", path.stem)
+    if not name.strip():
+        raise doc.error("name must not be empty")
+    description = doc.string("description", "")
+    doc.where = f"{path.name}"
+    scenario = importlib.import_module(KINDS[kind]).from_config(doc, name, description)
+    doc.where = f"{path.name}: top level"
+    doc.done()
+    return replace(scenario, source=str(path))
+
+
+def shipped_scenarios() -> dict[str, Path]:
+    """Name -> path of the scenario files shipped with holofold (the paper's problems)."""
+    return {p.stem: p for p in sorted(_SHIPPED.glob("*.toml"))}
+
+
+def shipped_text(name: str) -> str:
+    """The text of a shipped scenario file, ready to copy and edit."""
+    files = shipped_scenarios()
+    if name not in files:
+        raise ValueError(f"no shipped scenario {name!r}; shipped: {', '.join(files)}")
+    return files[name].read_text(encoding="utf-8")
+
+
+def load_scenario(spec: Scenario | str | os.PathLike) -> Scenario:
+    """A scenario from a :class:`Scenario`, a ``.toml`` path or one of the paper's names."""
+    if isinstance(spec, Scenario):
+        return spec
+    s = os.fspath(spec)
+    if s.lower().endswith(".toml"):
+        return read_scenario(s)
+    from holofold.design.scenarios import get_scenario
+
+    return get_scenario(s)

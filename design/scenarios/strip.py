@@ -1,0 +1,486 @@
+"""The strip kind: a Miura-like strip over any planar curve (the paper's arch, generalised).
+
+docs/scenarios.md §6. A :class:`StripSetting` fixes everything a design does not vary: the
+target curve, the material, the supports and the load cases. :func:`strip_scenario` turns a
+setting and the design features into a :class:`~holofold.design.scenarios.base.Scenario`
+whose ``evaluate(row)`` builds the strip of :func:`holofold.fitting.strip_geometry` for the
+row's ``m``, ``offset``, ``stripeWidth`` and ``extrude``, the concentrated-hinge model with
+the row's ``tpanel``, ``tcrease`` and ``W``, and runs every load case from the stress-free
+state (Newton-Raphson load control, the last iterate kept as in the reference).
+
+Columns, SI units:
+
+``{load}stiff``
+    total force / |displacement of the loaded node along the load direction|, N/m;
+``{load}snap``
+    1 if that displacement exceeds the load's ``snap_displacement`` (loads that set one);
+``error``
+    the paper's index-matched fitting error, m;
+``closest_error``
+    mean closest-point distance of the centre line to the curve, m;
+``mass``
+    density x (panel area x tpanel + hinge-strip area x (tcrease - tpanel)), kg: the flat
+    sheet of panel thickness, thinned to the crease thickness over a strip of width W along
+    every fold line (the compliant crease the model represents).
+
+The paper's arch (:mod:`~holofold.design.scenarios.arch`) is this kind with the half circle of
+radius 2 m, the six end nodes pinned and two 5 N loads at the apex.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import lru_cache, partial
+
+import numpy as np
+
+from holofold.design.scenarios.base import Column, Scenario, integer, positive, single_thread
+from holofold.design.scenarios.config import Section, read_features
+from holofold.fitting import (
+    BUILTIN_CURVES,
+    PlanarCurve,
+    builtin_curve,
+    closest_point_error,
+    export_strip_files,
+    fit_strip,
+    index_matched_error,
+    read_points_csv,
+    read_svg_curve,
+    strip_geometry,
+)
+from holofold.geometry import LENGTH_UNITS, length_factor
+from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.analyses import load_along, secant_stiffness
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.compat import PAPER
+from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.status import Outcome, Status
+
+__all__ = [
+    "StripLoad",
+    "StripSetting",
+    "STRIP_FEATURES",
+    "SUPPORTS",
+    "strip_scenario",
+    "strip_model",
+    "strip_columns",
+    "evaluate_strip",
+    "check_strip",
+    "loaded_node",
+    "strip_shape",
+    "write_strip_files",
+    "from_config",
+]
+
+#: the strip's design features with the paper's arch ranges (docs/scenarios.md §5)
+STRIP_FEATURES = (
+    Column("m", "-", "number of Miura units", choices=(8.0, 12.0, 16.0, 24.0)),
+    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3),
+    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3),
+    Column("W", "m", "crease width", 1e-3, 4e-3),
+    Column("offset", "m", "zigzag offset l_o of the middle vertices", 0.10, 0.30),
+    Column("stripeWidth", "m", "side-line shift W_s", 0.01, 0.04),
+    Column("extrude", "m", "half-width l_e of the strip", 0.05, 0.25),
+)
+
+#: support choices: which nodes of the strip are fixed
+SUPPORTS = {
+    "ends": "the first and last node of the centre line and of both side lines (6 nodes)",
+    "centre-ends": "the first and last node of the centre line (2 nodes)",
+    "side-ends": "the first and last node of both side lines (4 nodes)",
+}
+
+
+@dataclass(frozen=True)
+class StripLoad:
+    """One load case on a strip.
+
+    Attributes
+    ----------
+    name : str
+        Column prefix: the case gives ``{name}stiff`` (and ``{name}snap``).
+    at : float
+        Position as a fraction of the curve's arc length in [0, 1], snapped to the nearest
+        centre-line vertex (0.5: the paper's apex).
+    direction : (3,) float
+        Direction of the force (normalised), e.g. ``(0, 0, -1)``.
+    force : float
+        Total force after the last increment, N (> 0).
+    increments : int
+        Equal load increments (>= 1).
+    snap_displacement : float or None
+        Displacement above which the case counts as a snap-through, m.
+    """
+
+    name: str
+    at: float
+    direction: tuple[float, float, float]
+    force: float
+    increments: int = 5
+    snap_displacement: float | None = None
+
+
+@dataclass(frozen=True)
+class StripSetting:
+    """The fixed setting of a strip scenario (everything a design does not vary).
+
+    Attributes
+    ----------
+    curve : PlanarCurve
+        Target curve in the x-z plane, m.
+    loads : tuple of StripLoad
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio of panels and creases.
+    density : float
+        kg/m^3, for ``mass``.
+    supports : str
+        One of :data:`SUPPORTS`.
+    support_dofs : str
+        Fixed directions of the support nodes (any of "xyz").
+    tol : float
+        Newton-Raphson tolerance on ||dU||, m.
+    max_iter : int
+        Iteration cap per increment (the reference's: 30, i.e. 29 iterations).
+    sampling : {"paper", "arclength"} or None
+        Where the centre line meets the curve; None: the curve's default.
+    curve_label : str
+        How the curve was given (for reports).
+    """
+
+    curve: PlanarCurve
+    loads: tuple[StripLoad, ...]
+    E: float = 2e9
+    nu: float = 0.3
+    density: float = 1200.0
+    supports: str = "ends"
+    support_dofs: str = "xyz"
+    tol: float = 1e-7
+    max_iter: int = 30
+    sampling: str | None = None
+    curve_label: str = field(default="", compare=False)
+
+    @property
+    def curve_sampling(self) -> str:
+        return self.sampling or self.curve.default_sampling
+
+
+def strip_columns(setting: StripSetting, extras: bool = True) -> tuple[Column, ...]:
+    """Performance columns of a setting: per load ``stiff`` (and ``snap``), then ``error``
+    (and, with ``extras``, ``closest_error`` and ``mass``)."""
+    cols = []
+    for ld in setting.loads:
+        cols.append(
+            Column(f"{ld.name}stiff", "N/m", f"secant stiffness under {ld.force:g} N at {ld.at:g}")
+        )
+        if ld.snap_displacement is not None:
+            cols.append(
+                Column(
+                    f"{ld.name}snap",
+                    "-",
+                    f"1 if the loaded node moves more than {ld.snap_displacement:g} m",
+                )
+            )
+    cols.append(Column("error", "m", "mean index-matched distance of the centre line to the curve"))
+    if extras:
+        cols.append(Column("closest_error", "m", "mean closest-point distance to the curve"))
+        cols.append(Column("mass", "kg", "mass of the strip (panels and hinge strips)"))
+    return tuple(cols)
+
+
+@lru_cache(maxsize=16)
+def _topology(m: int) -> CreasePattern:
+    """A strip with the right faces, validated once per m (coordinates are replaced per design)."""
+    g = strip_geometry(builtin_curve("half-circle", radius=2.0), m, 0.2, 0.02, 0.15)
+    return CreasePattern.from_faces(g.nodes, list(g.faces))
+
+
+def loaded_node(setting: StripSetting, m: int, at: float, t: np.ndarray | None = None) -> int:
+    """Centre-line node nearest to the arc-length fraction ``at`` (node m for 0.5)."""
+    if t is None:
+        t = strip_geometry(setting.curve, m, 0.2, 0.02, 0.15, setting.curve_sampling).t
+    if math.isclose(at, 0.5, abs_tol=1e-12):
+        return int(m)  # the middle sample: exactly the apex, whatever the round-off of s(t)
+    s = setting.curve.arc_length(t) / setting.curve.length
+    return int(np.argmin(np.abs(s - at)))
+
+
+def check_strip(setting: StripSetting, row) -> list[str]:
+    """Physical validity of one design (empty if valid)."""
+    errs = integer(row, "m", 2)
+    errs += positive(row, ("tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"))
+    return errs
+
+
+def strip_model(setting: StripSetting, row, *, profile=PAPER):
+    """The stress-free model with its supports, its geometry and the fitting error.
+
+    Returns
+    -------
+    structure : Structure
+    geometry : StripGeometry
+    error : float
+        Index-matched fitting error, m.
+    """
+    m = int(row["m"])
+    g = strip_geometry(
+        setting.curve,
+        m,
+        float(row["offset"]),
+        float(row["stripeWidth"]),
+        float(row["extrude"]),
+        setting.curve_sampling,
+    )
+    fixed = {
+        "ends": g.ends,
+        "centre-ends": g.centre[[0, -1]],
+        "side-ends": np.concatenate([g.side_a[[0, -1]], g.side_b[[0, -1]]]),
+    }[setting.supports]
+    s = build_concentrated(
+        _topology(m),
+        coords=g.nodes,
+        crease_width=row["W"],
+        crease_thickness=row["tcrease"],
+        panel_thickness=row["tpanel"],
+        E_panel=setting.E,
+        E_crease=setting.E,
+        nu_panel=setting.nu,
+        nu_crease=setting.nu,
+        profile=profile,
+    ).fixed(fixed, setting.support_dofs)
+    return s, g, index_matched_error(setting.curve, g.centre_line, g.t)
+
+
+def _mass(setting: StripSetting, g, row) -> float:
+    X, F = g.nodes, g.faces
+    area = 0.5 * np.linalg.norm(np.cross(X[F[:, 2]] - X[F[:, 0]], X[F[:, 3]] - X[F[:, 1]]), axis=1)
+    topo = _topology(g.m)
+    e = topo.edges[topo.interior]
+    fold_length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1).sum()
+    tp, tc, w = float(row["tpanel"]), float(row["tcrease"]), float(row["W"])
+    return setting.density * (area.sum() * tp + fold_length * w * (tc - tp))
+
+
+def evaluate_strip(setting: StripSetting, columns: Sequence[str], row) -> dict:
+    """The ``columns`` of one design (see the module docstring) and a status."""
+    s, g, err = strip_model(setting, row)
+    asm = Assembler(s)  # one sparse pattern and reduction for every load case
+    out: dict = {}
+    cases = {}
+    for ld in setting.loads:
+        group = load_along([loaded_node(setting, g.m, ld.at, g.t)], ld.direction)
+        with single_thread():
+            r = secant_stiffness(
+                s,
+                group,
+                force_per_increment=ld.force / ld.increments,
+                increments=ld.increments,
+                tol=setting.tol,
+                max_iter=setting.max_iter,
+                assembler=asm,
+            )
+        out[f"{ld.name}stiff"] = r.stiffness
+        label = f"{ld.name} case"
+        if ld.snap_displacement is not None:
+            snap = r.displacement > ld.snap_displacement
+            out[f"{ld.name}snap"] = 1.0 if snap else 0.0
+            label += " (snap-through)" if snap else ""
+        cases[label] = r.result.status
+    out["error"] = err
+    if "closest_error" in columns:
+        out["closest_error"] = closest_point_error(setting.curve, g.centre_line, both=False).mean
+    if "mass" in columns:
+        out["mass"] = _mass(setting, g, row)
+    out = {c: out[c] for c in columns}
+    out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
+    return out
+
+
+def strip_shape(setting: StripSetting, row) -> CreasePattern:
+    """The design's stress-free strip (3-D pattern in the x-z plane, m)."""
+    return _fit(setting, row).pattern
+
+
+def _fit(setting: StripSetting, row):
+    return fit_strip(
+        setting.curve,
+        int(row["m"]),
+        float(row["offset"]),
+        float(row["stripeWidth"]),
+        float(row["extrude"]),
+        sampling=setting.curve_sampling,
+    )
+
+
+def write_strip_files(setting: StripSetting, row, folder) -> dict:
+    """FOLD, SVG (cut and score lines), STL/OBJ of the folded strip and its thick solid.
+
+    Returns label -> path (the labels name the formats).
+    """
+    paths = export_strip_files(
+        _fit(setting, row),
+        folder,
+        panel_thickness=float(row["tpanel"]),
+        crease_width=float(row["W"]),
+    )
+    return {p.name: p for p in paths}
+
+
+def strip_scenario(
+    name: str,
+    description: str,
+    setting: StripSetting,
+    features: tuple[Column, ...] = STRIP_FEATURES,
+    *,
+    extras: bool = True,
+    source: str = "",
+) -> Scenario:
+    """The :class:`Scenario` of a strip setting (picklable for worker processes)."""
+    perf = strip_columns(setting, extras)
+    words = {
+        "curve": setting.curve_label or setting.curve.name,
+        "curve length (m)": setting.curve.length,
+        "E (Pa)": setting.E,
+        "nu": setting.nu,
+        "density (kg/m^3)": setting.density,
+        "supports": f"{SUPPORTS[setting.supports]}, fixed in {setting.support_dofs}",
+    }
+    for ld in setting.loads:
+        d = ", ".join(f"{v:g}" for v in ld.direction)
+        snap = "" if ld.snap_displacement is None else f", snap above {ld.snap_displacement:g} m"
+        words[f"load {ld.name}"] = (
+            f"{ld.force:g} N along ({d}) at {ld.at:g} of the arc length, "
+            f"{ld.increments} increments{snap}"
+        )
+    return Scenario(
+        name=name,
+        description=description,
+        features=features,
+        performance=perf,
+        check=partial(check_strip, setting),
+        evaluate=partial(evaluate_strip, setting, tuple(c.name for c in perf)),
+        categorical=tuple(c.name for c in features if c.choices),
+        kind="strip",
+        setting=words,
+        source=source,
+        shape=partial(strip_shape, setting),
+        write_files=partial(write_strip_files, setting),
+    )
+
+
+# ---------------------------------------------------------------------- scenario files
+def _read_curve(sec: Section) -> tuple[PlanarCurve, str, str | None]:
+    """The ``[curve]`` table: a built-in with its parameters, or a points/SVG file in units."""
+    given = [k for k in ("builtin", "points", "svg") if sec.has(k)]
+    if len(given) != 1:
+        raise sec.error("give exactly one of builtin = ..., points = ..., svg = ...")
+    sampling = sec.choice("sampling", ("paper", "arclength"))
+    try:
+        if given[0] == "builtin":
+            key = sec.choice("builtin", tuple(sorted(BUILTIN_CURVES)))
+            params = {
+                k: sec.number(k) for k in BUILTIN_CURVES[key][1] if sec.has(k)
+            }  # only the built-in's own parameters; anything else is refused below
+            sec.done(["builtin", "sampling", *BUILTIN_CURVES[key][1]])
+            curve = builtin_curve(key, **params)
+            label = key + "".join(f", {k} = {v:g}" for k, v in params.items())
+            return curve, label, sampling
+        unit = sec.choice("units", tuple(LENGTH_UNITS))
+        if unit is None:
+            raise sec.error(f"units = ... is required for a {given[0]} file; allowed: "
+                            + ", ".join(LENGTH_UNITS))  # fmt: skip
+        file = sec.path(given[0])
+        if given[0] == "points":
+            curve = read_points_csv(file)
+        else:
+            frag = sec.raw("svg").partition("#")[2]
+            curve = read_svg_curve(f"{file}#{frag}" if frag else file)
+        sec.done(["svg" if given[0] == "svg" else "points", "units", "sampling"])
+        curve = curve.scaled(length_factor(unit))
+        return curve, f"{given[0]} from {file.name} ({unit})", sampling
+    except ValueError as exc:
+        if str(exc).startswith(sec.where):
+            raise
+        raise sec.error(str(exc)) from None
+
+
+def _read_load(sec: Section, names: set) -> StripLoad:
+    name = sec.string("name")
+    if not name or not name.isidentifier():
+        raise sec.error(f"name = {name!r} must be a column prefix such as 'Z' or 'tip'")
+    if name in names:
+        raise sec.error(f"name = {name!r} is used by another load")
+    d = sec.raw("direction")
+    if (
+        not isinstance(d, list)
+        or len(d) != 3
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in d)
+        or not all(math.isfinite(v) for v in d)
+        or not any(d)
+    ):
+        raise sec.error(f"direction = {d!r} must be a non-zero 3-vector [x, y, z]")
+    load = StripLoad(
+        name=name,
+        at=sec.number("at", low=0.0, high=1.0) if sec.has("at") else _missing(sec, "at"),
+        direction=tuple(float(v) for v in d),
+        force=sec.number("force", low=0.0, low_open=True) if sec.has("force")
+        else _missing(sec, "force"),
+        increments=sec.number("increments", 5, low=1, high=1000, integer=True),
+        snap_displacement=sec.number("snap_displacement", low=0.0, low_open=True),
+    )  # fmt: skip
+    sec.done(["name", "at", "direction", "force", "increments", "snap_displacement"])
+    return load
+
+
+def _missing(sec: Section, key: str):
+    raise sec.error(f"missing key {key!r}")
+
+
+def from_config(doc: Section, name: str, description: str) -> Scenario:
+    """The strip scenario of a parsed scenario file (``kind = "strip"``)."""
+    curve, label, sampling = _read_curve(doc.sub("curve", required=True))
+    mat = doc.sub("material")
+    E = mat.number("E", 2e9, low=0.0, low_open=True)
+    nu = mat.number("nu", 0.3, low=-1.0, high=0.5, low_open=True)
+    density = mat.number("density", 1200.0, low=0.0, low_open=True)
+    mat.done()
+    sup = doc.sub("supports")
+    supports = sup.choice("nodes", tuple(SUPPORTS), "ends")
+    dofs = sup.string("dofs", "xyz")
+    if not dofs or set(dofs) - set("xyz") or len(set(dofs)) != len(dofs):
+        raise sup.error(f"dofs = {dofs!r} must be some of 'x', 'y', 'z' (e.g. 'xyz')")
+    sup.done()
+    sol = doc.sub("solver")
+    tol = sol.number("tol", 1e-7, low=0.0, low_open=True)
+    max_iter = sol.number("max_iter", 30, low=2, high=1000, integer=True)
+    sol.done()
+    raw_loads = doc.raw("load", [])
+    if not isinstance(raw_loads, list) or not raw_loads:
+        raise doc.error("at least one [[load]] table is needed")
+    loads, names = [], set()
+    head = doc.where.rsplit(":", 1)[0]
+    for k, t in enumerate(raw_loads, start=1):
+        ld = _read_load(Section(t, f"{head}: [load] {k}", doc.base), names)
+        names.add(ld.name)
+        loads.append(ld)
+    setting = StripSetting(
+        curve=curve,
+        loads=tuple(loads),
+        E=E,
+        nu=nu,
+        density=density,
+        supports=supports,
+        support_dofs=dofs,
+        tol=tol,
+        max_iter=max_iter,
+        sampling=sampling,
+        curve_label=label,
+    )
+    features = read_features(doc.sub("features"), STRIP_FEATURES)
+    for c in features:
+        if c.name == "m" and not all(v >= 2 and v == int(v) for v in c.choices or (c.low, c.high)):
+            raise doc.error(
+                f"[features] m must be integers >= 2, got {c.choices or (c.low, c.high)}"
+            )
+    return strip_scenario(name, description, setting, features)

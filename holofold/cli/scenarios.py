@@ -1,0 +1,44 @@
+"""``holofold scenarios``: list the scenarios, or print a shipped scenario file to copy."""
+
+from __future__ import annotations
+
+import argparse
+
+from holofold.design import SCENARIO_NAMES, get_scenario, shipped_scenarios, shipped_text
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "scenarios",
+        help="list the scenarios; 'show NAME' prints a scenario file to copy and edit",
+        description=(
+            "List the paper's scenarios and the scenario files shipped with holofold, or print "
+            "one file (TOML) to copy and edit for your own problem: your curve, material, "
+            "supports, loads and feature ranges. Every command that takes a scenario name also "
+            "takes the path of such a file."
+        ),
+        epilog="example: holofold scenarios show arch > my_arch.toml",
+    )
+    p.add_argument("action", nargs="?", choices=("list", "show"), default="list")
+    p.add_argument("name", nargs="?", help="shipped scenario to print (with 'show')")
+    return p
+
+
+def run(args) -> int:
+    files = shipped_scenarios()
+    if args.action == "show":
+        if not args.name:
+            raise ValueError(f"say which scenario to show: {', '.join(files)}")
+        print(shipped_text(args.name), end="")
+        return 0
+    if args.name:
+        raise ValueError(f"'list' takes no name (did you mean 'show {args.name}'?)")
+    print("scenarios (use the name, or copy the file with 'holofold scenarios show NAME'):")
+    for name in SCENARIO_NAMES:
+        sc = get_scenario(name)
+        file = "  [file: scenarios show " + name + "]" if name in files else ""
+        print(f"  {name:18s} {sc.description}{file}")
+    print("scenario file kinds: strip (a Miura strip over any curve), sheet, gripper")
+    return 0

@@ -1,0 +1,241 @@
+"""The design loop: margins, refinement sampling, choosing, and ``holofold design`` end to end."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from holofold.cli import main
+from holofold.design import (
+    choose_design,
+    parse_target,
+    read_scenario,
+    refine_designs,
+    rule_mask,
+    run_demo,
+    run_design,
+    shipped_text,
+)
+from holofold.mechanics import CONVERGED, Status
+
+pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
+
+
+def test_target_margins_are_normalised_by_the_threshold():
+    t = parse_target("Zstiff > 100 & error < 0.05 & 1 < Xstiff <= 50 | Zsnap == 1")
+    df = pd.DataFrame({"Zstiff": [150, 90], "error": [0.04, 0.01], "Xstiff": [10, 60],
+                       "Zsnap": [0, 1]})  # fmt: skip
+    m = t.margins(df)
+    assert t.conditions == ("Zstiff > 100", "error < 0.05", "1 < Xstiff", "Xstiff <= 50",
+                            "Zsnap == 1")  # fmt: skip
+    assert m["Zstiff > 100"] == pytest.approx([0.5, -0.1])
+    assert m["error < 0.05"] == pytest.approx([0.2, 0.8])
+    assert m["1 < Xstiff"] == pytest.approx([9.0, 59.0])
+    assert m["Xstiff <= 50"] == pytest.approx([0.8, -0.2])
+    assert m["Zsnap == 1"].tolist() == [-np.inf, np.inf]
+    # worst case: min over &, max over |; its sign agrees with evaluate
+    assert t.margin(df) == pytest.approx([0.2, np.inf])
+    assert ((t.margin(df) >= 0) == t.evaluate(df)).all()
+    zero = parse_target("x > 0")
+    assert zero.margin(pd.DataFrame({"x": [0.25]})) == pytest.approx([0.25])  # |t| = 1 at 0
+
+
+def _status(n, failed=()):
+    return [Status.failed("boom") if i in failed else CONVERGED for i in range(n)]
+
+
+def test_choose_design_takes_the_largest_worst_margin_inside_the_rule():
+    t = parse_target("a > 10 & b < 1")
+    df = pd.DataFrame({
+        "x": [0.1, 0.2, 0.3, 0.4, 0.9],
+        "a": [20.0, 15.0, 40.0, 100.0, 100.0],
+        "b": [0.5, 0.1, 0.9, 0.2, 0.0],
+    })  # fmt: skip
+    df["status"] = _status(5, failed={3})
+    label, margins, how = choose_design(df, t, {"x": {"gt": None, "le": 0.5}})
+    # row 0: min(1.0, 0.5) = 0.5; row 1: min(0.5, 0.9) = 0.5 ... row 0 first; row 2: 0.1;
+    # row 3 failed; row 4 outside the rule
+    assert label in (0, 1) and how == "inside the best verified rule"
+    assert margins == pytest.approx({"a > 10": 1.0, "b < 1": 0.5} if label == 0 else
+                                    {"a > 10": 0.5, "b < 1": 0.9})  # fmt: skip
+    df.loc[1, "b"] = 0.05
+    assert choose_design(df, t, {"x": {"gt": None, "le": 0.5}})[0] == 0
+    df.loc[0, "a"] = 100.0  # now row 0: min(9, 0.5)
+    df.loc[1, "a"] = 30.0  # row 1: min(2, 0.95)
+    assert choose_design(df, t, {"x": {"gt": None, "le": 0.5}})[0] == 1
+    none = choose_design(df, parse_target("a > 1e6"), None)
+    assert none[0] is None and "no simulated design" in none[2]
+
+
+def test_refined_designs_lie_inside_and_around_the_rules():
+    sc = read_scenario_text(shipped_text("arch"))
+    rules = [{"bounds": {"offset": {"gt": 0.2, "le": 0.25}, "m": {"in": [12.0]}}},
+             {"bounds": {"extrude": {"gt": None, "le": 0.1}}}]  # fmt: skip
+    new = refine_designs(sc, rules, 41, seed=3, start=500)
+    assert len(new) == 41 and new["sample"].tolist() == list(range(500, 541))
+    inside = rule_mask(new, rules[0]["bounds"])
+    assert 10 <= inside.sum() <= 21  # half of rule 1's 21 designs inside (a few of the rest)
+    first = new.iloc[:21]
+    assert (first["m"] == 12).all()
+    pad = 0.25 * (0.30 - 0.10)
+    assert first["offset"].between(0.2 - pad, 0.25 + pad).all()
+    second = new.iloc[21:]
+    assert (second["extrude"] <= 0.1 + 0.25 * 0.2 + 1e-12).all()
+    assert rule_mask(second.iloc[:10], rules[1]["bounds"]).all()
+    again = refine_designs(sc, rules, 41, seed=3, start=500)
+    pd.testing.assert_frame_equal(new, again)  # reproducible, so a resumed run extends the same
+
+
+def read_scenario_text(text, tmp=None):
+    import tempfile
+    from pathlib import Path
+
+    folder = Path(tempfile.mkdtemp())
+    (folder / "s.toml").write_text(text)
+    return read_scenario(folder / "s.toml")
+
+
+USER = """
+kind = "strip"
+name = "my-arch"
+description = "An arch over a 3 m catenary from a CSV in mm."
+[curve]
+points = "catenary_mm.csv"
+units = "mm"
+[[load]]
+name = "V"
+at = 0.5
+direction = [0, 0, -1]
+force = 5.0
+increments = 5
+snap_displacement = 0.5
+[features]
+m = { choices = [8, 12] }
+tcrease = [0.5e-3, 1.0e-3]
+tpanel = [2e-3, 5e-3]
+W = [2e-3, 4e-3]
+offset = [0.06, 0.2]
+stripeWidth = [0.01, 0.03]
+extrude = [0.05, 0.15]
+"""
+TARGET = "Vstiff > 150 & error < 0.06"
+
+
+@pytest.fixture(scope="module")
+def designed(tmp_path_factory):
+    """A small run of the loop on a user's curve, once for the tests below."""
+    from holofold.fitting import builtin_curve
+
+    folder = tmp_path_factory.mktemp("design")
+    pts = builtin_curve("catenary", span=3.0, height=1.2)(np.linspace(0, 1, 81)) * 1000.0
+    np.savetxt(folder / "catenary_mm.csv", pts, delimiter=",", header="x_mm,z_mm", comments="")
+    (folder / "my_arch.toml").write_text(USER)
+    said = []
+    out = run_design(folder / "my_arch.toml", TARGET, folder / "out", samples=100, rounds=1,
+                     refine=30, verify=10, top=2, workers=2, progress=False,
+                     say=said.append)  # fmt: skip
+    return folder, out, said
+
+
+@pytest.mark.slow
+def test_design_loop_on_a_users_curve_writes_a_verified_design(designed):
+    folder, out, said = designed
+    s = json.loads((folder / "out" / "design.json").read_text())
+    assert s == json.loads(json.dumps(out.summary))
+    assert {"features", "performance", "rule", "verified_precision", "margins", "scenario"} <= set(
+        s
+    )
+    assert s["scenario"]["name"] == "my-arch" and s["scenario"]["kind"] == "strip"
+    t = parse_target(TARGET)
+    perf = pd.DataFrame([s["performance"]])
+    assert t.evaluate(perf)[0] and min(s["margins"].values()) >= 0
+    assert s["worst_margin"] == pytest.approx(min(s["margins"].values()))
+    assert [r["round"] for r in s["rounds"]] == [0, 1]
+    for r in s["rounds"]:
+        for rule in r["rules"]:
+            assert rule["verified_n"] + rule["verified_failed"] == 10
+            lo, hi = rule["verified_95ci"]
+            assert lo <= rule["verified_precision"] <= hi
+    # the chosen design lies inside the chosen rule
+    row = pd.DataFrame([s["features"]])
+    assert rule_mask(row, s["rule"]["bounds"])[0]
+    for f in ("design.png", "rule.png", "scatter.png", "report.html", "files/strip.fold",
+              "files/strip.svg", "files/strip.stl", "files/strip_solid.stl"):  # fmt: skip
+        assert (folder / "out" / f).is_file(), f
+    for label, rel in s["files"].items():
+        assert (folder / "out" / rel).is_file(), label
+    stages = [line.split("]")[0] + "]" for line in said if line.startswith("[")]
+    assert stages[:3] == ["[database]", "[mine]", "[verify]"] and "[refine]" in stages
+    assert stages[-2:] == ["[choose]", "[files]"]
+
+
+@pytest.mark.slow
+def test_the_chosen_design_resimulated_by_evaluate_meets_the_target(designed, capsys):
+    folder, out, _ = designed
+    row = pd.DataFrame([out.features])
+    row.to_csv(folder / "chosen.csv", index=False)
+    res_path = folder / "chosen_res.csv"
+    assert main(["evaluate", str(folder / "my_arch.toml"), str(folder / "chosen.csv"), "-o",
+                 str(res_path)]) == 0  # fmt: skip
+    res = pd.read_csv(res_path)
+    assert parse_target(TARGET).evaluate(res)[0]
+    for c, v in out.performance.items():
+        assert res[c][0] == pytest.approx(v, rel=1e-9), c
+
+
+@pytest.mark.slow
+def test_design_loop_resumes_without_simulating_again(designed):
+    folder, out, _ = designed
+    chunks = sorted((folder / "out" / "database").rglob("part-*.parquet"))
+    stamps = [p.stat().st_mtime_ns for p in chunks]
+    again = run_design(folder / "my_arch.toml", TARGET, folder / "out", samples=100, rounds=1,
+                       refine=30, verify=10, top=2, workers=2, progress=False)  # fmt: skip
+    assert [p.stat().st_mtime_ns for p in chunks] == stamps  # nothing re-simulated
+    assert sorted((folder / "out" / "database").rglob("part-*.parquet")) == chunks
+    assert again.features == out.features and again.summary["rounds"] == out.summary["rounds"]
+    assert again.summary["timings"]["database"] < 0.5 * max(out.summary["timings"]["database"], 1)
+
+
+@pytest.mark.slow
+def test_more_samples_extend_the_database_instead_of_rebuilding_it(designed, tmp_path):
+    folder, out, _ = designed
+    import shutil
+
+    db = tmp_path / "db"
+    shutil.copytree(folder / "out" / "database", db)
+    res = run_design(folder / "my_arch.toml", TARGET, tmp_path / "o", samples=120, db=db,
+                     verify=4, top=1, workers=2, progress=False, files=False)  # fmt: skip
+    assert (db / "base-000000-000100").is_dir() and (db / "base-000100-000120").is_dir()
+    base = res.table[res.table["origin"] == "database"]
+    assert len(base) == 120 and base["sample"].tolist() == list(range(120))
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [(["--target", "Zstif > 1"], "unknown column"), (["-n", "5"], "samples = 5"),
+     (["--rounds", "-1"], "rounds = -1"), (["--workers", "0"], "workers")],
+)  # fmt: skip
+def test_design_command_refuses_bad_arguments_before_writing(tmp_path, capsys, argv, match):
+    out = tmp_path / "out"
+    args = ["design", "arch", "-o", str(out)]
+    if "--target" not in argv:
+        args += ["--target", "Zstiff > 100"]
+    assert main(args + argv) == 2
+    err = capsys.readouterr().err
+    assert match in err and err.count("\n") == 1 and not out.exists()
+
+
+@pytest.mark.slow
+def test_demo_is_the_design_loop_on_the_arch(tmp_path):
+    out = tmp_path / "demo"
+    said = []
+    summary = run_demo(out, samples=150, verify=5, rounds=0, workers=2, say=said.append)
+    assert json.loads((out / "design.json").read_text()) == summary
+    assert summary["scenario"]["name"] == "arch" and (out / "report.html").is_file()
+    assert parse_target("Zstiff > 100 & error < 0.1").evaluate(
+        pd.DataFrame([summary["performance"]])
+    )[0]
+    assert said[0].startswith("[database]") and said[-1].startswith("chosen:")

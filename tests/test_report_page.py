@@ -1,0 +1,511 @@
+"""The HTML report page of ``holofold design`` and its two plots; a real headless-browser check."""
+
+from __future__ import annotations
+
+import base64
+import copy
+import re
+import shutil
+import subprocess
+from html.parser import HTMLParser
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from holofold.design.report import (
+    plot_folded_design,
+    plot_rule_boxes,
+    plot_target_scatter,
+    save_figure,
+)
+from holofold.design.report_page import report_page_html, write_report_page
+from holofold.design.rules import ForestRuleMiner
+from holofold.design.targets import parse_target
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def make_summary() -> dict:
+    """A complete summary in the shape the design loop writes."""
+    rule0 = {
+        "rank": 1,
+        "rule": "offset <= 0.2 & m in {12, 16}",
+        "train_precision": 0.95,
+        "test_precision": 0.9,
+        "test_support": 40,
+        "verified_precision": 0.88,
+        "verified_95ci": [0.76, 0.94],
+        "verified_n": 50,
+    }
+    rule1 = {
+        "rank": 1,
+        "rule": "offset <= 0.18 & m in {12, 16}",
+        "train_precision": 0.97,
+        "test_precision": 0.93,
+        "test_support": 35,
+        "verified_precision": 0.92,
+        "verified_95ci": [0.81, 0.97],
+        "verified_n": 50,
+    }
+    return {
+        "scenario": {
+            "name": "my-arch",
+            "kind": "strip",
+            "description": "A strip arch fitted to a catenary <span> & loaded at its crown.",
+            "source": "my_arch.toml",
+            "setting": {"curve": "catenary from catenary.csv (mm), span 3 m", "E": 2e9, "nu": 0.3},
+            "features": [
+                {
+                    "name": "m",
+                    "unit": "-",
+                    "description": "panels",
+                    "low": None,
+                    "high": None,
+                    "choices": [8, 12, 16],
+                },
+                {
+                    "name": "offset",
+                    "unit": "m",
+                    "description": "crease offset",
+                    "low": 0.1,
+                    "high": 0.3,
+                    "choices": [],
+                },
+            ],
+            "performance": [
+                {"name": "Zstiff", "unit": "N/m", "description": "vertical stiffness"},
+                {"name": "error", "unit": "-", "description": "fit error"},
+            ],
+        },
+        "target": "Zstiff > 100 & error < 0.05",
+        "database": {"rows": 600, "failed": 2, "path": "database/"},
+        "rounds": [
+            {
+                "round": 0,
+                "rows": 500,
+                "rules": [
+                    rule0,
+                    {
+                        **rule0,
+                        "rank": 2,
+                        "rule": "m == 8",
+                        "verified_precision": None,
+                        "verified_95ci": None,
+                        "verified_n": None,
+                    },
+                ],
+            },
+            {"round": 1, "rows": 600, "rules": [rule1]},
+        ],
+        "rule": {**rule1, "bounds": {"offset": [None, 0.18], "m": [12, 16]}},
+        "verified_precision": 0.92,
+        "features": {"m": 12.0, "offset": 0.1537},
+        "performance": {"Zstiff": 140.2, "error": 0.031},
+        "units": {"m": "-", "offset": "m", "Zstiff": "N/m", "E": "Pa"},
+        "margins": {"Zstiff > 100": 0.402, "error < 0.05": -0.38, "m == 12": float("inf")},
+        "files": {"FOLD": "files/design.fold", "printable STL": "files/printable.stl"},
+        "images": {"design": "design.png", "rule": "rule.png", "scatter": "scatter.png"},
+        "timings": {"database": 41.2, "mine": 3.1, "verify": 10.2, "refine": 30.0, "files": 1.2},
+    }
+
+
+def _small_png(path, seed: int) -> bytes:
+    import matplotlib.image
+
+    rng = np.random.default_rng(seed)
+    matplotlib.image.imsave(path, rng.random((8, 12, 3)))
+    return path.read_bytes()
+
+
+@pytest.fixture
+def folder(tmp_path):
+    tmp_path = tmp_path / "design"
+    tmp_path.mkdir()
+    for k, name in enumerate(("design.png", "rule.png", "scatter.png")):
+        _small_png(tmp_path / name, k)
+    (tmp_path / "files").mkdir()
+    (tmp_path / "files" / "design.fold").write_text("{}")
+    return tmp_path
+
+
+class _Tables(HTMLParser):
+    """Cell texts of every table, by class: ``{cls: [[cell, ...], ...]}``; also the hrefs."""
+
+    def __init__(self):
+        super().__init__()
+        self.tables, self.hrefs, self.srcs = {}, [], []
+        self._rows = self._cell = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "table":
+            self._rows = self.tables.setdefault(a.get("class") or "", [])
+        elif tag == "tr" and self._rows is not None:
+            self._rows.append([])
+        elif tag in ("td", "th") and self._rows is not None:
+            self._cell = []
+        elif tag == "a":
+            self.hrefs.append(a["href"])
+        elif tag == "img":
+            self.srcs.append(a["src"])
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell.append(data)
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th") and self._cell is not None:
+            self._rows[-1].append("".join(self._cell).replace("\u00a0", " ").strip())
+            self._cell = None
+        elif tag == "table":
+            self._rows = None
+
+
+def _parse(page: str) -> _Tables:
+    p = _Tables()
+    p.feed(page)
+    return p
+
+
+def _visible(page: str) -> str:
+    """The page without its embedded images (base64 may contain any letters)."""
+    return re.sub(r"data:image/[a-z+]+;base64,[A-Za-z0-9+/=]*", "data:", page)
+
+
+# ---- the page ------------------------------------------------------------------------------
+
+
+def test_page_holds_the_design_table_and_target(folder):
+    path = write_report_page(folder, make_summary())
+    assert path == folder / "report.html"
+    page = path.read_text(encoding="utf-8")
+    assert page.startswith("<!DOCTYPE html>")
+    design = _parse(page).tables["design-table"]
+    rows = {r[0]: r[1:] for r in design if len(r) == 3}
+    assert rows["m"] == ["12", ""]
+    assert rows["offset"] == ["0.1537", "m"]
+    assert rows["Zstiff"] == ["140.2", "N/m"]
+    assert rows["error"] == ["0.031", ""]
+    assert "Zstiff &gt; 100 &amp; error &lt; 0.05" in page
+    # the margins, signed, one met and one missed
+    margins = {r[0]: r[1:] for r in _parse(page).tables["margins"][1:]}
+    assert margins["Zstiff > 100"][0] == "+0.402" and margins["Zstiff > 100"][-1] == "met"
+    assert margins["error < 0.05"][0] == "-0.38" and margins["error < 0.05"][-1] == "missed"
+    assert margins["m == 12"] == ["\u2013", "", "met"]  # an equality: met, of no size
+
+
+def test_page_problem_rules_and_timings(folder):
+    page = report_page_html(folder, make_summary())
+    t = _parse(page).tables
+    features = {r[0]: r[1:] for r in t["features"][1:]}
+    assert features["m"][1] == "one of 8, 12, 16"
+    assert features["offset"][1] == "0.1 to 0.3 m"
+    setting = dict(r for r in t["setting-table"][1:])
+    assert setting["E"] == "2×109 Pa"  # 2×10<sup>9</sup>, tags dropped
+    assert setting["curve"] == "catenary from catenary.csv (mm), span 3 m"
+    rules = [r for r in t["rules"] if r[0] != "round"]  # both rounds' rows, no headers
+    assert rules[0] == [
+        "0",
+        "1",
+        "offset <= 0.2 & m in {12, 16}",
+        "95.0 %",
+        "90.0 %",
+        "88.0 % (95 % interval 76.0 % to 94.0 %, n = 50)",
+    ]
+    assert rules[1][-1] == "not verified"
+    assert rules[2][:3] == ["1", "1", "offset <= 0.18 & m in {12, 16}"]
+    assert "Round 1: best verified precision 92.0\u00a0% (rank 1), up 4.0 points from round 0" in (
+        page
+    )
+    assert '<tr class="chosen"><td class="num">1</td>' in page  # the chosen rule highlighted
+    timings = dict(r for r in t["timings"][1:])
+    assert timings["rule mining"] == "3.1 s"
+    assert timings["total"] == "1 min 26 s"  # 85.7 s
+
+
+def test_text_is_escaped(folder):
+    s = make_summary()
+    s["scenario"]["name"] = "arch <b>&</b>"
+    page = report_page_html(folder, s)
+    assert "offset &lt;= 0.2 &amp; m in {12, 16}" in page
+    assert "offset <= 0.2" not in page
+    assert "catenary &lt;span&gt; &amp; loaded" in page and "<span> &" not in page
+    assert "<b>&</b>" not in page and "arch &lt;b&gt;&amp;&lt;/b&gt;" in page
+
+
+def test_images_are_embedded_and_links_relative(folder):
+    page = report_page_html(folder, make_summary())
+    parsed = _parse(page)
+    assert len(parsed.srcs) == 3
+    for src, name in zip(parsed.srcs, ("design.png", "rule.png", "scatter.png"), strict=True):
+        assert src.startswith("data:image/png;base64,")
+        data = base64.b64decode(src.split(",", 1)[1])
+        assert data.startswith(PNG_SIGNATURE) and data == (folder / name).read_bytes()
+    assert 'data-images-total="3"' in page
+    assert "files/design.fold" in parsed.hrefs and "files/printable.stl" in parsed.hrefs
+    assert all(not h.startswith(("/", "http:", "https:", "file:")) for h in parsed.hrefs)
+    # self-contained: nothing loaded from elsewhere
+    assert "<link" not in page and "@import" not in page and 'src="http' not in page
+    assert "(not found)" in page  # printable.stl was never written
+
+
+def test_missing_parts_render_gracefully(folder):
+    s = make_summary()
+    for key in ("rounds", "database", "margins", "files", "images", "timings", "units"):
+        s.pop(key)
+    s["rule"] = {
+        "rank": 1,
+        "rule": "offset <= 0.2",
+        "verified_precision": None,
+        "verified_95ci": None,
+        "verified_n": None,
+    }
+    s["verified_precision"] = None
+    s["performance"]["error"] = float("nan")
+    s["performance"]["mass"] = None
+    s["scenario"]["description"] = None
+    page = _visible(write_report_page(folder, s).read_text(encoding="utf-8"))
+    assert "not verified" in page
+    assert re.search(r"\bnone\b", page, re.IGNORECASE) is None
+    assert re.search(r"\bnan\b", page, re.IGNORECASE) is None
+    assert "<img" not in page and 'data-images-total="0"' in page
+    assert "No rules were mined." in page
+    rows = {r[0]: r[1:] for r in _parse(page).tables["design-table"] if len(r) == 3}
+    assert rows["error"][0] == rows["mass"][0] == "\u2013"
+    assert rows["Zstiff"] == ["140.2", "N/m"]  # the unit from the scenario's columns
+
+
+def test_only_round_zero_and_missing_image_files(tmp_path):
+    s = make_summary()
+    s["rounds"] = s["rounds"][:1]
+    s["rounds"][0]["rules"][0]["verified_precision"] = None
+    page = _visible(report_page_html(tmp_path, s))  # no image file exists in tmp_path
+    assert "Round 0: best verified precision" not in page  # rank 2 is not verified either
+    assert "Round 0: no rule verified." in page
+    assert "<img" not in page and "picture design.png was not made" in page
+    assert re.search(r"\b(none|nan)\b", page, re.IGNORECASE) is None
+
+
+@pytest.mark.parametrize(
+    "breakage",
+    [
+        lambda s: s.pop("target"),
+        lambda s: s.pop("features"),
+        lambda s: s.__setitem__("scenario", "my-arch"),
+        lambda s: s.__setitem__("performance", [140.2]),
+    ],
+)
+def test_a_malformed_summary_writes_nothing(folder, breakage):
+    good = write_report_page(folder, make_summary()).read_bytes()
+    bad = copy.deepcopy(make_summary())
+    breakage(bad)
+    with pytest.raises((ValueError, TypeError)):
+        write_report_page(folder, bad)
+    assert (folder / "report.html").read_bytes() == good  # the old page stays whole
+    assert not list(folder.glob(".holofold-*"))  # and no temporary file is left
+
+
+def test_a_malformed_summary_leaves_no_page(tmp_path):
+    with pytest.raises(TypeError):
+        write_report_page(tmp_path, ["not", "a", "summary"])
+    with pytest.raises(OSError):
+        write_report_page(tmp_path / "absent", make_summary())
+    assert not list(tmp_path.iterdir())
+
+
+# ---- the plots -----------------------------------------------------------------------------
+
+
+def _database(n=400, seed=0) -> pd.DataFrame:
+    rng = np.random.default_rng(seed)
+    return pd.DataFrame(
+        {
+            "offset": rng.uniform(0.1, 0.3, n),
+            "m": rng.choice([8.0, 12.0, 16.0], n),
+            "Zstiff": 10 ** rng.uniform(0, 4, n),
+            "error": rng.uniform(0, 0.1, n),
+        }
+    )
+
+
+def _by_label(ax, prefix):
+    found = [c for c in ax.collections if c.get_label().startswith(prefix)]
+    assert len(found) == 1, [c.get_label() for c in ax.collections]
+    return found[0]
+
+
+def test_target_scatter_colours_the_meeting_rows():
+    import matplotlib.pyplot as plt
+
+    table = _database()
+    table.loc[:4, "Zstiff"] = np.nan  # failed rows: not plotted
+    target = parse_target("Zstiff > 100 & offset < 0.2", table.columns)
+    meets = target.evaluate(table)
+    fig = plot_target_scatter(
+        table,
+        target,
+        "offset",
+        "Zstiff",
+        chosen={"offset": 0.15, "Zstiff": 140.0},
+        units={"offset": "m", "Zstiff": "N/m"},
+    )
+    ax = fig.axes[0]
+    ok = np.isfinite(table["Zstiff"].to_numpy())
+    hit = _by_label(ax, "meets the target")
+    other = _by_label(ax, "other designs")
+    star = _by_label(ax, "chosen design")
+    assert 50 < meets.sum() < 250
+    expected = table.loc[meets & ok, ["offset", "Zstiff"]].to_numpy()
+    np.testing.assert_array_equal(hit.get_offsets(), expected)
+    assert len(other.get_offsets()) == (ok & ~meets).sum() == len(table) - 5 - meets.sum()
+    assert hit.get_label() == f"meets the target ({meets.sum()})"
+    np.testing.assert_array_equal(star.get_offsets(), [[0.15, 140.0]])
+    assert ax.get_yscale() == "log" and ax.get_xscale() == "linear"  # 4 decades vs 0.5
+    assert ax.get_xlabel() == "offset [m]" and ax.get_ylabel() == "Zstiff [N/m]"
+    # the thresholds: x = 0.2 vertical, y = 100 horizontal, both dashed
+    lines = {(tuple(ln.get_xdata()), tuple(ln.get_ydata())) for ln in ax.lines}
+    assert ((0.2, 0.2), (0, 1)) in lines and ((0, 1), (100.0, 100.0)) in lines
+    assert all(ln.get_linestyle() == "--" for ln in ax.lines)
+    plt.close(fig)
+
+
+def test_target_scatter_without_simple_thresholds():
+    import matplotlib.pyplot as plt
+
+    table = _database()
+    table.loc[0, "error"] = 0.0
+    fig = plot_target_scatter(table, "Zstiff > 3000 | error < 0.01", "offset", "error")
+    ax = fig.axes[0]
+    expected = (table["Zstiff"] > 3000) | (table["error"] < 0.01)
+    assert len(_by_label(ax, "meets the target").get_offsets()) == expected.sum()
+    assert not ax.lines  # an or-target has no single threshold per axis
+    assert ax.get_yscale() == "linear"  # an error of 0: no log
+    assert ax.get_xlabel() == "offset"
+    plt.close(fig)
+    with pytest.raises(ValueError, match="width"):
+        plot_target_scatter(table, "Zstiff > 1", "width", "error")
+
+
+def _arch(n=25, radius=1.2, width=0.15):
+    """A half-circle strip in the x-z plane, width along y: vertices (m), quads and creases."""
+    s = np.linspace(0.0, np.pi, n)
+    front = np.column_stack([radius * np.cos(s), np.zeros(n), 0.4 + radius * np.sin(s)])
+    back = front + [0.0, width, 0.0]
+    vertices = np.vstack([front, back])
+    faces = [[i, i + 1, n + i + 1, n + i] for i in range(n - 1)]
+    creases = np.array([[i, n + i] for i in range(1, n - 1)])
+    return vertices, faces, creases
+
+
+def test_folded_design_axes_cover_the_vertices_in_mm():
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    vertices, faces, creases = _arch()
+    triangles = [[0, 1, 26]] + faces[1:]  # a triangle among the quads
+    fig = plot_folded_design(vertices, triangles, creases=creases, title="arch m = 24")
+    ax = fig.axes[0]
+    mm = vertices * 1e3
+    for k, lim in enumerate((ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d())):
+        assert lim[0] <= mm[:, k].min() and lim[1] >= mm[:, k].max()
+        assert lim[1] - lim[0] <= np.ptp(mm[:, k]) + 0.01 * np.ptp(mm, axis=0).max()  # tight
+    assert (ax.get_xlim3d()[1]) > 1000  # in mm, not m
+    fig.canvas.draw()  # projects the 3D collections
+    panels = [c for c in ax.collections if isinstance(c, Poly3DCollection)]
+    lines = [c for c in ax.collections if isinstance(c, Line3DCollection)]
+    assert len(panels) == 1 and len(panels[0].get_paths()) == len(faces)
+    assert len(lines) == 1 and len(lines[0].get_segments()) == len(creases)
+    # equal aspect: the box's sides are in the ratio of the axis ranges (2405 : 155 : 1205 mm)
+    aspect = np.asarray(ax.get_box_aspect())
+    spans = np.ptp([ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d()], axis=1)
+    np.testing.assert_allclose(aspect / aspect[0], spans / spans[0], rtol=1e-9)
+    np.testing.assert_allclose(spans, np.ptp(mm, axis=0), atol=0.01 * np.ptp(mm))
+    assert "mm" in ax.get_xlabel() and "mm" in ax.get_zlabel()
+    assert ax.get_title() == "arch m = 24"
+    # shading: the panels' colours vary with their orientation
+    assert np.ptp(panels[0].get_facecolor()[:, :3].sum(axis=1)) > 0.1
+    plt.close(fig)
+    with pytest.raises(ValueError, match="shape"):
+        plot_folded_design(vertices[:, :2], faces)
+
+
+# ---- a real browser --------------------------------------------------------------------------
+
+
+def _real_pictures(folder):
+    """The three pictures of the page, drawn by the report's own plot functions."""
+    vertices, faces, creases = _arch()
+    save_figure(plot_folded_design(vertices, faces, creases=creases), folder / "design.png")
+    table = _database()
+    chosen = {"offset": 0.15, "Zstiff": 140.0}
+    save_figure(
+        plot_target_scatter(
+            table,
+            "Zstiff > 100 & error < 0.05",
+            "offset",
+            "Zstiff",
+            chosen=chosen,
+            units={"offset": "m", "Zstiff": "N/m"},
+        ),
+        folder / "scatter.png",
+    )
+    X = table[["offset", "m"]]
+    y = parse_target("offset < 0.2 & m >= 12", X.columns).evaluate(X)
+    miner = ForestRuleMiner(n_estimators=10, min_support=5, random_state=0)
+    miner.fit(X, y)
+    save_figure(plot_rule_boxes(miner, X, 0, units={"offset": "m"}), folder / "rule.png")
+
+
+def _chromium(tmp_path, *args):
+    exe = shutil.which("chromium")
+    if exe is None:
+        pytest.skip("chromium not installed: apt-get install chromium")
+    profile = tmp_path / f"profile-{len(list(tmp_path.glob('profile-*')))}"
+    flags = [
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        f"--user-data-dir={profile}",
+        "--enable-logging=stderr",  # console messages (JS errors) go to stderr
+        "--v=0",
+    ]
+    done = subprocess.run(
+        [exe, *flags, *args], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "Uncaught" not in done.stderr, done.stderr[-2000:]
+    return done
+
+
+@pytest.mark.slow
+def test_the_page_in_a_headless_browser(folder, tmp_path):
+    import matplotlib.image
+
+    _real_pictures(folder)
+    page = write_report_page(folder, make_summary())
+    url = page.resolve().as_uri()
+    dom = _chromium(tmp_path, "--dump-dom", url).stdout
+    body = re.search(r"<body([^>]*)>", dom)
+    assert body, dom[:500]
+    attrs = dict(re.findall(r'([\w-]+)="([^"]*)"', body.group(1)))
+    assert attrs.get("data-images-total") == "3"
+    assert attrs.get("data-images-loaded") == "3"  # every picture decoded
+    assert '<table class="design-table">' in dom and "140.2" in dom
+
+    shot = tmp_path / "shot.png"
+    _chromium(tmp_path, f"--screenshot={shot}", "--window-size=1200,3000", url)
+    pixels = matplotlib.image.imread(shot)[..., :3]
+    assert pixels.shape[:2] == (3000, 1200)
+    colours = np.unique((pixels * 255).astype(np.uint8).reshape(-1, 3), axis=0)
+    assert len(colours) > 200  # text, tables and the three pictures
+    assert pixels.std() > 0.08
+    # the pictures are drawn: the scatter's red points and the arch's blue panels show
+    red = (pixels[..., 0] > 0.7) & (pixels[..., 1] < 0.3) & (pixels[..., 2] < 0.3)
+    blue = (pixels[..., 2] > 0.6) & (pixels[..., 0] < 0.5)
+    assert red.sum() > 500 and blue.sum() > 2000
