@@ -50,6 +50,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "dask_scheduler",
         ],
         "sampling": ["sample_designs", "METHODS"],
+        "scenarios.strip": ["StripSetting", "StripLoad", "strip_scenario", "STRIP_FEATURES"],
         "scenarios": [
             "Scenario",
             "Column",

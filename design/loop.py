@@ -1,6 +1,6 @@
 """The design loop: from a scenario and a target to one chosen, verified design and its files.
 
-:func:`run_design` is what ``holofold design`` runs (docs/scenarios.md §7):
+:func:`run_design` is what ``holofold design`` runs (docs/scenarios.md §9):
 
 1. **database**: sample designs of the scenario and simulate them (resumable Parquet batches);
 2. **mine**: rules for the target (random forest), keeping distinct alternatives;

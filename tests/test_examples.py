@@ -61,3 +61,22 @@ def test_gripper_closing_example(tmp_path, monkeypatch):
         a, b = gripper_model(d).nodes.tips
         assert np.linalg.norm(x[a] - x[b]) == pytest.approx(sim.tip_distance[-1], rel=1e-12)
         assert sim.triangles.max() < len(x) and x[:, 2].max() > 1e-3
+
+
+@pytest.mark.slow
+def test_design_my_arch_example_chooses_a_design_that_meets_its_target(tmp_path):
+    ns = runpy.run_path(str(ROOT / "examples" / "design_my_arch.py"))
+    summary = ns["main"](tmp_path / "my-arch", samples=200, verify=10)
+    from holofold.design import parse_target, read_scenario
+
+    perf = summary["performance"]
+    assert perf["Vstiff"] > 300 and perf["error"] < 0.04 and min(summary["margins"].values()) > 0
+    # the Python scenario and examples/my_arch.toml are the same problem: same numbers
+    toml = read_scenario(ROOT / "examples" / "my_arch.toml")
+    again = toml.evaluate(summary["features"])
+    for c, v in perf.items():
+        assert again[c] == pytest.approx(v, rel=1e-12), c
+    assert parse_target(ns["TARGET"]).columns == ("Vstiff", "error")
+    for f in ("strip.fold", "strip.svg", "strip.stl", "strip.obj", "strip_solid.stl"):
+        assert (tmp_path / "my-arch" / "files" / f).is_file()
+    assert (tmp_path / "my-arch" / "design.json").is_file()

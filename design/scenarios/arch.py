@@ -45,6 +45,7 @@ SETTING = StripSetting(
     E=E,
     nu=NU,
     tol=TOL,
+    refuse_overlap=False,  # as the paper: every row simulated (none of its 3000 overlaps)
     curve_label="half circle, radius 2 m",
 )
 FEATURES = STRIP_FEATURES

@@ -1,6 +1,6 @@
 """Reading the tables of a scenario file: checked values, one clear line per problem.
 
-A scenario file (docs/scenarios.md §6) is TOML, parsed with :mod:`tomllib` and never executed.
+A scenario file (docs/scenarios.md §8) is TOML, parsed with :mod:`tomllib` and never executed.
 Each kind (:mod:`~holofold.design.scenarios.strip`, ``sheet``, ``gripper``) reads its tables
 with these helpers, so every refusal has the same form::
 

@@ -1,6 +1,6 @@
 """Scenario files: a designer's own problem in TOML, and the paper's problems shipped as such.
 
-docs/scenarios.md §6. A file names its ``kind`` (``strip``, ``sheet`` or ``gripper``), the
+docs/scenarios.md §8. A file names its ``kind`` (``strip``, ``sheet`` or ``gripper``), the
 fixed setting (curve, material, supports, loads) and the design features with their ranges or
 choices. It is parsed with :mod:`tomllib` and never executed; every problem (an unknown key, a
 range with low >= high, a missing file, an unknown unit, a load outside the curve) is refused

@@ -1,6 +1,6 @@
 """The strip kind: a Miura-like strip over any planar curve (the paper's arch, generalised).
 
-docs/scenarios.md §6. A :class:`StripSetting` fixes everything a design does not vary: the
+docs/scenarios.md §8. A :class:`StripSetting` fixes everything a design does not vary: the
 target curve, the material, the supports and the load cases. :func:`strip_scenario` turns a
 setting and the design features into a :class:`~holofold.design.scenarios.base.Scenario`
 whose ``evaluate(row)`` builds the strip of :func:`holofold.fitting.strip_geometry` for the
@@ -51,6 +51,7 @@ from holofold.fitting import (
     strip_geometry,
 )
 from holofold.geometry import LENGTH_UNITS, length_factor
+from holofold.geometry.errors import InvalidPatternError
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness
 from holofold.mechanics.assembly import Assembler
@@ -145,6 +146,10 @@ class StripSetting:
         Iteration cap per increment (the reference's: 30, i.e. 29 iterations).
     sampling : {"paper", "arclength"} or None
         Where the centre line meets the curve; None: the curve's default.
+    refuse_overlap : bool
+        Report a design whose panels are not simple polygons (a self-overlapping strip, which
+        :func:`~holofold.fitting.fit_strip` refuses and nobody can build) as a failed row
+        instead of simulating it. None of the 3000 published arch rows overlaps.
     curve_label : str
         How the curve was given (for reports).
     """
@@ -159,6 +164,7 @@ class StripSetting:
     tol: float = 1e-7
     max_iter: int = 30
     sampling: str | None = None
+    refuse_overlap: bool = True
     curve_label: str = field(default="", compare=False)
 
     @property
@@ -265,6 +271,14 @@ def _mass(setting: StripSetting, g, row) -> float:
 def evaluate_strip(setting: StripSetting, columns: Sequence[str], row) -> dict:
     """The ``columns`` of one design (see the module docstring) and a status."""
     s, g, err = strip_model(setting, row)
+    if setting.refuse_overlap:
+        try:
+            CreasePattern.from_faces(g.nodes, list(g.faces))
+        except InvalidPatternError as exc:
+            return {
+                **dict.fromkeys(columns, float("nan")),
+                "status": Status.failed(f"self-overlapping strip: {exc}"),
+            }
     asm = Assembler(s)  # one sparse pattern and reduction for every load case
     out: dict = {}
     cases = {}
