@@ -392,7 +392,14 @@ def run_design(
     if files:
         t0 = time.perf_counter()
         say("[files] fabrication files, pictures and report.html")
-        summary["files"], summary["images"] = _write_files(sc, row, out, mined, rule, table, tgt)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            summary["files"], summary["images"] = _write_files(
+                sc, row, out, mined, rule, table, tgt
+            )
+        summary["warnings"] = list(dict.fromkeys(str(w.message) for w in caught))
+        for w in summary["warnings"]:
+            say(f"  note: {w}")
         times["files"] = time.perf_counter() - t0
     summary["timings"] = {k: round(v, 3) for k, v in times.items()}
     write_json(out / "design.json", summary)

@@ -486,7 +486,13 @@ def _files(folder: Path, summary: Mapping) -> str:
             f'<li><a href="{href}">{_esc(label)}</a> <span class="note">{_esc(rel)}</span>'
             f"{missing}</li>"
         )
-    out.append("</ul></section>")
+    out.append("</ul>")
+    notes = [str(w) for w in summary.get("warnings") or () if w]
+    if notes:
+        out.append('<p><strong>Notes on the files:</strong></p><ul class="files">')
+        out.extend(f"<li>{_esc(w)}</li>" for w in notes)
+        out.append("</ul>")
+    out.append("</section>")
     return "".join(out)
 
 

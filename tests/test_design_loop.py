@@ -239,3 +239,20 @@ def test_demo_is_the_design_loop_on_the_arch(tmp_path):
         pd.DataFrame([summary["performance"]])
     )[0]
     assert said[0].startswith("[database]") and said[-1].startswith("chosen:")
+
+
+@pytest.mark.slow
+def test_the_report_page_of_a_real_run_loads_in_a_browser(designed, tmp_path):
+    import re
+
+    from _browser import chromium
+
+    folder, out, _ = designed
+    url = (folder / "out" / "report.html").resolve().as_uri()
+    dom = chromium(tmp_path, "--dump-dom", url).stdout
+    attrs = dict(re.findall(r'([\w-]+)="([^"]*)"', re.search(r"<body([^>]*)>", dom).group(1)))
+    assert attrs["data-images-total"] == attrs["data-images-loaded"] == "3"
+    assert '<table class="design-table">' in dom and "my-arch" in dom
+    assert f"{out.performance['Vstiff']:.4g}" in dom  # the chosen design's number, as shown
+    for rel in out.summary["files"].values():
+        assert f'href="{rel}"' in dom

@@ -5,13 +5,12 @@ from __future__ import annotations
 import base64
 import copy
 import re
-import shutil
-import subprocess
 from html.parser import HTMLParser
 
 import numpy as np
 import pandas as pd
 import pytest
+from _browser import chromium as _chromium
 
 from holofold.design.report import (
     plot_folded_design,
@@ -455,32 +454,6 @@ def _real_pictures(folder):
     miner = ForestRuleMiner(n_estimators=10, min_support=5, random_state=0)
     miner.fit(X, y)
     save_figure(plot_rule_boxes(miner, X, 0, units={"offset": "m"}), folder / "rule.png")
-
-
-def _chromium(tmp_path, *args):
-    exe = shutil.which("chromium")
-    if exe is None:
-        pytest.skip("chromium not installed: apt-get install chromium")
-    profile = tmp_path / f"profile-{len(list(tmp_path.glob('profile-*')))}"
-    flags = [
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-        f"--user-data-dir={profile}",
-        "--enable-logging=stderr",  # console messages (JS errors) go to stderr
-        "--v=0",
-    ]
-    done = subprocess.run(
-        [exe, *flags, *args], capture_output=True, text=True, timeout=60, check=False
-    )
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "Uncaught" not in done.stderr, done.stderr[-2000:]
-    return done
 
 
 @pytest.mark.slow

@@ -338,7 +338,14 @@ def write_strip_files(setting: StripSetting, row, folder) -> dict:
         panel_thickness=float(row["tpanel"]),
         crease_width=float(row["W"]),
     )
-    return {p.name: p for p in paths}
+    labels = {
+        "strip.fold": "FOLD crease pattern (flat layout and folded state, m)",
+        "strip.svg": "SVG of the flat layout: cut and score layers (mm)",
+        "strip.stl": "STL of the folded strip (m)",
+        "strip.obj": "OBJ of the folded strip (m)",
+        "strip_solid.stl": "STL of the thick solid: panels of thickness tpanel (m)",
+    }
+    return {labels.get(p.name, p.name): p for p in paths}
 
 
 def strip_scenario(
