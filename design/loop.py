@@ -36,7 +36,7 @@ from holofold.design.rules import FewRulesWarning
 from holofold.design.runner import check_workers
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
-from holofold.design.store import build_database
+from holofold.design.store import build_database, load_database
 from holofold.design.tables import ColumnRoles, write_table
 from holofold.design.targets import parse_target
 from holofold.design.verify import Verification, rule_mask, rule_ranges
@@ -162,14 +162,36 @@ def _roles(scenario: Scenario) -> ColumnRoles:
     return ColumnRoles(tuple(varied), tuple(scenario.performance_names), cats)
 
 
-def _base_batches(db: Path, n: int) -> list[tuple[int, int]]:
-    """Row spans [start, stop) of the base sample: the existing batches, then what is missing."""
+def _given_database(db: Path, sc: Scenario) -> pd.DataFrame | None:
+    """The rows of a database folder made by ``holofold generate`` (None if ``db`` is not one)."""
+    meta = db / "meta.json"
+    if not meta.is_file():
+        return None
+    import json
+
+    try:
+        info = json.loads(meta.read_text(encoding="utf-8"))
+        name = info["scenario"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{meta}: not a holofold database description ({exc})") from None
+    if name != sc.name:
+        raise ValueError(f"--db {db} holds designs of scenario {name!r}, not {sc.name!r}")
+    table = load_database(db)
+    missing = [c for c in (*sc.required_features, *sc.performance_names) if c not in table]
+    if missing:
+        raise ValueError(f"--db {db} lacks the column(s) {', '.join(missing)} of {sc.name!r}")
+    return table
+
+
+def _base_batches(db: Path, n: int, covered: int = 0) -> list[tuple[int, int]]:
+    """Row spans [start, stop) of the base sample from ``covered`` on: the existing batches,
+    then what is missing."""
     spans = sorted(
         (int(m[1]), int(m[2]))
         for p in (db.iterdir() if db.is_dir() else ())
         if (m := _BASE.match(p.name))
     )
-    out, covered = [], 0
+    out = []
     for a, b in spans:
         if a == covered and covered < n:
             out.append((a, b))
@@ -274,7 +296,9 @@ def run_design(
     top : int
         Rules kept and verified per round (distinct alternatives).
     db : path, optional
-        Database folder to use instead of ``folder/database`` (reused and extended).
+        Database folder to use instead of ``folder/database`` (reused and extended). A folder
+        made by ``holofold generate`` (with its ``meta.json``) gives all its rows, extended with
+        new batches inside it when it has fewer than ``samples``.
     seed : int
     workers : int
         Worker processes for the simulations.
@@ -301,12 +325,18 @@ def run_design(
     # 1. database
     t0 = time.perf_counter()
     say(f"[database] {samples} designs of {sc.name}")
-    parts = []
-    for a, b in _base_batches(dbf, samples):
+    parts, have = [], 0
+    given = _given_database(dbf, sc)
+    if given is not None:  # a database the user made (holofold generate): all its rows
+        parts.append(given.assign(origin="database"))
+        have = len(given)
+    for a, b in _base_batches(dbf, max(samples, have), have):
         designs = sample_designs(sc, b - a, seed=seed, start=a)
         res = _simulate(sc, designs, dbf / f"base-{a:06d}-{b:06d}", workers, progress)
         parts.append(res.assign(origin="database"))
-    table = pd.concat(parts, ignore_index=True).iloc[:samples]
+    table = pd.concat(parts, ignore_index=True)
+    if given is None:
+        table = table.iloc[:samples]
     times["database"] = time.perf_counter() - t0
 
     history = []

@@ -256,3 +256,19 @@ def test_the_report_page_of_a_real_run_loads_in_a_browser(designed, tmp_path):
     assert f"{out.performance['Vstiff']:.4g}" in dom  # the chosen design's number, as shown
     for rel in out.summary["files"].values():
         assert f'href="{rel}"' in dom
+
+
+@pytest.mark.slow
+def test_a_generated_database_is_reused_and_extended(tmp_path, capsys):
+    db = tmp_path / "db"
+    assert main(["generate", "arch", "-n", "60", "--seed", "5", "-o", str(db)]) == 0
+    generated = pd.read_parquet(db / "database.parquet")
+    res = run_design("arch", "Zstiff > 60 & error < 0.08", tmp_path / "o", samples=160, db=db,
+                     verify=3, top=1, workers=2, progress=False, files=False)  # fmt: skip
+    base = res.table[res.table["origin"] == "database"].reset_index(drop=True)
+    assert len(base) == 160 and (db / "base-000060-000160").is_dir()
+    pd.testing.assert_frame_equal(base.iloc[:60][generated.columns], generated)
+    # a database of another scenario is refused in one line
+    assert main(["design", "single-miura", "--target", "axialstiff60 > 1", "-o",
+                 str(tmp_path / "p"), "--db", str(db)]) == 2  # fmt: skip
+    assert "holds designs of scenario 'arch'" in capsys.readouterr().err
