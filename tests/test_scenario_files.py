@@ -245,6 +245,7 @@ BAD = [
     ),
     ("density", "density = 1200.0", "density = -1", "[material]: density = -1 is outside (0, inf]"),
     ("toml", "[supports]", "[supports", "not valid TOML"),
+    ("nu", "nu = 0.3", "nu = 0.5", "[material]: nu = 0.5 is outside (-1, 0.5)"),
 ]
 
 

@@ -18,7 +18,17 @@ from pathlib import Path
 
 from holofold.design.scenarios.base import Column
 
-__all__ = ["ScenarioFileError", "Section", "read_features"]
+__all__ = [
+    "ScenarioFileError",
+    "Section",
+    "read_features",
+    "read_material",
+    "read_dofs",
+    "read_solver",
+    "read_loads",
+    "read_direction",
+    "load_name",
+]
 
 
 class ScenarioFileError(ValueError):
@@ -180,3 +190,67 @@ def read_features(section: Section, defaults: Sequence[Column]) -> tuple[Column,
 
 def _finite(v) -> bool:
     return not isinstance(v, bool) and isinstance(v, (int, float)) and math.isfinite(v)
+
+
+def read_material(doc: Section) -> tuple[float, float, float]:
+    """``[material]``: E (Pa, > 0), nu (in (-1, 0.5)) and density (kg/m^3, > 0).
+
+    Defaults: the paper's 2 GPa and 0.3, and 1200 kg/m^3.
+    """
+    mat = doc.sub("material")
+    E = mat.number("E", 2e9, low=0.0, low_open=True)
+    nu = mat.number("nu", 0.3, low=-1.0, high=0.5, low_open=True)
+    if nu == 0.5:
+        raise mat.error("nu = 0.5 is outside (-1, 0.5): an incompressible material has no model")
+    density = mat.number("density", 1200.0, low=0.0, low_open=True)
+    mat.done()
+    return E, nu, density
+
+
+def read_dofs(sec: Section, default: str = "xyz") -> str:
+    """``dofs``: the fixed directions of the support nodes, some of ``"xyz"``."""
+    dofs = sec.string("dofs", default)
+    if not dofs or set(dofs) - set("xyz") or len(set(dofs)) != len(dofs):
+        raise sec.error(f"dofs = {dofs!r} must be some of 'x', 'y', 'z' (e.g. 'xyz')")
+    return dofs
+
+
+def read_solver(doc: Section) -> tuple[float, int]:
+    """``[solver]``: Newton-Raphson ``tol`` (m, 1e-7) and ``max_iter`` (30, the reference's)."""
+    sol = doc.sub("solver")
+    tol = sol.number("tol", 1e-7, low=0.0, low_open=True)
+    max_iter = sol.number("max_iter", 30, low=2, high=1000, integer=True)
+    sol.done()
+    return tol, max_iter
+
+
+def read_loads(doc: Section, read_one) -> list:
+    """The ``[[load]]`` tables, each read by ``read_one(section, names_so_far)``; >= 1."""
+    raw = doc.raw("load", [])
+    if not isinstance(raw, list) or not raw:
+        raise doc.error("at least one [[load]] table is needed")
+    loads, names = [], set()
+    head = doc.where.rsplit(":", 1)[0]
+    for k, t in enumerate(raw, start=1):
+        ld = read_one(Section(t, f"{head}: [load] {k}", doc.base), names)
+        names.add(ld.name)
+        loads.append(ld)
+    return loads
+
+
+def load_name(sec: Section, names: set, example: str) -> str:
+    """A load's ``name``: a column prefix (an identifier) not used by another load."""
+    name = sec.string("name")
+    if not name or not name.isidentifier():
+        raise sec.error(f"name = {name!r} must be a column prefix such as {example}")
+    if name in names:
+        raise sec.error(f"name = {name!r} is used by another load")
+    return name
+
+
+def read_direction(sec: Section) -> tuple[float, float, float]:
+    """A load's ``direction``: a finite non-zero 3-vector."""
+    d = sec.raw("direction")
+    if not isinstance(d, list) or len(d) != 3 or not all(_finite(v) for v in d) or not any(d):
+        raise sec.error(f"direction = {d!r} must be a non-zero 3-vector [x, y, z]")
+    return tuple(float(v) for v in d)

@@ -12,6 +12,10 @@ C. :func:`run_heating`: heating steps until the arm tips are closer than 1 mm; `
    and ``finalQ`` (W, the published formula) at closure;
 D. :func:`run_prying`: ``stiff``, the prying stiffness of the closed gripper, N/m.
 
+Material and surroundings (moduli, density, bimorph mismatch, conductivities, room temperature)
+are a :class:`GripperMaterial`, and the heating rate and closure distance fields of
+:class:`GripperOptions`; their defaults are the scripts' constants below.
+
 Supports and loads are the named node sets of :func:`gripper_nodes`. The reference's quirks are
 switches of ``GripperOptions.profile`` and the ``gripper_*`` formulas of
 :mod:`holofold.mechanics.compat`. A design that does not close within the step cap fails
@@ -62,6 +66,8 @@ from holofold.mechanics.thermal import (
 __all__ = [
     "SCENARIO",
     "SCENARIO_CONVERGED",
+    "GripperMaterial",
+    "PAPER_MATERIAL",
     "GripperOptions",
     "GripperResult",
     "GripperModel",
@@ -86,7 +92,7 @@ __all__ = [
     "STATUS_NO_CLOSURE",
 ]
 
-# constants of every gripper script
+# constants of every gripper script (the defaults of GripperMaterial and GripperOptions)
 E = 2e9
 NU = 0.3
 DENSITY = 1200.0
@@ -108,6 +114,45 @@ STATUS_NO_CLOSURE = Status.failed("no closure")
 CONVERGED_TOL = {"force": 1e-10, "displacement": 1e-12, "max_iter": 200}
 
 
+@dataclass(frozen=True)
+class GripperMaterial:
+    """Material of panels, creases and bimorph, and the surroundings; the defaults are the
+    scripts' constants (:data:`E`, :data:`NU`, ...), which reproduce the published database.
+
+    Attributes
+    ----------
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio of panels, creases and both bimorph layers.
+    density : float
+        kg/m^3 (lumped masses of step A).
+    d_alpha : float
+        Thermal expansion mismatch of the bimorph layers, 1/K.
+    k_panel, k_crease, k_air : float
+        Thermal conductivities of panels, creases and the surrounding air, W/(m K).
+    room_temperature : float
+        Ambient and initial temperature, °C.
+    env_layers : int
+        Air layers of the thermal model of the surroundings.
+    dissipation_deg : float
+        Angle of the heat-dissipation cone into the air, degrees.
+    """
+
+    E: float = E
+    nu: float = NU
+    density: float = DENSITY
+    d_alpha: float = D_ALPHA
+    k_panel: float = K_PANEL
+    k_crease: float = K_CREASE
+    k_air: float = K_AIR
+    room_temperature: float = ROOM_T
+    env_layers: int = ENV_LAYERS
+    dissipation_deg: float = DISSIPATION_DEG
+
+
+#: the scripts' material and surroundings
+PAPER_MATERIAL = GripperMaterial()
+
+
 def _ramp(pattern: int, step: int) -> tuple[float, float]:
     """(heating factor, self-folding tolerance in N) of heating step ``step`` (1-based)."""
     if pattern == 1:
@@ -121,17 +166,20 @@ def _ramp(pattern: int, step: int) -> tuple[float, float]:
     return 1.0, 5e-7
 
 
-def published_q(pattern: int, L1, L2, step, range_: float | None = None):
+def published_q(pattern: int, L1, L2, step, range_: float | None = None, q_load: float = QLOAD):
     """finalQ (W) for closure at heating step ``step``: :func:`~holofold.mechanics.compat.
-    gripper_final_q` at this scenario's heating rate and, by default, the pattern's range."""
+    gripper_final_q` at the heating rate ``q_load`` (W/m per step; default this scenario's) and,
+    by default, the pattern's range."""
     r = DEFAULT_RANGE[pattern] if range_ is None else range_
-    return gripper_final_q(pattern, L1, L2, step, r, rate=QLOAD)
+    return gripper_final_q(pattern, L1, L2, step, r, rate=q_load)
 
 
-def decode_closing_step(pattern: int, L1, L2, finalQ, range_: float | None = None):
+def decode_closing_step(
+    pattern: int, L1, L2, finalQ, range_: float | None = None, q_load: float = QLOAD
+):
     """The (real-valued) heating step of a published finalQ (inverse of :func:`published_q`)."""
     r = DEFAULT_RANGE[pattern] if range_ is None else range_
-    return gripper_closing_step(pattern, L1, L2, finalQ, r, rate=QLOAD)
+    return gripper_closing_step(pattern, L1, L2, finalQ, r, rate=q_load)
 
 
 @dataclass(frozen=True)
@@ -159,6 +207,13 @@ class GripperOptions:
         scripts' loose ones: the outputs are then repeatable functions of the design (a 1e-15
         change of the input moves them by < 1e-11). Use it for new databases; the default
         reproduces the published one.
+    material : GripperMaterial
+        Material and surroundings the model is built with (:func:`simulate`).
+    q_load : float
+        Heating power per metre of crease and heating step before the ramp factor, W/m
+        (:data:`QLOAD`; also the rate of the finalQ formula).
+    closure : float
+        Tip distance below which the gripper counts as closed, m (:data:`CLOSURE`).
     """
 
     profile: Profile = PAPER
@@ -167,6 +222,9 @@ class GripperOptions:
     stiffness_tol: float = 1e-7
     keep_history: bool = False
     converged: bool = False
+    material: GripperMaterial = PAPER_MATERIAL
+    q_load: float = QLOAD
+    closure: float = CLOSURE
 
     def tolerance(self, tol: float, kind: str) -> dict:
         """Keyword arguments ``tol``/``max_iter`` of one solve: the script's ``tol`` or, with
@@ -360,12 +418,25 @@ def gripper_nodes(grip: GripperPattern, structure: Structure) -> GripperNodes:
 
 
 # --------------------------------------------------------------------------- the model
-def build_model(pattern: int, L1, L2, t1, t2, tpanel, rate, W, *, profile: Profile = PAPER):
+def build_model(
+    pattern: int,
+    L1,
+    L2,
+    t1,
+    t2,
+    tpanel,
+    rate,
+    W,
+    *,
+    profile: Profile = PAPER,
+    material: GripperMaterial = PAPER_MATERIAL,
+):
     """Pattern and compliant-crease structure (no supports) of one gripper design.
 
-    Returns ``(GripperPattern, Structure)``. With ``profile.raw_crease_polarity`` the crease
-    springs keep the reference's raw orientation, to which the pattern's ``alpha_sign`` refers;
-    without it use ``fold_sign`` (both give the same physical folding).
+    Returns ``(GripperPattern, Structure)``, E and nu from ``material``. With
+    ``profile.raw_crease_polarity`` the crease springs keep the reference's raw orientation, to
+    which the pattern's ``alpha_sign`` refers; without it use ``fold_sign`` (both give the same
+    physical folding).
     """
     grip = gripper_pattern(pattern, L1, L2, rate)
     s = build_compliant(
@@ -373,10 +444,10 @@ def build_model(pattern: int, L1, L2, t1, t2, tpanel, rate, W, *, profile: Profi
         crease_width=W,
         crease_thickness=t1 + t2,
         panel_thickness=tpanel,
-        E_panel=E,
-        E_crease=E,
-        nu_panel=NU,
-        nu_crease=NU,
+        E_panel=material.E,
+        E_crease=material.E,
+        nu_panel=material.nu,
+        nu_crease=material.nu,
         diagonal_rate=100.0 if pattern == 3 else 4.0,
         profile=profile,
     )
@@ -397,6 +468,9 @@ class GripperModel:
         Bimorph coating of the creases, in ``structure.creases`` order.
     heat_length : (nci,) float
         Heated length of each crease, m, in ``structure.creases`` order.
+    material : GripperMaterial
+        What the model is made of; steps A-C take density, conductivities and room temperature
+        from it.
     """
 
     grip: GripperPattern
@@ -404,25 +478,29 @@ class GripperModel:
     nodes: GripperNodes
     bimorph: Bimorph
     heat_length: np.ndarray
+    material: GripperMaterial = PAPER_MATERIAL
 
     @property
     def kind(self) -> int:
         return self.grip.kind
 
 
-def gripper_model(row, profile: Profile = PAPER) -> GripperModel:
+def gripper_model(
+    row, profile: Profile = PAPER, material: GripperMaterial = PAPER_MATERIAL
+) -> GripperModel:
     """The model of one design (``row``: mapping with the 8 feature columns, SI units)."""
     P = int(round(row["Pattern"]))
     L1, L2, t1, t2, tp, rate, W = (
         float(row[k]) for k in ("L1", "L2", "t1", "t2", "tpanel", "rate", "W")
     )
-    grip, s = build_model(P, L1, L2, t1, t2, tp, rate, W, profile=profile)
+    grip, s = build_model(P, L1, L2, t1, t2, tp, rate, W, profile=profile, material=material)
     if not np.array_equal(s.creases.ids, grip.active):
         raise ValueError("every interior crease of a gripper pattern must be active")
     sign = grip.alpha_sign if profile.raw_crease_polarity else grip.fold_sign
     n = len(grip.active)
-    bimorph = Bimorph(d_alpha=D_ALPHA * sign, t1=t1, t2=t2, E1=E, E2=E, width=np.full(n, W))
-    return GripperModel(grip, s, gripper_nodes(grip, s), bimorph, grip.heat_length)
+    E, d_alpha = material.E, material.d_alpha
+    bimorph = Bimorph(d_alpha=d_alpha * sign, t1=t1, t2=t2, E1=E, E2=E, width=np.full(n, W))
+    return GripperModel(grip, s, gripper_nodes(grip, s), bimorph, grip.heat_length, material)
 
 
 # --------------------------------------------------------------------------- step A
@@ -434,12 +512,15 @@ class FrequencyResult:
     status: Status
 
 
-def _flat_frequency(s: Structure, n_panels: int, profile: Profile) -> float:
-    """Lowest angular natural frequency (rad/s) of the supported structure ``s``, unloaded."""
+def _flat_frequency(
+    s: Structure, n_panels: int, profile: Profile, density: float = DENSITY
+) -> float:
+    """Lowest angular natural frequency (rad/s) of the supported structure ``s``, unloaded
+    (``density`` in kg/m^3)."""
     _, _, K = Assembler(s).evaluate(np.zeros((s.n_nodes, 3)))
     m = lumped_mass(
         s,
-        DENSITY,
+        density,
         centre_share=profile.mass_centre_share,
         skip_first=n_panels if profile.mass_skip_first_triangles else 0,
     )
@@ -449,22 +530,27 @@ def _flat_frequency(s: Structure, n_panels: int, profile: Profile) -> float:
 def run_frequency(model: GripperModel) -> FrequencyResult:
     """Step A: the flat, unloaded gripper with its base clamped (``nodes.clamp``)."""
     s = model.structure
-    w = _flat_frequency(s.fixed(model.nodes.clamp), model.grip.pattern.n_faces, s.profile)
+    clamped = s.fixed(model.nodes.clamp)
+    w = _flat_frequency(clamped, model.grip.pattern.n_faces, s.profile, model.material.density)
     status = CONVERGED if math.isfinite(w) else Status.failed(f"not finite ({w!r})")
     return FrequencyResult(w, status)
 
 
 def natural_frequency(
-    pattern_id: int, grip: GripperPattern, structure: Structure, profile: Profile | None = None
+    pattern_id: int,
+    grip: GripperPattern,
+    structure: Structure,
+    profile: Profile | None = None,
+    density: float = DENSITY,
 ) -> float:
     """freqFinal (rad/s) of a model from :func:`build_model` (step A alone, one BLAS thread).
 
-    ``profile`` sets the mass switches (default: the structure's)."""
+    ``profile`` sets the mass switches (default: the structure's); ``density`` in kg/m^3."""
     if grip.kind != pattern_id:
         raise ValueError(f"pattern_id = {pattern_id!r} but the pattern is of kind {grip.kind}")
     s = structure.fixed(gripper_nodes(grip, structure).clamp)
     with single_thread():
-        return _flat_frequency(s, grip.pattern.n_faces, profile or structure.profile)
+        return _flat_frequency(s, grip.pattern.n_faces, profile or structure.profile, density)
 
 
 # --------------------------------------------------------------------------- step B
@@ -490,7 +576,7 @@ def run_prebias(model: GripperModel, options: GripperOptions) -> PrebiasResult:
     """Step B: ``PREBIAS_FORCE`` per node and increment, -z on ``prebias_down`` and +z on
     ``prebias_up``, ``PREBIAS_INCREMENTS`` Newton increments (these forces stay applied)."""
     s, n = model.structure, model.nodes
-    state = initial_thermal_state(s, ROOM_T)
+    state = initial_thermal_state(s, model.material.room_temperature)
     if not len(n.prebias_down) + len(n.prebias_up):
         return PrebiasResult(state, None, CONVERGED)
     sb = s.fixed(n.hold_7cd7abc if options.prebias_7cd7abc else n.hold)
@@ -526,20 +612,21 @@ class HeatingResult:
 
 
 def run_heating(model: GripperModel, start: ThermalState, options: GripperOptions) -> HeatingResult:
-    """Step C: each heating step adds ``ramp * QLOAD * heat_length`` (W) to the creases and
-    re-equilibrates, until the tips are closer than ``CLOSURE`` or the step cap."""
-    g, n = model.grip, model.nodes
+    """Step C: each heating step adds ``ramp * options.q_load * heat_length`` (W) to the creases
+    and re-equilibrates, until the tips are closer than ``options.closure`` or the step cap.
+    Conductivities and room temperature are the model's (``model.material``)."""
+    g, n, mat = model.grip, model.nodes, model.material
     s = model.structure.fixed(n.hold_heating)
     asm = Assembler(s)
     thermal = thermal_model(
         s,
-        panel_conductivity=K_PANEL,
-        crease_conductivity=K_CREASE,
+        panel_conductivity=mat.k_panel,
+        crease_conductivity=mat.k_crease,
         air_thickness=gripper_air_gap(g.kind, g.L1, g.L2, g.range),
-        env_conductivity=K_AIR,
-        env_layers=ENV_LAYERS,
-        dissipation_deg=DISSIPATION_DEG,
-        room_temperature=ROOM_T,
+        env_conductivity=mat.k_air,
+        env_layers=mat.env_layers,
+        dissipation_deg=mat.dissipation_deg,
+        room_temperature=mat.room_temperature,
     )
     H = heat_input_matrix(s.creases.nodes, s.n_nodes)
     A = crease_temperature_matrix(s.creases.nodes, s.n_nodes)
@@ -549,7 +636,7 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
     for step in range(1, (options.step_cap or STEP_CAP[g.kind]) + 1):
         factor, tol = _ramp(g.kind, step)
         state, results = electrothermal_stage(
-            s, thermal, model.bimorph, state, factor * QLOAD * model.heat_length,
+            s, thermal, model.bimorph, state, factor * options.q_load * model.heat_length,
             **options.tolerance(tol, "force"), assembler=asm, heat_matrix=H, temp_matrix=A,
         )  # fmt: skip
         unconverged += sum(int(not r.ok) for r in results)
@@ -559,7 +646,7 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
         if results[-1].failed:
             status = Status.failed(f"heating step {step}: {results[-1].status}")
             break
-        if dist[-1] < CLOSURE:
+        if dist[-1] < options.closure:
             closing = step
             why = f"{unconverged} of {step} heating steps did not meet the tolerance"
             status = Status.not_converged(why) if unconverged else CONVERGED
@@ -628,7 +715,7 @@ def simulate(row, options: GripperOptions = GripperOptions()) -> GripperResult:
     if errs:
         raise ParameterError("; ".join(errs))
     with single_thread():
-        model = gripper_model(row, options.profile)
+        model = gripper_model(row, options.profile, options.material)
         freq = run_frequency(model)
         prebias = run_prebias(model, options)
         heating = run_heating(model, prebias.state, options)
@@ -642,7 +729,7 @@ def simulate(row, options: GripperOptions = GripperOptions()) -> GripperResult:
             freq.freqFinal, nan, nan, nan, None, heating.status,
             unconverged_steps=heating.unconverged_steps, **history,
         )  # fmt: skip
-    finalQ = float(published_q(g.kind, g.L1, g.L2, heating.closing_step, g.range))
+    finalQ = float(published_q(g.kind, g.L1, g.L2, heating.closing_step, g.range, options.q_load))
     if g.kind == 1 and finalQ <= 0:  # the script discarded these rows
         step = heating.closing_step
         status = Status.failed(f"early closure at heating step {step} (published finalQ <= 0)")

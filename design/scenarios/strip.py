@@ -37,7 +37,16 @@ from functools import lru_cache, partial
 import numpy as np
 
 from holofold.design.scenarios.base import Column, Scenario, integer, positive, single_thread
-from holofold.design.scenarios.config import Section, read_features
+from holofold.design.scenarios.config import (
+    Section,
+    load_name,
+    read_direction,
+    read_dofs,
+    read_features,
+    read_loads,
+    read_material,
+    read_solver,
+)
 from holofold.fitting import (
     BUILTIN_CURVES,
     PlanarCurve,
@@ -427,24 +436,10 @@ def _read_curve(sec: Section) -> tuple[PlanarCurve, str, str | None]:
 
 
 def _read_load(sec: Section, names: set) -> StripLoad:
-    name = sec.string("name")
-    if not name or not name.isidentifier():
-        raise sec.error(f"name = {name!r} must be a column prefix such as 'Z' or 'tip'")
-    if name in names:
-        raise sec.error(f"name = {name!r} is used by another load")
-    d = sec.raw("direction")
-    if (
-        not isinstance(d, list)
-        or len(d) != 3
-        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in d)
-        or not all(math.isfinite(v) for v in d)
-        or not any(d)
-    ):
-        raise sec.error(f"direction = {d!r} must be a non-zero 3-vector [x, y, z]")
     load = StripLoad(
-        name=name,
+        name=load_name(sec, names, "'Z' or 'tip'"),
         at=sec.number("at", low=0.0, high=1.0) if sec.has("at") else _missing(sec, "at"),
-        direction=tuple(float(v) for v in d),
+        direction=read_direction(sec),
         force=sec.number("force", low=0.0, low_open=True) if sec.has("force")
         else _missing(sec, "force"),
         increments=sec.number("increments", 5, low=1, high=1000, integer=True),
@@ -461,30 +456,13 @@ def _missing(sec: Section, key: str):
 def from_config(doc: Section, name: str, description: str) -> Scenario:
     """The strip scenario of a parsed scenario file (``kind = "strip"``)."""
     curve, label, sampling = _read_curve(doc.sub("curve", required=True))
-    mat = doc.sub("material")
-    E = mat.number("E", 2e9, low=0.0, low_open=True)
-    nu = mat.number("nu", 0.3, low=-1.0, high=0.5, low_open=True)
-    density = mat.number("density", 1200.0, low=0.0, low_open=True)
-    mat.done()
+    E, nu, density = read_material(doc)
     sup = doc.sub("supports")
     supports = sup.choice("nodes", tuple(SUPPORTS), "ends")
-    dofs = sup.string("dofs", "xyz")
-    if not dofs or set(dofs) - set("xyz") or len(set(dofs)) != len(dofs):
-        raise sup.error(f"dofs = {dofs!r} must be some of 'x', 'y', 'z' (e.g. 'xyz')")
+    dofs = read_dofs(sup)
     sup.done()
-    sol = doc.sub("solver")
-    tol = sol.number("tol", 1e-7, low=0.0, low_open=True)
-    max_iter = sol.number("max_iter", 30, low=2, high=1000, integer=True)
-    sol.done()
-    raw_loads = doc.raw("load", [])
-    if not isinstance(raw_loads, list) or not raw_loads:
-        raise doc.error("at least one [[load]] table is needed")
-    loads, names = [], set()
-    head = doc.where.rsplit(":", 1)[0]
-    for k, t in enumerate(raw_loads, start=1):
-        ld = _read_load(Section(t, f"{head}: [load] {k}", doc.base), names)
-        names.add(ld.name)
-        loads.append(ld)
+    tol, max_iter = read_solver(doc)
+    loads = read_loads(doc, _read_load)
     setting = StripSetting(
         curve=curve,
         loads=tuple(loads),

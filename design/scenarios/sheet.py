@@ -1,0 +1,662 @@
+"""The sheet kind: Miura-ori or TMP sheets of any footprint (the paper's canopy, generalised).
+
+docs/scenarios.md §8. A :class:`SheetSetting` fixes everything a design does not vary: the
+footprint, the Miura sector angle (unless it is the feature ``gama``), the extensions at which
+the sheet is modelled, the load cases, the material and the supports; the pattern and the cell
+counts are features unless the setting fixes them. :func:`sheet_scenario` turns a setting and
+the design features into a :class:`~holofold.design.scenarios.base.Scenario`.
+
+Geometry, m and n panels along x and y, footprint ``size_x`` x ``size_y`` (the paper's L):
+
+* Miura-ori (``pattern`` 1): b = size_x/m, a = (size_y - b cot gamma)/n (needs a > 0);
+* Tachi-Miura polyhedron (``pattern`` 2, m even, n a multiple of 3): b = size_x/m,
+  a = size_y/n (a design whose folded tubes overlap at the smallest extension is invalid).
+
+One stress-free concentrated-hinge model per extension (``row["W"]``, ``row["tcrease"]``,
+``row["tpanel"]``; E of panels and creases from the optional features ``panelE``/``creaseE``,
+default the setting's E). The nodes at x = min are fixed; the nodes at x = max share each load
+case (Newton-Raphson load control from the stress-free state, ``increments`` equal steps).
+
+Columns, SI units:
+
+``{load}stiff{tag}``
+    total force / mean displacement of the loaded nodes along the load direction, N/m, at
+    the extension ``ext`` with ``tag = round(100 ext)`` (``bendstiff30``: load ``bend`` at 0.3);
+``mass``
+    density x (panel area x tpanel + fold-line length x W x (tcrease - tpanel)), kg: the flat
+    sheet of panel thickness, thinned to the crease thickness over a strip of width W along
+    every fold line.
+
+The paper's canopy (:mod:`~holofold.design.scenarios.canopy`) is this kind with a 0.2 m square,
+gamma = 70 deg, extensions 0.3, 0.6, 0.9 and the loads ``bend`` (3 N in -z) and ``axial``
+(3 N in +x); the single Miura cell (:mod:`~holofold.design.scenarios.single_miura`) is a fixed
+2 x 2 Miura sheet of 0.04 m with the feature ``gama`` and the ``axial`` load alone.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from functools import lru_cache, partial
+
+import numpy as np
+
+from holofold.design.scenarios.base import Column, Scenario, integer, positive, single_thread
+from holofold.design.scenarios.config import (
+    Section,
+    load_name,
+    read_direction,
+    read_dofs,
+    read_features,
+    read_loads,
+    read_material,
+    read_solver,
+)
+from holofold.geometry import export_pattern_files
+from holofold.geometry.errors import DegenerateGeometryError
+from holofold.geometry.miura import miura_faces, miura_nodes, miura_sheet, rigid_fold_pattern
+from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.tmp import tmp_faces, tmp_node_count, tmp_nodes
+from holofold.mechanics.analyses import load_along, secant_stiffness
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.compat import PAPER
+from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.status import Outcome, Status
+
+__all__ = [
+    "MIURA",
+    "TMP",
+    "PATTERNS",
+    "GAMMA_70",
+    "SheetLoad",
+    "SheetSetting",
+    "SHEET_FEATURES",
+    "sheet_features",
+    "sheet_columns",
+    "sheet_nodes",
+    "sheet_models",
+    "sheet_mass",
+    "check_sheet",
+    "evaluate_sheet",
+    "sheet_shape",
+    "write_sheet_files",
+    "sheet_scenario",
+    "extension_tag",
+    "from_config",
+]
+
+MIURA, TMP = 1, 2
+#: pattern names of scenario files -> the feature's codes
+PATTERNS = {"miura": MIURA, "tmp": TMP}
+GAMMA_70 = 70.0 / 180.0 * math.pi  #: the canopy's Miura sector angle, rad
+
+#: every feature a sheet can have, with the paper's ranges (canopy; ``gama`` from data0).
+#: ``pattern``, ``m``, ``n`` are features unless the setting fixes them, ``gama`` only when the
+#: setting has no sector angle; ``creaseE``/``panelE`` are optional (default: the setting's E).
+SHEET_FEATURES = (
+    Column("pattern", "-", "1 = Miura-ori, 2 = TMP", choices=(1.0, 2.0)),
+    Column("m", "-", "panels along x (TMP: even)", choices=(24.0, 30.0, 36.0)),
+    Column("n", "-", "panels along y (TMP: multiple of 3)", choices=(6.0, 9.0, 12.0)),
+    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3),
+    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3),
+    Column("W", "m", "crease width", 1e-3, 4e-3),
+    Column("gama", "rad", "Miura sector angle gamma", math.radians(50), math.radians(80)),
+    Column("creaseE", "Pa", "crease Young's modulus", 1e9, 5e9, required=False, default=2e9),
+    Column("panelE", "Pa", "panel Young's modulus", 1e9, 5e9, required=False, default=2e9),
+)
+_OPTIONAL_E = ("creaseE", "panelE")
+
+
+@dataclass(frozen=True)
+class SheetLoad:
+    """One load case on a sheet: the nodes at x = max share the force equally.
+
+    Attributes
+    ----------
+    name : str
+        Column prefix: the case gives ``{name}stiff{tag}`` per extension.
+    direction : (3,) float
+        Direction of the force (normalised), e.g. ``(0, 0, -1)``.
+    force : float
+        Total force after the last increment, N (> 0).
+    increments : int
+        Equal load increments (>= 1).
+    """
+
+    name: str
+    direction: tuple[float, float, float]
+    force: float = 3.0
+    increments: int = 3
+
+
+@dataclass(frozen=True)
+class SheetSetting:
+    """The fixed setting of a sheet scenario (everything a design does not vary).
+
+    Attributes
+    ----------
+    size_x, size_y : float
+        Footprint, m: b = size_x/m; a = (size_y - b cot gamma)/n (Miura) or size_y/n (TMP).
+    gamma : float or None
+        Miura sector angle, rad, in (0, pi/2); None: the feature ``gama``.
+    extensions : tuple of float
+        Extension ratios in (0, 1], one stress-free model each (distinct ``extension_tag``).
+    loads : tuple of SheetLoad
+    E, nu : float
+        Young's modulus (Pa; default of ``creaseE``/``panelE``) and Poisson's ratio.
+    density : float
+        kg/m^3, for ``mass``.
+    pattern, m, n : int or None
+        Fixed pattern (:data:`MIURA` or :data:`TMP`) and panel counts; None: features.
+    support_dofs : str
+        Fixed directions of the nodes at x = min (any of "xyz").
+    tol : float
+        Newton-Raphson tolerance on ||dU||, m.
+    max_iter : int
+        Iteration cap per increment (the reference's: 30, i.e. 29 iterations).
+    """
+
+    size_x: float = 0.2
+    size_y: float = 0.2
+    gamma: float | None = GAMMA_70
+    extensions: tuple[float, ...] = (0.3, 0.6, 0.9)
+    loads: tuple[SheetLoad, ...] = (
+        SheetLoad("bend", (0.0, 0.0, -1.0)),
+        SheetLoad("axial", (1.0, 0.0, 0.0)),
+    )
+    E: float = 2e9
+    nu: float = 0.3
+    density: float = 1200.0
+    pattern: int | None = None
+    m: int | None = None
+    n: int | None = None
+    support_dofs: str = "xyz"
+    tol: float = 1e-7
+    max_iter: int = 30
+
+
+def extension_tag(ext: float) -> int:
+    """Column tag of an extension: round(100 ext) (0.3 -> 30)."""
+    return int(round(100 * ext))
+
+
+def sheet_features(setting: SheetSetting, moduli: bool = True) -> tuple[Column, ...]:
+    """The default features of a setting: :data:`SHEET_FEATURES` without what it fixes and,
+    with ``moduli``, the optional ``creaseE``/``panelE`` defaulting to its E over the data4
+    range scaled to it, [E/2, 5E/2]."""
+    fixed = {k for k in ("pattern", "m", "n") if getattr(setting, k) is not None}
+    if setting.gamma is not None or setting.pattern == TMP:
+        fixed.add("gama")
+    if not moduli:
+        fixed.update(_OPTIONAL_E)
+    E = setting.E
+    out = []
+    for c in SHEET_FEATURES:
+        if c.name in _OPTIONAL_E:
+            c = replace(c, low=E / 2, high=2.5 * E, default=E)
+        if c.name not in fixed:
+            out.append(c)
+    return tuple(out)
+
+
+def _along(direction) -> str:
+    """``in -z`` for an axis direction, else ``along (x, y, z)``."""
+    nz = [k for k, v in enumerate(direction) if v]
+    if len(nz) == 1:
+        return f"in {'+' if direction[nz[0]] > 0 else '-'}{'xyz'[nz[0]]}"
+    return f"along ({', '.join(f'{v:g}' for v in direction)})"
+
+
+def sheet_columns(setting: SheetSetting, extras: bool = True) -> tuple[Column, ...]:
+    """Performance columns: per load, per extension ``{load}stiff{tag}``; with ``extras``
+    ``mass``."""
+    cols = [
+        Column(
+            f"{ld.name}stiff{extension_tag(e)}",
+            "N/m",
+            f"secant stiffness under {ld.force:g} N {_along(ld.direction)} at Ext = {e:g}",
+        )
+        for ld in setting.loads
+        for e in setting.extensions
+    ]
+    if extras:
+        cols.append(Column("mass", "kg", "mass of the sheet (panels and thinned fold lines)"))
+    return tuple(cols)
+
+
+def _design(setting: SheetSetting, row) -> tuple[int, int, int, float | None]:
+    """(pattern, m, n, gamma) of a design: the setting's values, else the row's."""
+    pat = setting.pattern if setting.pattern is not None else int(row["pattern"])
+    m = setting.m if setting.m is not None else int(row["m"])
+    n = setting.n if setting.n is not None else int(row["n"])
+    gamma = setting.gamma if setting.gamma is not None or pat == TMP else float(row["gama"])
+    return pat, m, n, gamma
+
+
+@lru_cache(maxsize=32)
+def _topology(pattern: int, m: int, n: int) -> CreasePattern:
+    """A sheet with the right faces (coordinates are replaced per design)."""
+    if pattern == MIURA:
+        faces = miura_faces(m, n)
+        X = miura_nodes(m, n, 1.0, 1.0, 1.0, 0.5)
+    else:
+        faces = tmp_faces(m, n)
+        X = tmp_nodes(m, n, 1.0, 0.5)
+    return CreasePattern.from_faces(X, faces)
+
+
+def _tmp_nodes(m: int, n: int, size_x: float, size_y: float, ext: float) -> np.ndarray:
+    """TMP nodes with b = size_x/m, a = size_y/n, (nv, 3) m: those of
+    :func:`holofold.geometry.tmp.tmp_nodes` for a square, :func:`_tmp_nodes_xy` otherwise."""
+    if size_x == size_y:
+        return tmp_nodes(m, n, size_x, ext)
+    return _tmp_nodes_xy(m, n, size_x, size_y, ext)
+
+
+def _tmp_nodes_xy(m: int, n: int, size_x: float, size_y: float, ext: float) -> np.ndarray:
+    """:func:`holofold.geometry.tmp.tmp_nodes` with a = size_y/n, b = size_x/m instead of L/n,
+    L/m (the same operations: bit for bit the same nodes for a square)."""
+    a, b = size_y / n, size_x / m
+    delta = b * math.sqrt(1.0 - ext**2)
+    theta = math.atan(2.0 * delta / a)
+    zs, ys = a * math.sin(2.0 * theta), a * math.cos(2.0 * theta)
+    p = a + 2.0 * ys
+    y0 = p * np.arange(n // 3)
+    ones = np.ones(n // 3)
+    ya = np.append(np.column_stack([y0, ys + y0, (a + ys) + y0]).ravel(), p + p * (n // 3 - 1))
+    za = np.append(
+        np.column_stack([(zs + delta) * ones, delta * ones, delta * ones]).ravel(), zs + delta
+    )
+    yb = np.column_stack([a / 2 + y0, (a / 2 + ys) + y0, (a / 2 + 2 * ys) + y0]).ravel()
+    zb = np.column_stack([zs * ones, 0.0 * ones, zs * ones]).ravel()
+    X = np.zeros((tmp_node_count(m, n), 3))
+    blk = 2 * n + 1
+    for i in range(m // 2 + 1):
+        X[i * blk + np.arange(n + 1)] = np.column_stack([np.full(n + 1, b * ext * (2 * i)), ya, za])
+    for i in range(m // 2):
+        x = np.full(n, b * ext * (2 * i) + b * ext)
+        X[i * blk + n + 1 + np.arange(n)] = np.column_stack([x, yb, zb])
+    return X
+
+
+def _miura_sides(setting: SheetSetting, m: int, n: int, gamma: float) -> tuple[float, float]:
+    """Panel sides (a, b) of a Miura sheet, m."""
+    b = setting.size_x / m
+    return (setting.size_y - b / math.tan(gamma)) / n, b
+
+
+def sheet_nodes(setting: SheetSetting, row, ext: float) -> np.ndarray:
+    """Node coordinates of the design's sheet folded to ``ext``, (nv, 3) m."""
+    pat, m, n, gamma = _design(setting, row)
+    if pat == MIURA:
+        a, b = _miura_sides(setting, m, n, gamma)
+        return miura_nodes(m, n, a, b, gamma, ext)
+    return _tmp_nodes(m, n, setting.size_x, setting.size_y, ext)
+
+
+def _modulus(row, key: str, default: float) -> float:
+    v = row.get(key, default)
+    return default if v is None or math.isnan(v) else v
+
+
+def sheet_models(setting: SheetSetting, row, *, profile=PAPER, extensions=None):
+    """Stress-free models with supports, one per extension (default the setting's).
+
+    Returns
+    -------
+    list of (Structure, tuple of LoadGroup)
+        The load groups in the order of ``setting.loads``.
+    """
+    pat, m, n, _ = _design(setting, row)
+    Ec = _modulus(row, "creaseE", setting.E)
+    Ep = _modulus(row, "panelE", setting.E)
+    topo = _topology(pat, m, n)
+    out = []
+    for ext in setting.extensions if extensions is None else extensions:
+        X = sheet_nodes(setting, row, ext)
+        x = X[:, 0]
+        tip = np.flatnonzero(x == x.max())
+        s = build_concentrated(
+            topo,
+            coords=X,
+            crease_width=row["W"],
+            crease_thickness=row["tcrease"],
+            panel_thickness=row["tpanel"],
+            E_panel=Ep,
+            E_crease=Ec,
+            nu_panel=setting.nu,
+            nu_crease=setting.nu,
+            profile=profile,
+        ).fixed(np.flatnonzero(x == x.min()), setting.support_dofs)  # vertex v is node v
+        out.append((s, tuple(load_along(tip, ld.direction) for ld in setting.loads)))
+    return out
+
+
+def sheet_mass(setting: SheetSetting, row) -> float:
+    """density x (panel area x tpanel + fold-line length x W x (tcrease - tpanel)), kg, of the
+    flat sheet (ext = 1; rigid folding keeps panel areas and fold lengths)."""
+    pat, m, n, _ = _design(setting, row)
+    X = sheet_nodes(setting, row, 1.0)
+    topo = _topology(pat, m, n)
+    area = 0.0
+    for f in topo.faces:  # vector area of each planar polygon
+        P = X[f]
+        area += 0.5 * np.linalg.norm(np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0))
+    e = topo.edges[topo.interior]
+    fold_length = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1).sum()
+    tp, tc, w = float(row["tpanel"]), float(row["tcrease"]), float(row["W"])
+    return float(setting.density * (area * tp + fold_length * w * (tc - tp)))
+
+
+def check_sheet(setting: SheetSetting, row) -> list[str]:
+    """Physical validity of one design (empty if valid)."""
+    errs = positive(row, ("tcrease", "tpanel", "W"))
+    for opt in _OPTIONAL_E:
+        v = row.get(opt)
+        if v is not None and not (isinstance(v, float) and math.isnan(v)):
+            errs += positive(row, (opt,))
+    d = dict(row)
+    for k in ("pattern", "m", "n"):
+        if getattr(setting, k) is not None:
+            d[k] = getattr(setting, k)
+    p = d.get("pattern")
+    if p not in (MIURA, TMP):
+        errs.append(f"pattern = {p!r} must be 1 (Miura) or 2 (TMP)")
+    ok_m, ok_n = not integer(d, "m", 1), not integer(d, "n", 1)
+    errs += integer(d, "m", 1) + integer(d, "n", 1)
+    if p == TMP and ok_m and d["m"] % 2:
+        errs.append(f"m = {d['m']:g} must be even for a TMP sheet")
+    if p == TMP and ok_n and d["n"] % 3:
+        errs.append(f"n = {d['n']:g} must be a multiple of 3 for a TMP sheet")
+    if p == TMP and ok_m and ok_n and not d["n"] % 3:
+        ext = min(setting.extensions)
+        b, a = setting.size_x / d["m"], setting.size_y / d["n"]
+        if 2 * b * math.sqrt(1 - ext**2) > a:
+            errs.append(
+                f"m = {d['m']:g}, n = {d['n']:g}: the TMP tubes overlap at Ext = {ext:g} "
+                f"(2 b sqrt(1 - Ext^2) = {2 * b * math.sqrt(1 - ext**2):.4g} m > a = {a:.4g} m)"
+            )
+    if p == MIURA:
+        g = setting.gamma if setting.gamma is not None else row.get("gama")
+        if g is None or not math.isfinite(g) or not 0 < g < math.pi / 2:
+            errs.append(f"gama = {g!r} rad must lie in (0, pi/2)")
+        elif ok_m and ok_n and not _miura_sides(setting, int(d["m"]), int(d["n"]), g)[0] > 0:
+            errs.append(
+                f"m = {d['m']:g} is too small for the Miura sheet with gamma = {g:.6g} rad: "
+                f"a = (size_y - b cot gamma)/n must be > 0 (m tan(gamma) > size_x/size_y)"
+            )
+    return errs
+
+
+def evaluate_sheet(setting: SheetSetting, columns: Sequence[str], row) -> dict:
+    """The ``columns`` of one design (see the module docstring) and a status."""
+    out, cases = {}, {}
+    for ext, (s, groups) in zip(setting.extensions, sheet_models(setting, row), strict=True):
+        tag = extension_tag(ext)
+        asm = Assembler(s)  # one sparse pattern and reduction for every load case
+        for ld, grp in zip(setting.loads, groups, strict=True):
+            with single_thread():
+                r = secant_stiffness(
+                    s,
+                    grp,
+                    force_per_increment=ld.force / ld.increments,
+                    increments=ld.increments,
+                    tol=setting.tol,
+                    max_iter=setting.max_iter,
+                    assembler=asm,
+                )
+            out[f"{ld.name}stiff{tag}"] = r.stiffness
+            cases[f"{ld.name} Ext {ext}"] = r.result.status
+    if "mass" in columns:
+        out["mass"] = sheet_mass(setting, row)
+    out = {c: out[c] for c in columns}
+    out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
+    return out
+
+
+def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreasePattern:
+    """The design's stress-free sheet folded to ``ext`` (default the largest of the setting's
+    extensions: the least folded modelled state), with its flat layout and M/V assignment, m."""
+    ext = max(setting.extensions) if ext is None else ext
+    pat, m, n, gamma = _design(setting, row)
+    if pat == MIURA:
+        a, b = _miura_sides(setting, m, n, gamma)
+        return miura_sheet(m, n, a, b, gamma, ext)
+    lx, ly = setting.size_x, setting.size_y
+    meta = {"kind": "tmp", "m": m, "n": n, "size_x": lx, "size_y": ly, "ext": ext}
+    return rigid_fold_pattern(
+        _tmp_nodes(m, n, lx, ly, ext),
+        tmp_faces(m, n),
+        _tmp_nodes(m, n, lx, ly, 1.0)[:, :2],
+        _tmp_nodes(m, n, lx, ly, 0.5),
+        meta | {"a": ly / n, "b": lx / m},
+    )
+
+
+def write_sheet_files(setting: SheetSetting, row, folder, ext: float | None = None) -> dict:
+    """FOLD, SVG (cut and score lines), STL/OBJ of the sheet folded as :func:`sheet_shape` and
+    its thick solid (:func:`~holofold.geometry.export_pattern_files`); if the thick panels
+    overlap too much in that state, every file but ``thick.stl``, with a warning saying why.
+
+    Returns label -> path (the labels name the files).
+    """
+    shape = sheet_shape(setting, row, ext)
+    W = float(row["W"])
+    try:
+        paths = export_pattern_files(shape, folder, thickness=float(row["tpanel"]), crease_width=W)
+    except DegenerateGeometryError as exc:
+        warnings.warn(f"no thick.stl: {exc}", stacklevel=2)
+        paths = export_pattern_files(shape, folder, crease_width=W)
+    return {p.name: p for p in paths}
+
+
+def sheet_scenario(
+    name: str,
+    description: str,
+    setting: SheetSetting,
+    features: tuple[Column, ...] | None = None,
+    *,
+    extras: bool = True,
+    source: str = "",
+) -> Scenario:
+    """The :class:`Scenario` of a sheet setting (picklable for worker processes); ``features``
+    default to :func:`sheet_features`."""
+    features = sheet_features(setting) if features is None else features
+    perf = sheet_columns(setting, extras)
+    pattern = {None: "feature pattern (1 Miura-ori, 2 TMP)", MIURA: "Miura-ori", TMP: "TMP"}
+    words = {
+        "footprint (m)": f"{setting.size_x:g} x {setting.size_y:g}",
+        "pattern": pattern[setting.pattern],
+        "panels m x n": f"{'feature m' if setting.m is None else setting.m} x "
+        f"{'feature n' if setting.n is None else setting.n}",
+        "Miura sector angle": "feature gama"
+        if setting.gamma is None
+        else f"{math.degrees(setting.gamma):g} deg",
+        "extensions": ", ".join(f"{e:g}" for e in setting.extensions),
+        "E (Pa)": setting.E,
+        "nu": setting.nu,
+        "density (kg/m^3)": setting.density,
+        "supports": f"the nodes at x = min, fixed in {setting.support_dofs}",
+    }
+    for ld in setting.loads:
+        words[f"load {ld.name}"] = (
+            f"{ld.force:g} N {_along(ld.direction)} shared by the nodes at x = max, "
+            f"{ld.increments} increments"
+        )
+    return Scenario(
+        name=name,
+        description=description,
+        features=features,
+        performance=perf,
+        check=partial(check_sheet, setting),
+        evaluate=partial(evaluate_sheet, setting, tuple(c.name for c in perf)),
+        categorical=tuple(c.name for c in features if c.choices),
+        kind="sheet",
+        setting=words,
+        source=source,
+        shape=partial(sheet_shape, setting),
+        write_files=partial(write_sheet_files, setting),
+    )
+
+
+# ---------------------------------------------------------------------- scenario files
+def _known(sec: Section, allowed: Sequence[str]) -> None:
+    """Refuse unknown keys first (a misspelt key is named as such, not as a missing one)."""
+    for k in allowed:
+        sec.raw(k)
+    sec.done(allowed)
+
+
+def _read_load(sec: Section, names: set) -> SheetLoad:
+    _known(sec, ["name", "direction", "force", "increments"])
+    name = load_name(sec, names, "'bend' or 'axial'")
+    if not sec.has("force"):
+        raise sec.error("missing key 'force' (total force, N)")
+    load = SheetLoad(
+        name=name,
+        direction=read_direction(sec),
+        force=sec.number("force", low=0.0, low_open=True),
+        increments=sec.number("increments", 3, low=1, high=1000, integer=True),
+    )
+    return load
+
+
+def _read_extensions(sec: Section) -> tuple[float, ...]:
+    raw = sec.raw("extensions", [0.3, 0.6, 0.9])
+    ok = isinstance(raw, list) and raw and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in raw
+    )  # fmt: skip
+    if not ok or not all(0 < v <= 1 for v in raw):
+        raise sec.error(
+            f"extensions = {raw!r} must be a list of extension ratios in (0, 1], e.g. [0.3, 0.6]"
+        )
+    exts = tuple(float(v) for v in raw)
+    tags = [extension_tag(e) for e in exts]
+    for k, t in enumerate(tags):
+        if t in tags[:k]:
+            other = exts[tags.index(t)]
+            raise sec.error(
+                f"extensions = {raw!r}: {other:g} and {exts[k]:g} give the same column tag {t} "
+                "(round(100 Ext)); allowed: ratios whose round(100 Ext) differ"
+            )
+    return exts
+
+
+def _read_sheet(sec: Section) -> dict:
+    """The ``[sheet]`` table: footprint, sector angle, extensions, fixed pattern and counts."""
+    _known(sec, ["size_x", "size_y", "gamma", "gamma_deg", "extensions", "pattern", "m", "n"])
+    if not sec.has("size_x") or not sec.has("size_y"):
+        raise sec.error("size_x and size_y (the footprint, m) are required")
+    out = {
+        "size_x": sec.number("size_x", low=0.0, low_open=True),
+        "size_y": sec.number("size_y", low=0.0, low_open=True),
+        "extensions": _read_extensions(sec),
+    }
+    if sec.has("gamma") and sec.has("gamma_deg"):
+        raise sec.error("give gamma (rad) or gamma_deg, not both")
+    if sec.has("gamma_deg"):
+        out["gamma"] = sec.number("gamma_deg", low=0.0, high=90.0, low_open=True) / 180.0 * math.pi
+    elif sec.has("gamma"):
+        out["gamma"] = sec.number("gamma", low=0.0, high=math.pi / 2, low_open=True)
+    else:
+        out["gamma"] = None  # fixed at 70 deg unless [features] names gama
+    if out["gamma"] is not None and not out["gamma"] < math.pi / 2:
+        raise sec.error("the sector angle must be < 90 deg (pi/2 rad)")
+    pat = sec.choice("pattern", tuple(PATTERNS))
+    out["pattern"] = None if pat is None else PATTERNS[pat]
+    for k in ("m", "n"):
+        out[k] = sec.number(k, low=1, high=10000, integer=True)
+    if out["pattern"] == TMP:
+        if out["gamma"] is not None:
+            raise sec.error("gamma/gamma_deg is the Miura sector angle; pattern = 'tmp' has none")
+        if out["m"] is not None and out["m"] % 2:
+            raise sec.error(f"m = {out['m']} must be even for pattern = 'tmp'")
+        if out["n"] is not None and out["n"] % 3:
+            raise sec.error(f"n = {out['n']} must be a multiple of 3 for pattern = 'tmp'")
+    return out
+
+
+def _values(c: Column) -> tuple[float, ...]:
+    return c.choices or (c.low, c.high)
+
+
+def _check_features(doc: Section, sheet: dict, features: tuple[Column, ...]) -> None:
+    """Refuse feature levels that no design could use (before anything is simulated)."""
+    by = {c.name: c for c in features}
+    pats = (sheet["pattern"],) if sheet["pattern"] is not None else _values(by["pattern"])
+    if not set(pats) <= {MIURA, TMP}:
+        raise doc.error(
+            f"[features] pattern = {pats}: allowed: 1 (Miura-ori), 2 (TMP), or fix one with "
+            "[sheet] pattern = 'miura' | 'tmp'"
+        )
+    counts, where = {}, {}
+    for k in ("m", "n"):
+        counts[k] = (sheet[k],) if sheet[k] is not None else _values(by[k])
+        where[k] = f"[sheet] {k}" if sheet[k] is not None else f"[features] {k}"
+        if not all(v >= 1 and v == int(v) for v in counts[k]):
+            raise doc.error(f"{where[k]} must be integers >= 1, got {counts[k]}")
+    if TMP in pats:
+        if any(int(v) % 2 for v in counts["m"]):
+            raise doc.error(f"{where['m']} = {counts['m']}: TMP sheets (pattern 2) need even m")
+        if any(int(v) % 3 for v in counts["n"]):
+            raise doc.error(
+                f"{where['n']} = {counts['n']}: TMP sheets (pattern 2) need multiples of 3"
+            )
+    if MIURA in pats:
+        gammas = (sheet["gamma"],) if sheet["gamma"] is not None else _values(by["gama"])
+        if not all(0 < g < math.pi / 2 for g in gammas):
+            raise doc.error(f"[features] gama = {gammas} rad must lie in (0, pi/2)")
+        m, g = min(counts["m"]), min(gammas)
+        if not sheet["size_y"] * m * math.tan(g) > sheet["size_x"]:
+            raise doc.error(
+                f"{where['m']} = {m:g} with the sector angle {math.degrees(g):.6g} deg gives Miura "
+                f"panels of side a <= 0; allowed: m tan(gamma) > size_x/size_y = "
+                f"{sheet['size_x'] / sheet['size_y']:.6g}"
+            )
+
+
+def from_config(doc: Section, name: str, description: str) -> Scenario:
+    """The sheet scenario of a parsed scenario file (``kind = "sheet"``)."""
+    sheet = _read_sheet(doc.sub("sheet", required=True))
+    E, nu, density = read_material(doc)
+    sup = doc.sub("supports")
+    dofs = read_dofs(sup)
+    sup.done()
+    tol, max_iter = read_solver(doc)
+    loads = read_loads(doc, _read_load)
+    fsec = doc.sub("features")
+    for k in ("pattern", "m", "n"):
+        if sheet[k] is not None and fsec.has(k):
+            raise fsec.error(f"{k} is fixed in [sheet]; remove it there or here")
+    gama_feature = fsec.has("gama")
+    if gama_feature and (sheet["gamma"] is not None or sheet["pattern"] == TMP):
+        why = "pattern = 'tmp' has no sector angle" if sheet["pattern"] == TMP else (
+            "the sector angle is fixed in [sheet]; remove it there or here")  # fmt: skip
+        raise fsec.error(f"gama: {why}")
+    if sheet["gamma"] is None and not gama_feature and sheet["pattern"] != TMP:
+        sheet["gamma"] = GAMMA_70
+    setting = SheetSetting(
+        size_x=sheet["size_x"],
+        size_y=sheet["size_y"],
+        gamma=sheet["gamma"],
+        extensions=sheet["extensions"],
+        loads=tuple(loads),
+        E=E,
+        nu=nu,
+        density=density,
+        pattern=sheet["pattern"],
+        m=sheet["m"],
+        n=sheet["n"],
+        support_dofs=dofs,
+        tol=tol,
+        max_iter=max_iter,
+    )
+    # the optional moduli are features when the file names them (else E holds everywhere)
+    moduli = any(fsec.has(k) for k in _OPTIONAL_E)
+    features = read_features(fsec, sheet_features(setting, moduli))
+    if moduli and not all(fsec.has(k) for k in _OPTIONAL_E):
+        features = tuple(c for c in features if c.name not in _OPTIONAL_E or fsec.has(c.name))
+    _check_features(doc, sheet, features)
+    return sheet_scenario(name, description, setting, features)
