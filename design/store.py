@@ -1,22 +1,40 @@
-"""A resumable, chunked Parquet database of simulated designs.
+"""A resumable, chunked Parquet database of simulated designs that guards itself.
 
 Layout of a database folder::
 
     designs.parquet        the design table to simulate (written first, never changed)
-    meta.json              scenario, column units, sampling, holofold version
-    chunks/part-00000.parquet ...   results, ``chunk_size`` rows each, written atomically
+    meta.json              scenario, column roles and units, the chunk layout, sampling, version
+    chunks/part-00000-<sha256:16>.parquet ...   results, ``chunk_size`` rows each
+    chunks/damaged/        chunks found damaged, moved aside (their rows are simulated again)
     database.parquet       all chunks concatenated, written when every chunk exists
 
 Running :func:`build_database` again on the same folder skips the chunks already on disk, so an
-interrupted run (Ctrl-C, a killed job) resumes without losing or duplicating rows. A folder that
-holds a *different* design table is refused rather than mixed. On a Dask cluster every missing
-row is submitted at once and a chunk is written as soon as its rows are done, in any order.
+interrupted run (Ctrl-C, a killed job) resumes without losing or duplicating rows:
+
+* the chunk layout (rows per chunk) is fixed when the database is created and stored in
+  ``meta.json``; a resume asking for another ``chunk_size`` uses the stored one (with a
+  warning), so rows are never lost or counted twice;
+* every chunk is written atomically and named by the SHA-256 of its bytes; each open checks the
+  checksum and that the chunk holds exactly its rows of the design table (sample ids and
+  features). A truncated, empty or altered chunk is moved to ``chunks/damaged/`` with a warning
+  and its rows are simulated again;
+* ``meta.json`` is written atomically and rebuilt from the design table and the scenario when
+  it is missing.
+
+A folder that holds a *different* design table is refused rather than mixed. On a Dask cluster
+every missing row is submitted at once and a chunk is written as soon as its rows are done, in
+any order.
 """
 
 from __future__ import annotations
 
+import hashlib
+import io
 import logging
 import os
+import re
+import time
+import warnings
 from contextlib import closing
 from pathlib import Path
 
@@ -36,9 +54,9 @@ from holofold.design.runner import (
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.tables import write_table
-from holofold.geometry.outputs import write_json
+from holofold.geometry.outputs import atomic_write, write_json
 
-__all__ = ["build_database", "generate_database", "load_database"]
+__all__ = ["build_database", "generate_database", "load_database", "scan_chunks", "write_chunk"]
 
 log = logging.getLogger(__name__)
 
@@ -110,8 +128,9 @@ def build_database(
     chunks.mkdir(parents=True, exist_ok=True)
     designs = designs.reset_index(drop=True)
     dpath = folder / "designs.parquet"
+    meta_path = folder / "meta.json"
     if dpath.exists():
-        old = pd.read_parquet(dpath)
+        old = _read_parquet(dpath, "the design table")
         same = list(old.columns) == list(designs.columns) and len(old) == len(designs)
         if same:
             a = old.to_numpy(dtype=float, na_value=np.nan)
@@ -122,8 +141,17 @@ def build_database(
                 f"{folder} already holds a different design table; use another folder "
                 "(or delete it) instead of mixing two databases"
             )
+        stored = _stored_layout(meta_path, chunks, len(designs))
+        if stored is not None and stored != chunk_size:
+            warnings.warn(
+                f"{folder} was created with {stored} rows per chunk: resuming with that "
+                f"layout, not chunk_size = {chunk_size}",
+                stacklevel=2,
+            )
+            chunk_size = stored
     else:
         write_table(designs, dpath)
+    if not meta_path.is_file():  # new, or lost: (re)built from the scenario and the designs
         info = {
             "scenario": scenario.name,
             "scenario_file": scenario.source or None,
@@ -135,9 +163,10 @@ def build_database(
             "holofold_version": _version(),
             **(meta or {}),
         }
-        write_json(folder / "meta.json", info)
+        write_json(meta_path, info)
     n_chunks = (len(designs) + chunk_size - 1) // chunk_size
-    todo = [k for k in range(n_chunks) if not (chunks / f"part-{k:05d}.parquet").exists()]
+    done = scan_chunks(folder, designs, chunk_size)
+    todo = [k for k in range(n_chunks) if k not in done]
     if len(todo) < n_chunks:
         log.info("resuming: %d of %d chunks already done", n_chunks - len(todo), n_chunks)
     bar = None
@@ -157,13 +186,136 @@ def build_database(
             for k in todo:
                 part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
                 res = evaluate_designs(scenario, part, workers=workers, progress=False)
-                write_table(res, chunks / f"part-{k:05d}.parquet")
+                write_chunk(res, chunks, k)
                 if bar is not None:
                     bar.update(len(part))
     finally:
         if bar is not None:
             bar.close()
     return load_database(folder, _write=True)
+
+
+_CHUNK = re.compile(r"part-(\d{5})(?:-([0-9a-f]{16}))?\.parquet$")
+
+
+def _digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()[:16]
+
+
+def write_chunk(frame: pd.DataFrame, chunks: Path, k: int) -> Path:
+    """Write chunk ``k`` atomically as ``part-<k>-<sha256 of its bytes>.parquet``."""
+    buf = io.BytesIO()
+    frame.to_parquet(buf, index=False)
+    data = buf.getvalue()
+    path = Path(chunks) / f"part-{k:05d}-{_digest(data)}.parquet"
+    return atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))
+
+
+def _read_parquet(path: Path, what: str) -> pd.DataFrame:
+    try:
+        return pd.read_parquet(path)
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
+        raise ValueError(f"{path}: {what} is not a readable Parquet file ({exc})") from None
+
+
+def _stored_layout(meta_path: Path, chunks: Path, n_rows: int) -> int | None:
+    """Rows per chunk the database was created with (meta.json, else its chunks), or None."""
+    if meta_path.is_file():
+        import json
+
+        try:
+            return int(json.loads(meta_path.read_text(encoding="utf-8"))["chunk_size"])
+        except (OSError, ValueError, KeyError, TypeError):
+            pass
+    # meta.json lost or unreadable: a sound first chunk tells (unless it is the only one)
+    for p in sorted(chunks.glob("part-00000*.parquet")):
+        if not _CHUNK.match(p.name):
+            continue
+        try:
+            rows = len(pd.read_parquet(p, columns=["sample"]))
+        except Exception:  # noqa: BLE001 - a damaged chunk says nothing
+            continue
+        if 0 < rows < n_rows:
+            return rows
+    return None
+
+
+def _damaged(path: Path, why: str) -> None:
+    aside = path.parent / "damaged"
+    aside.mkdir(exist_ok=True)
+    dest = aside / f"{path.name}.{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}"
+    os.replace(path, dest)
+    warnings.warn(
+        f"damaged chunk {path.name} ({why}) moved to {dest.relative_to(path.parent.parent)}; "
+        "its rows will be simulated again",
+        stacklevel=3,
+    )
+
+
+def scan_chunks(folder, designs: pd.DataFrame, chunk_size: int) -> dict[int, Path]:
+    """The sound chunks of a database folder: chunk index -> path.
+
+    A chunk is sound when its name's checksum matches its bytes and it holds exactly rows
+    ``k * chunk_size ...`` of ``designs`` (same sample ids and feature values). Every other
+    chunk file (truncated, empty, altered, a duplicate or outside the layout) is moved to
+    ``chunks/damaged/`` with a warning. A chunk of an older holofold (no checksum in its
+    name) that holds the right rows is renamed with its checksum.
+    """
+    chunks = Path(folder) / "chunks"
+    n = len(designs)
+    n_chunks = (n + chunk_size - 1) // chunk_size
+    good: dict[int, Path] = {}
+    for p in sorted(chunks.glob("part-*.parquet")):
+        m = _CHUNK.match(p.name)
+        if m is None:
+            _damaged(p, "not a chunk name")
+            continue
+        k = int(m[1])
+        data = p.read_bytes()
+        why = None
+        if k >= n_chunks:
+            why = f"chunk {k} is outside the layout of {n_chunks} chunks"
+        elif k in good:
+            why = f"a second copy of chunk {k}"
+        elif m[2] is not None and _digest(data) != m[2]:
+            why = "checksum mismatch: truncated or altered"
+        else:
+            why = _content_problem(data, designs.iloc[k * chunk_size : (k + 1) * chunk_size])
+        if why:
+            _damaged(p, why)
+            continue
+        if m[2] is None:  # older layout: add the checksum to the name
+            named = p.with_name(f"part-{k:05d}-{_digest(data)}.parquet")
+            os.replace(p, named)
+            p = named
+        good[k] = p
+    return good
+
+
+def _content_problem(data: bytes, part: pd.DataFrame) -> str | None:
+    """Why a chunk's bytes do not hold exactly the design rows ``part`` (None if they do)."""
+    try:
+        res = pd.read_parquet(io.BytesIO(data))
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
+        return f"unreadable: {type(exc).__name__}"
+    if len(res) != len(part):
+        return f"{len(res)} rows instead of {len(part)}"
+    cols = [c for c in part.columns if c in res.columns]
+    if len(cols) != len(part.columns) or "status" not in res.columns:
+        return "columns missing"
+    for c in cols:
+        a, b = res[c], part[c]
+        if pd.api.types.is_numeric_dtype(b) and pd.api.types.is_numeric_dtype(a):
+            same = np.array_equal(
+                a.to_numpy(dtype=float, na_value=np.nan),
+                b.to_numpy(dtype=float, na_value=np.nan),
+                equal_nan=True,
+            )
+        else:
+            same = a.astype(str).tolist() == b.astype(str).tolist()
+        if not same:
+            return f"its {c} column differs from the design table"
+    return None
 
 
 def _build_on_dask(
@@ -208,7 +360,7 @@ def _build_on_dask(
                 lo, hi = spans[k]
                 # the same table as evaluate_designs(scenario, part) would give
                 res = results_table(scenario, designs.iloc[lo:hi], outs.pop(k))
-                write_table(res, chunks / f"part-{k:05d}.parquet")
+                write_chunk(res, chunks, k)
 
 
 def generate_database(
@@ -247,9 +399,16 @@ def generate_database(
 
 
 def load_database(folder: str | os.PathLike, *, _write: bool = False) -> pd.DataFrame:
-    """All finished chunks of a database folder, in row order."""
+    """All sound chunks of a database folder, in row order (damaged ones are moved aside)."""
     folder = Path(folder)
-    parts = sorted((folder / "chunks").glob("part-*.parquet"))
+    dpath = folder / "designs.parquet"
+    if dpath.is_file():
+        designs = _read_parquet(dpath, "the design table")
+        stored = _stored_layout(folder / "meta.json", folder / "chunks", len(designs))
+        chunk_size = stored or max(len(designs), 1)
+        parts = [p for _, p in sorted(scan_chunks(folder, designs, chunk_size).items())]
+    else:
+        parts = sorted((folder / "chunks").glob("part-*.parquet"))
     if not parts:
         raise FileNotFoundError(f"{folder} holds no finished chunks")
     df = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)

@@ -182,12 +182,16 @@ def write_table(frame: pd.DataFrame, path) -> Path:
     return atomic_write(path, lambda tmp: frame.to_parquet(tmp, index=False))
 
 
+_BOOKKEEPING = {"sample", "status", "origin", "meets_target"}
+
+
 def column_roles(columns, path=None) -> ColumnRoles | None:
     """Recognise the roles of a database's columns.
 
     A holofold database folder (``holofold generate``) has a ``meta.json`` beside its Parquet
     file naming the scenario's features, performance columns and categorical features; that is
-    used first when ``path`` is given. Otherwise a published column set is recognised (in any
+    used first when ``path`` is given (without it, the ``designs.parquet`` beside names the
+    features; none is then categorical). Otherwise a published column set is recognised (in any
     order). Returns None when neither applies.
     """
     cols = {str(c) for c in columns}
@@ -205,6 +209,18 @@ def column_roles(columns, path=None) -> ColumnRoles | None:
                 info = None
             if info is not None and feats:
                 return ColumnRoles(feats, perf, cat)
+        designs = Path(path).with_name("designs.parquet")
+        if designs.is_file():  # meta.json lost: the design table names the features
+            try:
+                import pyarrow.parquet as pq
+
+                names = pq.read_schema(designs).names
+            except Exception:  # noqa: BLE001 - pyarrow raises several types
+                names = []
+            feats = tuple(c for c in names if c in cols and c != "sample")
+            if feats:
+                perf = tuple(c for c in columns if c not in feats and c not in _BOOKKEEPING)
+                return ColumnRoles(feats, tuple(map(str, perf)), ())
     for roles in PUBLISHED.values():
         if cols == set(roles.features + roles.performance):
             return roles

@@ -163,21 +163,21 @@ def _recording_evaluate_one(scenario, row, limit_threads):
 
 
 def _chunk_files(folder):
-    return {p.name: pd.read_parquet(p) for p in sorted((folder / "chunks").glob("*"))}
+    """Chunk name without its checksum ("part-00003") -> table."""
+    return {p.name[:10]: pd.read_parquet(p) for p in sorted((folder / "chunks").glob("*.parquet"))}
 
 
 def _record_writes(monkeypatch, fail_at=None):
-    """Record the chunk files ``store.write_table`` writes; Ctrl-C instead of write fail_at."""
-    written, real = [], store.write_table
+    """Record the chunks ``store.write_chunk`` writes; Ctrl-C instead of writing fail_at."""
+    written, real = [], store.write_chunk
 
-    def recording(df, path):
-        if path.parent.name == "chunks":
-            if len(written) + 1 == fail_at:
-                raise KeyboardInterrupt
-            written.append(path.name)
-        real(df, path)
+    def recording(df, chunks, k):
+        if len(written) + 1 == fail_at:
+            raise KeyboardInterrupt
+        written.append(f"part-{k:05d}")
+        return real(df, chunks, k)
 
-    monkeypatch.setattr(store, "write_table", recording)
+    monkeypatch.setattr(store, "write_chunk", recording)
     return written
 
 
@@ -192,14 +192,14 @@ def test_dask_build_writes_each_chunk_when_its_rows_are_done(
     )
     # every row was submitted at once: the three later chunks were written while the first
     # chunk's slow row was still running
-    assert sorted(written[:3]) == ["part-00001.parquet", "part-00002.parquet", "part-00003.parquet"]
-    assert written[3:] == ["part-00000.parquet"]
+    assert sorted(written[:3]) == ["part-00001", "part-00002", "part-00003"]
+    assert written[3:] == ["part-00000"]
     assert "7/7" in capsys.readouterr().err  # the bar counted every row
     assert db["status"].tolist()[4] == "failed: RuntimeError: unlucky design"
     assert db["double"].tolist()[:4] == [2.0, 4.0, 6.0, 8.0]
     pd.testing.assert_frame_equal(db, serial, check_exact=True)
     a, b = _chunk_files(tmp_path / "dask"), _chunk_files(tmp_path / "serial")
-    assert list(a) == list(b) == [f"part-0000{k}.parquet" for k in range(4)]
+    assert list(a) == list(b) == [f"part-0000{k}" for k in range(4)]
     for name in a:
         pd.testing.assert_frame_equal(a[name], b[name], check_exact=True)
 
@@ -223,7 +223,7 @@ def test_interrupted_dask_build_resumes_without_duplicates(address, miura, tmp_p
     with pytest.raises(KeyboardInterrupt):
         store.build_database(sc, designs, db_dir, chunk_size=2, scheduler="local", workers=3)
     assert len(written) == 2
-    assert sorted(p.name for p in (db_dir / "chunks").iterdir()) == sorted(written)
+    assert sorted(p.name[:10] for p in (db_dir / "chunks").iterdir()) == sorted(written)
     assert not (db_dir / "database.parquet").exists()
     assert len(EVALUATED) <= 7  # every row submitted once
     first_run = set(written)
@@ -237,16 +237,17 @@ def test_interrupted_dask_build_resumes_without_duplicates(address, miura, tmp_p
     written.clear()
     db = store.build_database(sc, designs, db_dir, chunk_size=2, scheduler="local", workers=3)
     assert started == [("local", 3), ("local", 3)]  # one cluster per run, not per chunk
-    assert sorted(_chunk_files(db_dir)) == [f"part-0000{k}.parquet" for k in range(4)]
-    rest = [k for k in range(4) if f"part-0000{k}.parquet" not in first_run]
-    assert sorted(written) == [f"part-0000{k}.parquet" for k in rest]  # only the missing ones
+    assert sorted(_chunk_files(db_dir)) == [f"part-0000{k}" for k in range(4)]
+    rest = [k for k in range(4) if f"part-0000{k}" not in first_run]
+    assert sorted(written) == [f"part-0000{k}" for k in rest]  # only the missing ones
     rows = runner.validate_designs(sc, designs).rows
     want = [tuple(sorted(rows[i].items())) for k in rest for i in range(2 * k, min(7, 2 * k + 2))]
     assert sorted(EVALUATED) == sorted(want)  # only the missing chunks' rows, each once
     assert list(db["sample"]) == list(range(7))
     pd.testing.assert_frame_equal(db, serial, check_exact=True)
+    resumed = _chunk_files(db_dir)
     for name, part in _chunk_files(tmp_path / "serial").items():
-        pd.testing.assert_frame_equal(pd.read_parquet(db_dir / "chunks" / name), part)
+        pd.testing.assert_frame_equal(resumed[name], part)
 
 
 def test_cli_scheduler_flag(address, miura, tmp_path, capsys):
