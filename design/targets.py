@@ -119,11 +119,18 @@ class _BoolOp:
     args: tuple
 
 
+#: longest target expression accepted, characters (a target is a handful of comparisons)
+MAX_LENGTH = 10_000
+#: deepest nesting of parentheses accepted (the parser recurses once per level)
+MAX_DEPTH = 50
+
+
 class _Parser:
     def __init__(self, expr: str, tokens: list[_Token]):
         self.expr = expr
         self.tokens = tokens
         self.i = 0
+        self.depth = 0
 
     @property
     def tok(self) -> _Token:
@@ -156,8 +163,12 @@ class _Parser:
 
     def parse_atom(self):
         if self.tok.kind == "punct" and self.tok.text == "(":
+            self.depth += 1
+            if self.depth > MAX_DEPTH:
+                raise self.error(f"parentheses nested deeper than {MAX_DEPTH} levels")
             self.i += 1
             node = self.parse_or()
+            self.depth -= 1
             if not (self.tok.kind == "punct" and self.tok.text == ")"):
                 raise self.error("expected ')'")
             self.i += 1
@@ -369,6 +380,10 @@ def parse_target(expr: str, columns=None) -> Target:
         raise TargetError(f"a target must be a string, got {type(expr).__name__}")
     if not expr.strip():
         raise TargetError("the target expression is empty")
+    if len(expr) > MAX_LENGTH:
+        raise TargetError(
+            f"the target expression has {len(expr)} characters; at most {MAX_LENGTH} are read"
+        )
     tree = _Parser(expr, _tokenize(expr)).parse()
     used: list[_Column] = []
     _columns_of(tree, used)
