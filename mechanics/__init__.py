@@ -39,6 +39,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "springs": ["dihedral_angle", "dihedral_derivatives", "spring_forces"],
         "status": ["Status", "Outcome", "CONVERGED", "failed_mask", "converged_mask"],
         "structure": ["Structure", "CreaseModel", "BarType", "SpringRole", "support_mask"],
+        "threads": ["single_thread", "single_threaded"],
         "thermal": [
             "ThermalModel",
             "thermal_model",

@@ -17,6 +17,7 @@ from holofold.geometry.errors import ParameterError
 from holofold.mechanics.solvers import solve_mgdcm, solve_newton
 from holofold.mechanics.solvers.result import SolveResult
 from holofold.mechanics.structure import Structure
+from holofold.mechanics.threads import single_threaded
 
 __all__ = [
     "LoadGroup",
@@ -124,6 +125,7 @@ class StiffnessResult:
         return self.result.ok
 
 
+@single_threaded
 def secant_stiffness(
     structure: Structure,
     group: LoadGroup,
@@ -204,6 +206,7 @@ def _peak(u: np.ndarray, lam: np.ndarray) -> float:
     return float(max(lam.max(), c - b * b / (4 * a)))
 
 
+@single_threaded
 def snap_check_mgdcm(
     structure: Structure,
     group: LoadGroup,

@@ -16,6 +16,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from holofold.mechanics.threads import single_threaded
+
 __all__ = ["lumped_mass", "natural_frequencies", "eigenvalues"]
 
 
@@ -74,6 +76,7 @@ def lumped_mass(
     return out
 
 
+@single_threaded
 def eigenvalues(K, mass_dof: np.ndarray, free_dofs: np.ndarray | None = None) -> np.ndarray:
     """Finite eigenvalues lambda of ``K phi = lambda M phi`` on the free DOFs, ascending.
 
@@ -147,6 +150,7 @@ def _inverse_form(K: np.ndarray, s: np.ndarray, nm: int) -> np.ndarray | None:
     return mu if (np.isfinite(mu).all() and (np.abs(mu) > 0).all()) else None
 
 
+@single_threaded
 def natural_frequencies(
     K, mass_dof: np.ndarray, free_dofs: np.ndarray | None = None, n: int | None = None
 ) -> np.ndarray:

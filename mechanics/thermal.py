@@ -32,6 +32,7 @@ import scipy.sparse.linalg as spla
 from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
 from holofold.mechanics.solvers import solve_selffold
+from holofold.mechanics.threads import single_threaded
 
 __all__ = [
     "ThermalModel",
@@ -285,6 +286,7 @@ def _solve_spd(A: sp.spmatrix, b: np.ndarray) -> np.ndarray:
     return spla.splu(sp.csc_matrix(A)).solve(b)
 
 
+@single_threaded
 def steady_temperature(
     model: ThermalModel,
     x: np.ndarray,
@@ -504,6 +506,7 @@ def initial_thermal_state(structure, room_temperature: float = 21.0) -> ThermalS
     )
 
 
+@single_threaded
 def electrothermal_stage(
     structure,
     model: ThermalModel,

@@ -19,22 +19,14 @@ from dataclasses import dataclass, field
 
 __all__ = ["Column", "Scenario", "single_thread"]
 
-_CONTROLLER = None
-
 
 def single_thread():
-    """Context manager limiting BLAS/OpenMP to one thread (cheap after the first call).
+    """Context manager limiting BLAS/OpenMP to one thread: :func:`holofold.mechanics.single_thread`
+    (re-entrant, cheap when nested). Every scenario's ``evaluate`` and every solver already run
+    inside it, so a script that calls them directly is as fast as the runner."""
+    from holofold.mechanics.threads import single_thread as limit
 
-    The models' small dense solves get much slower (10x and more on a busy machine) when
-    several BLAS threads contend for the cores, so every evaluation runs single-threaded;
-    parallelism comes from running rows on several processes (:mod:`~holofold.design.runner`).
-    """
-    global _CONTROLLER
-    if _CONTROLLER is None:
-        from threadpoolctl import ThreadpoolController
-
-        _CONTROLLER = ThreadpoolController()
-    return _CONTROLLER.limit(limits=1)
+    return limit()
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, integer, positive, single_thread
+from holofold.design.scenarios.base import Column, Scenario, integer, positive
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -64,6 +64,7 @@ from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
 from holofold.mechanics.status import Outcome, Status
+from holofold.mechanics.threads import single_threaded
 
 __all__ = [
     "MIURA",
@@ -390,6 +391,7 @@ def check_sheet(setting: SheetSetting, row) -> list[str]:
     return errs
 
 
+@single_threaded
 def evaluate_sheet(setting: SheetSetting, columns: Sequence[str], row) -> dict:
     """The ``columns`` of one design (see the module docstring) and a status."""
     out, cases = {}, {}
@@ -397,16 +399,15 @@ def evaluate_sheet(setting: SheetSetting, columns: Sequence[str], row) -> dict:
         tag = extension_tag(ext)
         asm = Assembler(s)  # one sparse pattern and reduction for every load case
         for ld, grp in zip(setting.loads, groups, strict=True):
-            with single_thread():
-                r = secant_stiffness(
-                    s,
-                    grp,
-                    force_per_increment=ld.force / ld.increments,
-                    increments=ld.increments,
-                    tol=setting.tol,
-                    max_iter=setting.max_iter,
-                    assembler=asm,
-                )
+            r = secant_stiffness(
+                s,
+                grp,
+                force_per_increment=ld.force / ld.increments,
+                increments=ld.increments,
+                tol=setting.tol,
+                max_iter=setting.max_iter,
+                assembler=asm,
+            )
             out[f"{ld.name}stiff{tag}"] = r.stiffness
             cases[f"{ld.name} Ext {ext}"] = r.result.status
     if "mass" in columns:

@@ -36,7 +36,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, integer, positive, single_thread
+from holofold.design.scenarios.base import Column, Scenario, integer, positive
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -67,6 +67,7 @@ from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
 from holofold.mechanics.status import Outcome, Status
+from holofold.mechanics.threads import single_threaded
 
 __all__ = [
     "StripLoad",
@@ -277,6 +278,7 @@ def _mass(setting: StripSetting, g, row) -> float:
     return setting.density * (area.sum() * tp + fold_length * w * (tc - tp))
 
 
+@single_threaded
 def evaluate_strip(setting: StripSetting, columns: Sequence[str], row) -> dict:
     """The ``columns`` of one design (see the module docstring) and a status."""
     s, g, err = strip_model(setting, row)
@@ -293,16 +295,15 @@ def evaluate_strip(setting: StripSetting, columns: Sequence[str], row) -> dict:
     cases = {}
     for ld in setting.loads:
         group = load_along([loaded_node(setting, g.m, ld.at, g.t)], ld.direction)
-        with single_thread():
-            r = secant_stiffness(
-                s,
-                group,
-                force_per_increment=ld.force / ld.increments,
-                increments=ld.increments,
-                tol=setting.tol,
-                max_iter=setting.max_iter,
-                assembler=asm,
-            )
+        r = secant_stiffness(
+            s,
+            group,
+            force_per_increment=ld.force / ld.increments,
+            increments=ld.increments,
+            tol=setting.tol,
+            max_iter=setting.max_iter,
+            assembler=asm,
+        )
         out[f"{ld.name}stiff"] = r.stiffness
         label = f"{ld.name} case"
         if ld.snap_displacement is not None:

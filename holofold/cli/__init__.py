@@ -7,7 +7,9 @@ Each sub-command lives in its own module of this package and exposes two names:
 ``run(args) -> int``
     does the work and returns the exit status.
 
-Modules are discovered automatically, so adding a sub-command means adding one module. A
+Modules are discovered automatically, so adding a sub-command means adding one module; a run
+imports only the module of its command, and ``holofold --help`` none (their help lines are read
+from their sources), so the command line starts fast. A
 sub-command parses its arguments and calls the library through the layers' public faces
 (``holofold.geometry``, ``holofold.fitting``, ``holofold.mechanics``, ``holofold.design``);
 an import-linter contract in pyproject.toml keeps it so.
@@ -20,11 +22,13 @@ file, and writes every file atomically). Warnings become one line each on stderr
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
 import logging
 import pkgutil
 import sys
 import warnings
+from pathlib import Path
 
 __all__ = ["main", "build_parser"]
 
@@ -32,13 +36,50 @@ __all__ = ["main", "build_parser"]
 _ORDER = ["demo", "design", "scenarios", "pattern", "fit", "evaluate", "generate", "mine", "verify"]
 
 
-def _command_modules():
+def _command_names() -> list[str]:
     names = [m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
     names.sort(key=lambda n: (_ORDER.index(n) if n in _ORDER else len(_ORDER), n))
-    return [importlib.import_module(f"{__name__}.{n}") for n in names]
+    return names
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _command_modules():
+    return [importlib.import_module(f"{__name__}.{n}") for n in _command_names()]
+
+
+def _help_line(name: str) -> str | None:
+    """The literal ``help=`` of the ``add_parser`` call in command ``name``'s source, read
+    without importing it (the commands import the library, which ``holofold --help`` must
+    not pay for), or None if it is not a string literal."""
+    try:
+        tree = ast.parse((Path(__file__).parent / f"{name}.py").read_text(encoding="utf-8"))
+    except (OSError, SyntaxError):
+        return None
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and getattr(node.func, "attr", None) == "add_parser":
+            for kw in node.keywords:
+                if kw.arg == "help" and isinstance(kw.value, ast.Constant):
+                    return kw.value.value if isinstance(kw.value.value, str) else None
+    return None
+
+
+def _command_of(argv: list[str]) -> str | None:
+    """The sub-command named in ``argv`` (its first word that is not an option), or None."""
+    for a in argv:
+        if a == "--":
+            return None
+        if not a.startswith("-"):
+            return a
+    return None
+
+
+def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.ArgumentParser:
+    """The ``holofold`` parser.
+
+    Every command module is imported and registered, unless ``lazy``: then only ``command``
+    (if it is one) is, and the others get a stand-in parser with the help line read from
+    their source, so that ``holofold --help`` and a single command start without importing
+    the library for every other command.
+    """
     parser = argparse.ArgumentParser(
         prog="holofold",
         description="Holistic inverse design of origami: shape and function.",
@@ -46,14 +87,20 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for mod in _command_modules():
-        p = mod.register(sub)
-        p.set_defaults(_run=mod.run)
+    for name in _command_names():
+        line = _help_line(name) if lazy and name != command else None
+        if line is None:
+            mod = importlib.import_module(f"{__name__}.{name}")
+            p = mod.register(sub)
+            p.set_defaults(_run=mod.run)
+        else:
+            sub.add_parser(name, help=line)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_command_of(argv), lazy=True)
     args = parser.parse_args(argv)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,

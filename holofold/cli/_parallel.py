@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.design import check_scheduler, check_workers
-
 
 def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
     """Add ``--workers N`` (joblib processes) and ``--scheduler ADDRESS`` (Dask) to ``p``."""
@@ -32,6 +30,8 @@ def add_parallel_arguments(p: argparse.ArgumentParser) -> None:
 
 def parallel_settings(args) -> tuple[int, str | None]:
     """(workers, scheduler) of parsed arguments, checked before anything is written."""
+    from holofold.design import check_scheduler, check_workers  # the runner imports pandas
+
     scheduler = None if args.scheduler is None else check_scheduler(args.scheduler)
     if args.workers is None:
         return (-1 if scheduler == "local" else 1), scheduler

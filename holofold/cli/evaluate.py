@@ -13,19 +13,19 @@ import sys
 from pathlib import Path
 
 from holofold.cli._parallel import add_parallel_arguments, parallel_settings
-from holofold.design import (
-    SCENARIO_NAMES,
-    check_table_path,
-    evaluate_designs,
-    get_scenario,
-    load_scenario,
-    read_table,
-    validate_designs,
-    write_table,
-)
-from holofold.mechanics import converged_mask, failed_mask
+from holofold.design import SCENARIO_NAMES
 
 __all__ = ["register", "run"]
+
+_EPILOG = "<the scenarios' columns>"
+
+
+class _EpilogFormatter(argparse.RawDescriptionHelpFormatter):
+    """Builds the epilog (every scenario's columns) only when the help is printed: building
+    the scenarios imports most of the library, which a run of the command need not pay for."""
+
+    def add_text(self, text):
+        super().add_text(_epilog() if text is _EPILOG else text)
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -38,8 +38,8 @@ def register(subparsers) -> argparse.ArgumentParser:
             "published feature names as header (SI units: metres, radians, pascals), or a "
             "published headerless data*_*.txt (names from the *_FeatureName.txt next to it)."
         ),
-        epilog=_epilog(),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=_EPILOG,
+        formatter_class=_EpilogFormatter,
     )
     p.add_argument(
         "scenario",
@@ -55,6 +55,8 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 def _epilog() -> str:
+    from holofold.design import get_scenario
+
     lines = ["columns (SI units; [paper's sampling range]):"]
     for name in SCENARIO_NAMES:
         sc = get_scenario(name)
@@ -77,6 +79,16 @@ def _epilog() -> str:
 
 
 def run(args) -> int:
+    from holofold.design import (
+        check_table_path,
+        evaluate_designs,
+        load_scenario,
+        read_table,
+        validate_designs,
+        write_table,
+    )
+    from holofold.mechanics import converged_mask, failed_mask
+
     scenario = load_scenario(args.scenario)
     check_table_path(args.output)
     workers, scheduler = parallel_settings(args)

@@ -30,10 +30,12 @@ from holofold.mechanics.solvers._common import (
 )
 from holofold.mechanics.solvers.result import SolveResult
 from holofold.mechanics.structure import Structure
+from holofold.mechanics.threads import single_threaded
 
 __all__ = ["solve_mgdcm"]
 
 
+@single_threaded
 def solve_mgdcm(
     structure: Structure,
     load,
