@@ -216,6 +216,19 @@ def _verify(scenario, records, target, n, folder, seed, workers, progress):
     return out
 
 
+def _box_of(sc: Scenario, hits: pd.DataFrame, roles: ColumnRoles) -> dict:
+    """A pseudo-rule: the box spanned by the designs that meet the target (to refine around)."""
+    bounds: dict = {}
+    for name in roles.features:
+        col = hits[name].to_numpy(dtype=float)
+        if name in roles.categorical:
+            bounds[name] = {"in": sorted(set(col.tolist()))}
+        else:
+            bounds[name] = {"gt": float(np.nextafter(col.min(), -np.inf)), "le": float(col.max())}
+    return {"rank": 0, "rule": f"the box of the {len(hits)} designs meeting the target",
+            "bounds": bounds}  # fmt: skip
+
+
 def _rule_entry(rec: Mapping, v: Verification | None) -> dict:
     e = {
         "rank": rec["rank"],
@@ -364,11 +377,21 @@ def run_design(
             write_rules(rdir / "rules.json", records)
         times["mine"] += time.perf_counter() - t0
         if not records:
-            raise ValueError(
-                f"no rule reaches the miner's precision for {str(tgt)!r} in round {r} "
-                f"({int(mined.meets.sum())} of {len(mined.table)} designs meet it); "
-                "try more samples or a looser target"
-            )
+            hits = int(mined.meets.sum())
+            if r == rounds:
+                more = "more --rounds, " if hits else ""
+                raise ValueError(
+                    f"no rule reaches the miner's precision for {str(tgt)!r} in round {r} "
+                    f"({hits} of {len(mined.table)} designs meet it); try {more}more samples "
+                    "or a looser target"
+                )
+            # a rare target: refine around the designs that meet it, then mine again
+            box = _box_of(sc, mined.table.loc[mined.meets], roles)
+            say(f"  round {r}: no rule yet ({hits} of {len(mined.table)} designs meet the "
+                "target); the next round samples around them")  # fmt: skip
+            history.append({"round": r, "rows": int(len(mined.table) + mined.n_failed),
+                            "records": [box], "rules": [], "best": None})  # fmt: skip
+            continue
         t0 = time.perf_counter()
         say(f"[verify] round {r}: {len(records)} rule(s), {verify} fresh designs each")
         checks = _verify(sc, records, tgt, verify, rdir / "verify", seed + 100 * r, workers,

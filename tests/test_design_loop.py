@@ -272,3 +272,32 @@ def test_a_generated_database_is_reused_and_extended(tmp_path, capsys):
     assert main(["design", "single-miura", "--target", "axialstiff60 > 1", "-o",
                  str(tmp_path / "p"), "--db", str(db)]) == 2  # fmt: skip
     assert "holds designs of scenario 'arch'" in capsys.readouterr().err
+
+
+def _cheap(row):
+    return {"double": 2.0 * row["a"], "status": CONVERGED}
+
+
+def test_a_rare_target_is_refined_around_its_hits_before_any_rule_exists(tmp_path):
+    from holofold.design import Column, Scenario
+
+    cheap = Scenario(
+        name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
+        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
+        performance=(Column("double", "m"),),
+    )  # fmt: skip
+    said = []
+    res = run_design(cheap, "double > 1.94", tmp_path / "o", samples=100, rounds=2, refine=60,
+                     verify=10, top=1, workers=1, progress=False, files=False,
+                     say=said.append)  # fmt: skip
+    r0, r1 = res.summary["rounds"][:2]
+    assert r0["rules"] == [] and r0["best"] is None  # 3 % of the rows: no rule of support 10
+    assert any("no rule yet" in line for line in said)
+    refined = res.table[res.table["origin"] == "refine-1"]
+    # half inside the hits' box (a > 0.97), half in it widened by a quarter of the range
+    assert len(refined) == 60 and (refined["a"] > 0.96).sum() >= 30 and refined["a"].min() > 0.7
+    assert r1["rules"] and res.summary["verified_precision"] >= 0.9
+    assert res.performance["double"] > 1.94
+    with pytest.raises(ValueError, match="try more --rounds"):
+        run_design(cheap, "double > 1.94", tmp_path / "p", samples=100, verify=5,
+                   workers=1, progress=False, files=False)  # fmt: skip
