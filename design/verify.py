@@ -43,15 +43,24 @@ def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
     """
     cols = {c.name: c for c in scenario.features}
     out: dict = {}
+    if not isinstance(bounds, Mapping):
+        raise ValueError(f"a rule's bounds must be a mapping feature -> box, got {bounds!r:.60}")
     for name, b in bounds.items():
         if name not in cols:
             raise ValueError(f"rule constrains {name!r}, which is not a feature of {scenario.name}")
         c = cols[name]
-        if "in" in b:
-            out[name] = [float(v) for v in b["in"]]
+        levels, lo, hi = _check_bound(name, b)
+        if levels is not None:
+            out[name] = levels
             continue
-        lo = c.low if b.get("gt") is None else max(float(b["gt"]), c.low)
-        hi = c.high if b.get("le") is None else min(float(b["le"]), c.high)
+        if c.choices:  # an interval over a categorical feature: the levels inside it
+            inside = [v for v in c.choices if (lo is None or v > lo) and (hi is None or v <= hi)]
+            if not inside:
+                raise ValueError(f"rule range of {name} ({lo}, {hi}] holds none of {c.choices}")
+            out[name] = inside
+            continue
+        lo = c.low if lo is None else max(lo, c.low)
+        hi = c.high if hi is None else min(hi, c.high)
         if not lo <= hi:
             raise ValueError(
                 f"rule range of {name} ({b.get('gt')}, {b.get('le')}] lies outside the "
@@ -59,6 +68,29 @@ def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
             )
         out[name] = (lo, hi)
     return out
+
+
+def _number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and not math.isnan(v)
+
+
+def _check_bound(name: str, b) -> tuple[list | None, float | None, float | None]:
+    """(levels, low, high) of one feature's box; one clear line for a malformed one."""
+    shape = '{"gt": number or null, "le": number or null} or {"in": [numbers]}'
+    if not isinstance(b, Mapping) or not b or set(b) - {"gt", "le", "in"}:
+        raise ValueError(f"bounds of {name} = {b!r:.60} must be {shape}")
+    if "in" in b:
+        v = b["in"]
+        if set(b) != {"in"} or not isinstance(v, list) or not v or not all(map(_number, v)):
+            raise ValueError(f"bounds of {name}: 'in' = {v!r:.60} must be a list of numbers")
+        return [float(x) for x in v], None, None
+    lo, hi = b.get("gt"), b.get("le")
+    for key, v in (("gt", lo), ("le", hi)):
+        if v is not None and not _number(v):
+            raise ValueError(f"bounds of {name}: {key!r} = {v!r:.60} must be a number or null")
+    lo = None if lo is None or lo == -math.inf else float(lo)
+    hi = None if hi is None or hi == math.inf else float(hi)
+    return None, lo, hi
 
 
 def rule_mask(table: pd.DataFrame, bounds: Mapping[str, Mapping]) -> np.ndarray:

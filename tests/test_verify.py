@@ -75,3 +75,25 @@ def test_verify_rules_checks_every_rule_first_and_writes_strict_json(tmp_path):
     report = write_verification(tmp_path / "v", rules[:1], res)
     assert json.loads((tmp_path / "v" / "verify.json").read_text()) == report
     assert (tmp_path / "v" / "verify_rule1.csv").is_file()
+
+
+@pytest.mark.parametrize(
+    "bounds, match",
+    [([1, 2], "must be a mapping"), ({"offset": [0.1, 0.2]}, "bounds of offset"),
+     ({"offset": None}, "bounds of offset"), ({"offset": "wide"}, "bounds of offset"),
+     ({"m": {"in": 8}}, "'in' = 8 must be a list"), ({"m": {"in": ["8"]}}, "list of numbers"),
+     ({"offset": {"gt": "0.1"}}, "'gt' = '0.1' must be a number"),
+     ({"offset": {"le": True}}, "must be a number"), ({"offset": {"gt": 0.1, "lt": 1}}, "must be")],
+)  # fmt: skip
+def test_malformed_rule_bounds_are_refused_in_one_line(bounds, match):
+
+    with pytest.raises(ValueError, match=match) as err:
+        rule_ranges(get_scenario("arch"), bounds)
+    assert "\n" not in str(err.value)
+
+
+def test_an_interval_over_a_categorical_feature_gives_its_levels():
+
+    arch = get_scenario("arch")
+    got = rule_ranges(arch, {"m": {"gt": 10, "le": None}, "offset": {"gt": None, "le": 0.2}})
+    assert got == {"m": [12.0, 16.0, 24.0], "offset": (0.10, 0.2)}
