@@ -121,6 +121,7 @@ def read_table(path, columns=None) -> pd.DataFrame:
         raise FileNotFoundError(f"database {path} does not exist")
     suffix = path.suffix.lower()
     if suffix == ".csv":
+        _check_csv_shape(path)
         try:
             frame = pd.read_csv(path)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
@@ -167,6 +168,34 @@ def read_table(path, columns=None) -> pd.DataFrame:
             )
         frame = frame[list(columns)]
     return frame
+
+
+def _check_csv_shape(path: Path) -> None:
+    """Refuse a CSV whose header names a column twice or whose rows have another field count
+    than the header (pandas would rename the copy or shift every later column silently)."""
+    import csv
+
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            rows = csv.reader(fh)
+            header = next(rows, None)
+            if header is None:
+                raise ValueError(f"{path.name} is empty: expected a header row of column names")
+            seen = set()
+            for name in header:
+                if name in seen:
+                    raise ValueError(f"{path.name}: the header names column {name!r} twice")
+                seen.add(name)
+            for line, row in enumerate(rows, start=2):
+                if row and len(row) != len(header):
+                    raise ValueError(
+                        f"{path.name} line {line}: {len(row)} fields, but the header has "
+                        f"{len(header)} columns"
+                    )
+    except UnicodeDecodeError:
+        raise ValueError(f"{path.name} is not a UTF-8 text file") from None
+    except csv.Error as exc:
+        raise ValueError(f"{path.name} is not a readable CSV table: {exc}") from None
 
 
 def check_table_path(path, what: str = "output") -> Path:

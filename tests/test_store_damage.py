@@ -173,3 +173,18 @@ def test_a_database_without_meta_json_can_still_be_mined(tmp_path):
     (db / "meta.json").unlink()
     roles = column_roles(out.columns, db / "database.parquet")
     assert roles.features == ("a", "k") and roles.performance == ("double", "square")
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [("a,k,a\n0.1,1,0.2\n", "names column 'a' twice"),
+     ("a,k\n0.1,1\n0.2,1,5\n", "line 3: 3 fields"),
+     ("a,k\n0.1\n", "line 2: 1 fields"), ("", "is empty")],
+)  # fmt: skip
+def test_a_malformed_csv_table_is_refused_in_one_line(tmp_path, text, match):
+    from holofold.design import read_table
+
+    p = tmp_path / "t.csv"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=match):
+        read_table(p)
