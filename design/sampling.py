@@ -18,9 +18,12 @@ import pandas as pd
 
 from holofold.design.scenarios.base import Scenario
 
-__all__ = ["sample_designs", "METHODS"]
+__all__ = ["sample_designs", "METHODS", "MAX_SAMPLES"]
 
 METHODS = ("random", "lhs", "sobol")
+#: most designs drawn in one call: a table of 5e6 rows is ~0.3 GB and days of simulation;
+#: larger databases are built in batches (``start=``), each resumable
+MAX_SAMPLES = 5_000_000
 
 
 def _unit_samples(method: str, n: int, d: int, seed: int, start: int) -> np.ndarray:
@@ -74,9 +77,18 @@ def sample_designs(
     """
     if method not in METHODS:
         raise ValueError(f"method = {method!r} is not one of {', '.join(METHODS)}")
+    if not float(n).is_integer():
+        raise ValueError(f"n = {n!r} designs must be a whole number")
     n = int(n)
     if n < 1:
         raise ValueError(f"n = {n} must be >= 1")
+    if n > MAX_SAMPLES:
+        gb = n * (len(scenario.features) + 1) * 8 / 1e9
+        raise ValueError(
+            f"n = {n:,} designs would need ~{gb:.3g} GB for the design table alone and, at ~30 "
+            f"ms a design on one core, ~{n * 0.03 / 86400:.3g} core-days; at most "
+            f"{MAX_SAMPLES:,} in one call: build a larger database in batches (start=...)"
+        )
     ranges = dict(ranges or {})
     fixed = dict(fixed or {})
     names = [c.name for c in scenario.features]

@@ -80,3 +80,14 @@ def test_generate_command(tmp_path, capsys):
     assert main(["generate", "single-miura", "-n", "0", "-o", str(tmp_path / "x")]) == 2
     assert not (tmp_path / "x").exists()
     assert main(["generate", "nosuch", "-n", "3", "-o", str(tmp_path / "y")]) == 2
+
+
+def test_a_huge_sample_is_refused_before_any_work(scen):
+    import time
+
+    t = time.perf_counter()
+    with pytest.raises(ValueError, match="core-days; at most 5,000,000"):
+        sample_designs(scen, 10**9)
+    with pytest.raises(ValueError, match="whole number"):
+        sample_designs(scen, 2.5)
+    assert time.perf_counter() - t < 1.0
