@@ -1,7 +1,8 @@
 """holofold.geometry: crease patterns, pattern generators, meshes and fabrication files.
 
 The first layer: it imports nothing from the others. Lengths in metres, angles in radians
-(fold angles in degrees, as FOLD has them); files a user opens use their format's convention.
+(fold angles in degrees, as FOLD has them); files a user opens use their format's convention
+(meshes in millimetres unless asked otherwise, SVG in millimetres, FOLD in metres).
 """
 
 import lazy_loader
@@ -27,10 +28,12 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "DEFAULT_RANGE",
             "GRIPPER_NAMES",
         ],
-        "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation"],
+        "clearance": ["Printability", "printability", "panel_overlap", "panel_clearance"],
+        "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],
         "miura": ["miura_cell", "miura_sheet", "miura_sheet_paper", "miura_nodes", "miura_faces"],
         "outputs": ["check_output_path", "atomic_write", "write_text", "write_json"],
         "pattern": ["CreasePattern", "ASSIGNMENTS"],
+        "printable": ["PrintableLayout", "printable_layout", "printable_solid"],
         "solid": ["thick_solid", "panel_solids", "shrunk_panels", "SolidWarning"],
         "svg": ["export_svg", "load_svg", "polylines_svg"],
         "tmp": ["tmp_sheet", "tmp_nodes", "tmp_faces"],

@@ -7,7 +7,10 @@ has the pattern's vertices first (ids kept) and one centre per panel after them
 (non-planar) quad is the same surface the simulator sees. Faces are oriented consistently
 (:func:`holofold.geometry.pattern.orient_faces`), so normals point to one side of the sheet.
 
-STL, OBJ and PLY are written by trimesh (:func:`export_mesh`); nothing is written by hand.
+STL, OBJ and PLY are written by trimesh (:func:`export_mesh`), in millimetres unless asked
+otherwise (the convention of slicers and CAD programs, which read these unit-less formats as mm);
+the unit is stated where the format allows: an OBJ comment, a PLY header comment and the STL's
+80-byte header (which no reader interprets).
 """
 
 from __future__ import annotations
@@ -16,10 +19,21 @@ import numpy as np
 import trimesh
 
 from holofold.geometry.pattern import CreasePattern, orient_faces
+from holofold.geometry.units import length_factor
 
-__all__ = ["fan_triangulation", "folded_mesh", "flat_mesh", "export_mesh", "MESH_TYPES"]
+__all__ = [
+    "fan_triangulation",
+    "folded_mesh",
+    "flat_mesh",
+    "export_mesh",
+    "MESH_TYPES",
+    "MESH_UNITS",
+]
 
 MESH_TYPES = ("stl", "obj", "ply")
+
+#: default length unit of mesh files (slicers and CAD read STL/OBJ/PLY as millimetres)
+MESH_UNITS = "mm"
 
 
 def fan_triangulation(coords: np.ndarray, faces) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -76,9 +90,27 @@ def flat_mesh(pattern: CreasePattern) -> trimesh.Trimesh:
     return mesh
 
 
-def export_mesh(mesh: trimesh.Trimesh, file_type: str) -> bytes | str:
-    """Serialise ``mesh`` as STL (binary), OBJ or PLY (binary) through trimesh."""
+def export_mesh(mesh: trimesh.Trimesh, file_type: str, units: str = MESH_UNITS) -> bytes | str:
+    """Serialise ``mesh`` (metres) as STL (binary), OBJ or PLY (binary) in ``units``.
+
+    The coordinates are divided by :func:`~holofold.geometry.units.length_factor` of ``units``;
+    the unit is named in an OBJ comment (``# units: mm``), a PLY header comment
+    (``comment units: mm``) and the STL header.
+    """
     file_type = file_type.lower().lstrip(".")
     if file_type not in MESH_TYPES:
         raise ValueError(f"unknown mesh type {file_type!r}; known: {', '.join(MESH_TYPES)}")
-    return trimesh.exchange.export.export_mesh(mesh, None, file_type=file_type)
+    k = length_factor(units)
+    if k != 1.0:
+        mesh = mesh.copy()
+        mesh.apply_scale(1.0 / k)
+    data = trimesh.exchange.export.export_mesh(mesh, None, file_type=file_type)
+    note = f"holofold mesh, units: {units}"
+    if file_type == "stl":  # 80-byte header, free text (must not start with "solid")
+        return note.encode("ascii").ljust(80, b" ")[:80] + data[80:]
+    if file_type == "obj":
+        return f"# {note}\n" + (data if isinstance(data, str) else data.decode())
+    head, sep, body = data.partition(b"end_header\n")
+    first, nl, rest = head.partition(b"\n")  # "ply", then the format line
+    fmt, nl2, rest = rest.partition(b"\n")
+    return first + nl + fmt + nl2 + f"comment {note}\n".encode("ascii") + rest + sep + body

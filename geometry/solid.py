@@ -24,15 +24,99 @@ import trimesh
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError
 from holofold.geometry.pattern import CreasePattern, newell_normals, orient_faces
 
-__all__ = ["shrunk_panels", "panel_solids", "thick_solid", "SolidWarning"]
+__all__ = [
+    "shrunk_panels",
+    "offset_corners",
+    "corner_edges",
+    "panel_solids",
+    "thick_solid",
+    "SolidWarning",
+]
 
 
 class SolidWarning(UserWarning):
     """The thick panels of a folded state overlap (the part would not print as designed)."""
 
 
-def _edge_index(pattern: CreasePattern) -> dict[tuple[int, int], int]:
-    return {(int(a), int(b)): i for i, (a, b) in enumerate(pattern.edges)}
+def corner_edges(pattern: CreasePattern, faces) -> np.ndarray:
+    """Edge id (N,) of the side leaving each corner of ``faces`` (flattened loops, in order)."""
+    fv = np.concatenate(faces)
+    sizes = np.array([len(f) for f in faces])
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    nxt = np.arange(len(fv)) + 1
+    nxt[starts + sizes - 1] = starts
+    nv = np.int64(pattern.n_vertices)
+    keys = pattern.edges[:, 0] * nv + pattern.edges[:, 1]
+    order = np.argsort(keys)
+    side = np.minimum(fv, fv[nxt]) * nv + np.maximum(fv, fv[nxt])
+    return order[np.searchsorted(keys[order], side)]
+
+
+def offset_corners(coords: np.ndarray, faces, inset: np.ndarray) -> np.ndarray:
+    """Corners (N, 3) of every polygon after moving each side inwards in the polygon's plane.
+
+    Parameters
+    ----------
+    coords : (nv, 3) float
+        Vertex coordinates, m.
+    faces : sequence of (k,) int
+        Loops, each counter-clockwise about its own (Newell) normal.
+    inset : (N,) float
+        Inward offset of the side leaving each corner (flattened loops), m.
+
+    Every corner moves to the intersection of its two offset side lines, so the offset sides stay
+    parallel to the old ones at exactly their inset; a warped polygon is offset in its best-fit
+    plane and keeps its warp. Raises :class:`ParameterError` for a polygon that vanishes.
+    """
+    faces = [np.asarray(f, np.int64) for f in faces]
+    fv = np.concatenate(faces)
+    sizes = np.array([len(f) for f in faces])
+    owner = np.repeat(np.arange(len(faces)), sizes)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    nxt = np.arange(len(fv)) + 1
+    nxt[starts + sizes - 1] = starts
+    prev = np.empty_like(nxt)
+    prev[nxt] = np.arange(len(fv))
+    p = np.asarray(coords, float)[fv]
+    n = newell_normals(coords, faces)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    cen = np.stack([np.bincount(owner, weights=p[:, d]) for d in range(3)], 1) / sizes[:, None]
+    u = p[starts + 1] - p[starts]
+    u -= n * np.einsum("ij,ij->i", u, n)[:, None]
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    v = np.cross(n, u)
+    rel = p - cen[owner]
+    q = np.column_stack(
+        [np.einsum("ij,ij->i", rel, u[owner]), np.einsum("ij,ij->i", rel, v[owner])]
+    )
+    e = q[nxt] - q
+    t = e / np.linalg.norm(e, axis=1, keepdims=True)
+    inward = np.column_stack([-t[:, 1], t[:, 0]])  # left of a counter-clockwise side
+    d = np.asarray(inset, float)
+    # corner j joins side j-1 (into j) and side j (out of j): intersect the offset lines
+    a1, d1, o1 = t[prev], inward[prev], d[prev]
+    a2, d2, o2 = t, inward, d
+    cross = a1[:, 0] * a2[:, 1] - a1[:, 1] * a2[:, 0]
+    flat = np.abs(cross) < 1e-12
+    if flat.any():
+        raise ParameterError(
+            f"panel {int(owner[np.flatnonzero(flat)[0]])} has collinear consecutive edges; "
+            "cannot offset it"
+        )
+    diff = o2[:, None] * d2 - o1[:, None] * d1
+    s = (diff[:, 0] * a2[:, 1] - diff[:, 1] * a2[:, 0]) / cross
+    shift = o1[:, None] * d1 + s[:, None] * a1
+    q2 = q + shift
+    e2 = q2[nxt] - q2
+    area = 0.5 * np.bincount(owner, weights=q2[:, 0] * q2[nxt, 1] - q2[nxt, 0] * q2[:, 1])
+    bad = (area <= 0) | (np.bincount(owner, weights=np.einsum("ij,ij->i", e2, e) <= 0) > 0)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise ParameterError(
+            f"crease width up to {2 * d[owner == k].max():.6g} m is wider than panel {k} allows "
+            "(the panel vanishes after the hinge-gap pull-back)"
+        )
+    return p + shift[:, :1] * u[owner] + shift[:, 1:] * v[owner]
 
 
 def shrunk_panels(pattern: CreasePattern, crease_width) -> list[np.ndarray]:
@@ -45,47 +129,9 @@ def shrunk_panels(pattern: CreasePattern, crease_width) -> list[np.ndarray]:
     if not np.isfinite(W).all() or (W < 0).any():
         raise ParameterError(f"crease width must be finite and >= 0, got {W.min()!r}")
     half = np.where(pattern.interior, W / 2.0, 0.0)
-    index = _edge_index(pattern)
     faces = orient_faces(pattern.faces)
-    normals = newell_normals(pattern.coords, faces)
-    out = []
-    for k, (f, nrm) in enumerate(zip(faces, normals, strict=True)):
-        p = pattern.coords[f]
-        n = nrm / np.linalg.norm(nrm)
-        c = p.mean(axis=0)
-        u = p[1] - p[0]
-        u -= n * (u @ n)
-        u /= np.linalg.norm(u)
-        v = np.cross(n, u)
-        q = np.column_stack([(p - c) @ u, (p - c) @ v])  # in-plane, counter-clockwise
-        nxt = np.roll(np.arange(len(f)), -1)
-        d = np.array(
-            [half[index[tuple(sorted((int(f[j]), int(f[nxt[j]]))))]] for j in range(len(f))]
-        )
-        e = q[nxt] - q
-        t = e / np.linalg.norm(e, axis=1, keepdims=True)
-        inward = np.column_stack([-t[:, 1], t[:, 0]])  # left of a counter-clockwise edge
-        # corner j joins edge j-1 (into j) and edge j (out of j): intersect the offset lines
-        prev = np.roll(np.arange(len(f)), 1)
-        a1, d1, o1 = t[prev], inward[prev], d[prev]
-        a2, d2, o2 = t, inward, d
-        cross = a1[:, 0] * a2[:, 1] - a1[:, 1] * a2[:, 0]
-        if (np.abs(cross) < 1e-12).any():
-            raise ParameterError(f"panel {k} has collinear consecutive edges; cannot offset it")
-        # point = q + o1*d1 + s*a1 = q + o2*d2 + r*a2 -> solve for s
-        diff = o2[:, None] * d2 - o1[:, None] * d1
-        s = (diff[:, 0] * a2[:, 1] - diff[:, 1] * a2[:, 0]) / cross
-        shift = o1[:, None] * d1 + s[:, None] * a1
-        q2 = q + shift
-        e2 = q2[nxt] - q2
-        area = 0.5 * np.sum(q2[:, 0] * q2[nxt, 1] - q2[nxt, 0] * q2[:, 1])
-        if area <= 0 or (np.einsum("ij,ij->i", e2, e) <= 0).any():
-            raise ParameterError(
-                f"crease width up to {2 * d.max():.6g} m is wider than panel {k} allows "
-                "(the panel vanishes after the hinge-gap pull-back)"
-            )
-        out.append(p + shift[:, :1] * u + shift[:, 1:] * v)
-    return out
+    corners = offset_corners(pattern.coords, faces, half[corner_edges(pattern, faces)])
+    return np.split(corners, np.cumsum([len(f) for f in faces])[:-1])
 
 
 def _prism(corners: np.ndarray, thickness: float) -> trimesh.Trimesh:

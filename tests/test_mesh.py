@@ -36,14 +36,28 @@ def test_folded_mesh_is_consistently_oriented_and_flat_mesh_is_flat(miura):
 
 
 @pytest.mark.parametrize("kind", ["stl", "obj", "ply"])
-def test_round_trip_through_trimesh(miura, kind, tmp_path):
+def test_round_trip_through_trimesh_in_mm_by_default(miura, kind, tmp_path):
     path = export(miura, tmp_path / f"s.{kind}")
     back = trimesh.load(path, force="mesh", process=True)
     mesh = folded_mesh(miura)
-    assert back.area == pytest.approx(mesh.area, rel=1e-6)
-    assert np.allclose(back.bounds, mesh.bounds, atol=1e-7)
+    assert back.area == pytest.approx(mesh.area * 1e6, rel=1e-6)  # mm^2
+    assert np.allclose(back.bounds, mesh.bounds * 1e3, atol=1e-4)
     data = export_mesh(mesh, kind)
-    assert len(data if isinstance(data, bytes) else data.encode()) > 100
+    raw = data if isinstance(data, bytes) else data.encode()
+    assert b"holofold mesh, units: mm" in raw[:200]  # STL header, OBJ and PLY comments
+    metres = trimesh.load(export(miura, tmp_path / f"m.{kind}", units="m"), force="mesh")
+    assert np.allclose(metres.bounds, mesh.bounds, atol=1e-7)
+    assert b"units: m\n" in path.with_name(f"m.{kind}").read_bytes()[:200] or kind == "stl"
+
+
+def test_units_are_checked_before_writing(miura, tmp_path):
+    from holofold.geometry import ParameterError
+
+    with pytest.raises(ParameterError, match="unknown length unit 'furlong'"):
+        export(miura, tmp_path / "x.stl", units="furlong")
+    with pytest.raises(ParameterError, match="applies to mesh files only"):
+        export(miura, tmp_path / "x.fold", units="mm")
+    assert not list(tmp_path.iterdir())
 
 
 def test_unknown_export_type_is_named(miura, tmp_path):
