@@ -1,6 +1,7 @@
 """holofold.fitting: planar target curves and the Miura-like strips fitted to them.
 
-:mod:`~holofold.fitting.curves` (curves from functions, points and drawings),
+:mod:`~holofold.fitting.curves` (curves from functions, points and path data),
+:mod:`~holofold.fitting.curve_files` (curves from CSV and SVG files, in their units),
 :mod:`~holofold.fitting.strip` (the analytic strip and its named nodes),
 :mod:`~holofold.fitting.strip_fit` (the fit with its errors and flat layout),
 :mod:`~holofold.fitting.error` (index-matched and closest-point errors),
@@ -22,6 +23,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "builtin_curve",
             "load_curve",
             "parse_curve_spec",
+        ],
+        "curve_files": [
+            "CurveUnitWarning",
+            "PLAUSIBLE_SIZE",
+            "check_curve_size",
             "read_points_csv",
             "read_svg_curve",
         ],

@@ -4,12 +4,12 @@ A :class:`PlanarCurve` is a map ``t -> (x, z)`` on ``t in [0, 1]`` (metres), vec
 ``t``. It is built from
 
 * a Python callable (:meth:`PlanarCurve.from_function`),
-* an ``(N, 2)`` array of points or a CSV file of points, interpolated by a scipy spline
-  through the points with a chord-length parameter (:meth:`PlanarCurve.from_points`,
-  :func:`read_points_csv`),
-* the ``d`` attribute of an SVG path, or a path of an SVG file selected by ``file.svg#id``
-  (:meth:`PlanarCurve.from_svg_path`, :func:`read_svg_curve`; parsed with ``svgpathtools``;
-  the SVG y axis points down, so z = -y),
+* an ``(N, 2)`` array of points, interpolated by a scipy spline through the points with a
+  chord-length parameter (:meth:`PlanarCurve.from_points`),
+* the ``d`` attribute of an SVG path (:meth:`PlanarCurve.from_svg_path`, parsed with
+  ``svgelements``; the SVG y axis points down, so z = -y),
+* files, in the units they are drawn in: CSV points and SVG drawings
+  (:mod:`holofold.fitting.curve_files`),
 * a built-in by name (:func:`builtin_curve`, :func:`parse_curve_spec`):
   ``half-circle:radius=2`` (the paper's target, x = R - R cos(pi t), z = R sin(pi t)),
   ``arc:radius=..,angle=..`` (angle in degrees), ``parabola:span=..,height=..``,
@@ -27,12 +27,9 @@ gets a :class:`UserWarning`.
 
 from __future__ import annotations
 
-import csv
-import io
 import logging
 import math
 import warnings
-import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -49,8 +46,6 @@ __all__ = [
     "BUILTIN_CURVES",
     "builtin_curve",
     "parse_curve_spec",
-    "read_points_csv",
-    "read_svg_curve",
     "load_curve",
 ]
 
@@ -174,36 +169,21 @@ class PlanarCurve:
     def from_svg_path(cls, d: str, name: str = "svg", *, source: str = "") -> PlanarCurve:
         """Curve from the ``d`` attribute of an SVG path (y down in SVG -> z = -y).
 
-        The path is sampled densely with ``svgpathtools`` (all segments, equal parameter per
-        segment weighted by length) and interpolated linearly in arc length; the origin is
-        moved to the path's first point.
+        The path is parsed with ``svgelements`` and sampled densely (every segment, points in
+        proportion to its length), then interpolated linearly in arc length; the origin is moved
+        to the path's first point. One unit of ``d`` is 1 m (scale with :meth:`scaled`); a file
+        with its units and transforms is read by
+        :func:`~holofold.fitting.curve_files.read_svg_curve`.
         """
-        try:
-            from svgpathtools import parse_path
+        from holofold.fitting.curve_files import _curve_of
 
-            path = parse_path(d)
+        try:
+            from svgelements import Path as SvgPath
+
+            path = SvgPath(d)
         except Exception as exc:
             raise CurveFormatError(f"cannot parse SVG path data {d[:60]!r}: {exc}") from exc
-        if len(path) == 0:
-            raise CurveFormatError(f"SVG path data {d[:60]!r} has no segments")
-        lengths = np.array([float(seg.length()) for seg in path])
-        if not np.isfinite(lengths).all() or lengths.sum() <= 0:
-            raise CurveError(f"SVG path {d[:60]!r} has zero or non-finite length")
-        n_seg = np.maximum(2, np.ceil(2048 * lengths / lengths.sum()).astype(int))
-        pts = []
-        for seg, n, ln in zip(path, n_seg, lengths, strict=True):
-            if ln <= 0:
-                continue
-            ts = np.linspace(0.0, 1.0, n + 1)[(1 if pts else 0) :]
-            if hasattr(seg, "poly"):
-                z = np.polyval(np.asarray(seg.poly().coeffs), ts)
-            else:  # arcs: scalar evaluation
-                z = np.array([seg.point(float(s)) for s in ts])
-            pts.append(z)
-        zc = np.concatenate(pts)
-        xy = np.column_stack([zc.real, -zc.imag])
-        xy -= xy[0]
-        curve = cls.from_points(xy, name=name, degree=1, source=source or "svg path")
+        curve = _curve_of(path, name, source or "svg path", 1.0)
         return cls(curve.func, name=name, kind="svg", params={"d": d[:200], **curve.params})
 
     def __getstate__(self) -> dict:
@@ -544,87 +524,30 @@ def parse_curve_spec(spec: str) -> PlanarCurve:
     return builtin_curve(name, **params)
 
 
-# ---------------------------------------------------------------------- files
-def read_points_csv(path) -> PlanarCurve:
-    """Curve through the (x, z) points of a CSV file (comma, semicolon or blank separated).
-
-    The first two columns are used; a header line (any non-numeric first row) is skipped.
-    """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CurveFormatError(f"cannot read points file {str(path)!r}: {exc}") from exc
-    rows = []
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
-        raise CurveFormatError(f"points file {str(path)!r} is empty")
-    try:
-        dialect = csv.Sniffer().sniff(lines[0], delimiters=",;\t ")
-        delim = dialect.delimiter
-    except csv.Error:
-        delim = ","
-    for n, ln in enumerate(lines):
-        fields = [f for f in next(csv.reader(io.StringIO(ln), delimiter=delim)) if f.strip()]
-        if delim != " " and len(fields) < 2:
-            fields = ln.split()
-        try:
-            vals = [float(f) for f in fields[:2]]
-            if len(vals) < 2:
-                raise ValueError
-        except ValueError:
-            if n == 0:
-                continue  # header
-            raise CurveFormatError(
-                f"{str(path)!r} line {n + 1}: expected two numbers x, z, got {ln.strip()!r}"
-            ) from None
-        rows.append(vals)
-    if not rows:
-        raise CurveFormatError(f"points file {str(path)!r} has no numeric rows")
-    return PlanarCurve.from_points(np.array(rows), name=path.stem, source=str(path))
-
-
-def read_svg_curve(ref) -> PlanarCurve:
-    """Curve from an SVG file: ``"file.svg"`` (first ``<path>``) or ``"file.svg#path-id"``."""
-    ref = str(ref)
-    file, _, pid = ref.partition("#")
-    path = Path(file)
-    try:
-        root = ET.parse(path).getroot()
-    except (OSError, ET.ParseError) as exc:
-        raise CurveFormatError(f"cannot read SVG file {file!r}: {exc}") from exc
-    paths = [el for el in root.iter() if el.tag.rsplit("}", 1)[-1] == "path"]
-    if pid:
-        paths = [el for el in paths if el.get("id") == pid]
-        if not paths:
-            raise CurveFormatError(f"SVG file {file!r} has no <path id={pid!r}>")
-    if not paths:
-        raise CurveFormatError(f"SVG file {file!r} contains no <path> element")
-    d = paths[0].get("d")
-    if not d:
-        raise CurveFormatError(f"the <path> in {file!r} has no 'd' attribute")
-    return PlanarCurve.from_svg_path(d, name=pid or path.stem, source=ref)
-
-
-def load_curve(curve) -> PlanarCurve:
+# ---------------------------------------------------------------------- any description
+def load_curve(curve, units: str | None = None, *, check_size: bool = True) -> PlanarCurve:
     """A :class:`PlanarCurve` from any accepted description.
 
     ``curve`` may be a PlanarCurve, a callable, an (N, 2) array, a built-in specification
     string (``"parabola:span=4,height=1"``), a CSV/TXT file of points or an SVG file
-    (optionally ``file.svg#path-id``).
+    (optionally ``file.svg#path-id``). ``units`` is the unit of a file's numbers
+    (:mod:`~holofold.fitting.curve_files`: CSV default m, SVG default the document's own);
+    ``check_size`` warns about a file's curve of implausible size.
     """
     if isinstance(curve, PlanarCurve):
         return curve
     if isinstance(curve, (str, Path)):
+        from holofold.fitting.curve_files import read_points_csv, read_svg_curve
+
         s = str(curve)
         file = s.partition("#")[0]
         low = file.lower()
         if low.endswith(".svg"):
-            return read_svg_curve(s)
+            return read_svg_curve(s, units, check_size=check_size)
         if low.endswith((".csv", ".txt", ".dat")) or Path(file).is_file():
             if not Path(file).is_file():
                 raise CurveFormatError(f"points file {file!r} does not exist")
-            return read_points_csv(file)
+            return read_points_csv(file, units or "m", check_size=check_size)
         return parse_curve_spec(s)
     if callable(curve):
         return PlanarCurve.from_function(curve)

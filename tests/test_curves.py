@@ -7,14 +7,13 @@ import warnings
 import numpy as np
 import pytest
 
+from holofold.fitting.curve_files import CurveUnitWarning, read_points_csv, read_svg_curve
 from holofold.fitting.curves import (
     CurveError,
     PlanarCurve,
     builtin_curve,
     load_curve,
     parse_curve_spec,
-    read_points_csv,
-    read_svg_curve,
 )
 from holofold.geometry.errors import FormatError, ParameterError
 
@@ -116,6 +115,7 @@ SVG = """<svg xmlns="http://www.w3.org/2000/svg" width="400" height="300">
 </svg>"""
 
 
+@pytest.mark.filterwarnings("ignore::holofold.fitting.CurveUnitWarning")  # 200 m across
 def test_svg(tmp_path):
     f = tmp_path / "drawing.svg"
     f.write_text(SVG)
@@ -171,8 +171,10 @@ def test_parameter_and_file_errors(tmp_path):
     with pytest.raises(FormatError, match="no <path id='nope'>"):
         read_svg_curve(f"{svg}#nope")
     svg.write_text('<svg xmlns="http://www.w3.org/2000/svg"><path d="Q oops"/></svg>')
-    with pytest.raises(FormatError, match="cannot parse SVG path"):
+    with pytest.raises(FormatError, match="has no segments"):
         read_svg_curve(svg)
+    with pytest.raises(FormatError, match="cannot parse SVG path data"):
+        PlanarCurve.from_svg_path("Q oops")
 
 
 def test_self_intersection_warns():
@@ -187,3 +189,72 @@ def test_self_intersection_warns():
         warnings.simplefilter("error")
         builtin_curve("parabola")  # simple: no warning
         PlanarCurve.from_function(lambda t: (np.cos(2 * np.pi * t), np.sin(2 * np.pi * t)))
+
+
+def _svg(tmp_path, head, body, name="d.svg"):
+    f = tmp_path / name
+    f.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" {head}>{body}</svg>')
+    return f
+
+
+def test_svg_document_units_viewbox_and_transforms(tmp_path):
+    # 400 mm wide drawing, viewBox in mm, the path inside a group scaled by 2: a 0.4 m chord
+    arc = '<path id="arch" d="M 0 100 A 50 50 0 0 1 200 100"/>'
+    f = _svg(tmp_path, 'width="400mm" height="200mm" viewBox="0 0 400 200"',
+             f'<g transform="scale(2)">{arc}</g>')  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a plausible size: no warning
+        arch = read_svg_curve(f"{f}#arch")
+    np.testing.assert_allclose(arch(np.array([0.0, 0.5, 1.0])),
+                               [[0, 0], [0.2, 0.2], [0.4, 0]], atol=1e-9)  # fmt: skip
+    assert arch.length == pytest.approx(np.pi * 0.2, rel=1e-6)
+    assert arch.params["units"] == "mm"
+    # a viewBox of tenths of a millimetre, and inches
+    g = _svg(tmp_path, 'width="400mm" height="200mm" viewBox="0 0 4000 2000"',
+             '<path d="M 0 0 L 3000 0"/>', "tenths.svg")  # fmt: skip
+    assert read_svg_curve(g).length == pytest.approx(0.3, rel=1e-12)
+    h = _svg(tmp_path, 'width="10in" height="5in" viewBox="0 0 10 5"',
+             '<path d="M 0 0 L 5 0"/>', "in.svg")  # fmt: skip
+    assert read_svg_curve(h).length == pytest.approx(5 * 0.0254, rel=1e-12)
+    # no viewBox: user units are CSS px (96 per inch)
+    k = _svg(tmp_path, 'width="400mm" height="200mm"', '<path d="M 0 0 L 96 0"/>', "px.svg")
+    assert read_svg_curve(k).length == pytest.approx(0.0254, rel=1e-12)
+
+
+def test_svg_units_given_and_implausible_sizes(tmp_path):
+    f = _svg(tmp_path, 'width="400" height="300"', '<path id="a" d="M 0 100 Q 200 -100 400 100"/>')
+    # no unit in the file: one user unit = 1 m, and a 400 m arch gets a warning naming mm
+    with pytest.warns(CurveUnitWarning, match=r"400 m across .* in mm, it is 0\.4 m"):
+        big = read_svg_curve(f"{f}#a")
+    assert np.ptp(big.polyline(), axis=0)[0] == pytest.approx(400.0, rel=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mm = read_svg_curve(f"{f}#a", units="mm")  # as the scenario files say it
+    assert np.ptp(mm.polyline(), axis=0)[0] == pytest.approx(0.4, rel=1e-9)
+    # a document in mm read as if its user unit were a metre: warned, and done as asked
+    g = _svg(tmp_path, 'width="400mm" height="300mm" viewBox="0 0 400 300"',
+             '<path d="M 0 0 L 300 0"/>', "g.svg")  # fmt: skip
+    with pytest.warns(CurveUnitWarning, match="declares one user unit = 1 mm"):
+        read_svg_curve(g, units="m", check_size=False)
+    with pytest.raises(ParameterError, match="unknown length unit 'furlong'"):
+        read_svg_curve(g, units="furlong")
+    two = _svg(tmp_path, "", '<path d="M 0 0 L 1 0 M 5 5 L 6 6"/>', "two.svg")
+    with pytest.raises(FormatError, match="2 subpaths"):
+        read_svg_curve(two)
+
+
+def test_csv_units_and_a_tiny_arch(tmp_path):
+    t = np.linspace(0, 1, 11)
+    f = tmp_path / "arch_mm.csv"
+    f.write_text("x,z\n" + "\n".join(f"{3000 * s},{4 * 800 * s * (1 - s)}" for s in t))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        c = read_points_csv(f, units="mm")
+    assert np.ptp(c.polyline(), axis=0)[0] == pytest.approx(3.0, rel=1e-12)
+    assert load_curve(str(f), units="mm").length == pytest.approx(c.length, rel=1e-12)
+    with pytest.warns(CurveUnitWarning, match="3000 m across"):
+        read_points_csv(f)  # default metres: a 3 km arch
+    g = tmp_path / "tiny.csv"
+    g.write_text("0,0\n1,1\n2,0\n")
+    with pytest.warns(CurveUnitWarning, match=r"0\.002 m across read in mm.* in m, it is 2 m"):
+        read_points_csv(g, units="mm")

@@ -1,0 +1,237 @@
+"""Target curves from files: CSV point lists and SVG drawings, in the units they are drawn in.
+
+* :func:`read_points_csv` reads (x, z) points in ``units`` (default metres).
+* :func:`read_svg_curve` reads a path of an SVG document with ``svgelements``: the document's
+  ``width``/``height`` units and ``viewBox`` and every ``transform`` on the way to the path are
+  applied. With ``units=None`` a document that states its size in an absolute unit (mm, cm, in,
+  pt, pc, px: ``width="400mm"``) is read in that size; a document that states none (no
+  ``width``, or a bare number) is read with one user unit = 1 m, as before. With ``units`` given,
+  one user unit (the coordinates inside the root ``viewBox``) is one ``units``: the scenario
+  files' and ``--curve-units``' meaning.
+
+A curve whose size is implausible for an origami part read in the unit it was given in (under
+1 cm or over 100 m across, :data:`PLAUSIBLE_SIZE`) gets a :class:`CurveUnitWarning` that names
+its size and the unit that would make it plausible (a 400 m "arch" from a drawing in mm read as
+metres, a 2 mm arch from points in metres read as mm).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from holofold.fitting.curves import CurveError, CurveFormatError, PlanarCurve
+from holofold.geometry.units import LENGTH_UNITS, length_factor
+
+__all__ = [
+    "CurveUnitWarning",
+    "PLAUSIBLE_SIZE",
+    "check_curve_size",
+    "read_points_csv",
+    "read_svg_curve",
+]
+
+#: (smallest, largest) extent of a target curve that is plausible for an origami part, m
+PLAUSIBLE_SIZE = (0.01, 100.0)
+
+#: CSS absolute units in metres (SVG lengths; 96 px per inch)
+_SVG_UNITS = {"mm": 1e-3, "cm": 1e-2, "q": 0.25e-3, "in": 0.0254, "pt": 0.0254 / 72,
+              "pc": 0.0254 / 6, "px": 0.0254 / 96}  # fmt: skip
+_PX = 0.0254 / 96  # svgelements reports coordinates in CSS px
+
+
+class CurveUnitWarning(UserWarning):
+    """A curve whose size is implausible in the unit it was read in (probably the wrong unit)."""
+
+
+def check_curve_size(curve: PlanarCurve, unit: str, per_unit: float, where: str = "") -> None:
+    """Warn (:class:`CurveUnitWarning`) if ``curve`` (m) is implausibly small or large.
+
+    ``unit`` names the unit the file was read in and ``per_unit`` its size in metres; the
+    message suggests the unit of :data:`~holofold.geometry.units.LENGTH_UNITS` that brings the
+    curve nearest to 1 m.
+    """
+    size = float(np.ptp(curve.polyline(257), axis=0).max())
+    lo, hi = PLAUSIBLE_SIZE
+    if lo <= size <= hi:
+        return
+    raw = size / per_unit  # the size in the file's own numbers
+    better = min(
+        (u for u in ("m", "cm", "mm", "in") if lo <= raw * LENGTH_UNITS[u] <= hi),
+        key=lambda u: abs(math.log10(raw * LENGTH_UNITS[u])),
+        default=None,
+    )
+    hint = (
+        f"; if its numbers are in {better}, it is {raw * LENGTH_UNITS[better]:.4g} m across: "
+        f"give units={better!r} (holofold fit --curve-units {better})"
+        if better
+        else ""
+    )
+    warnings.warn(
+        f"curve {curve.name!r}{where} is {size:.4g} m across read in {unit}, implausible for an "
+        f"origami part ({lo:g}-{hi:g} m){hint}",
+        CurveUnitWarning,
+        stacklevel=3,
+    )
+
+
+def read_points_csv(path, units: str = "m", *, check_size: bool = True) -> PlanarCurve:
+    """Curve through the (x, z) points of a CSV file (comma, semicolon or blank separated).
+
+    The first two columns are used, in ``units`` (default m); a header line (any non-numeric
+    first row) is skipped. ``check_size`` warns about an implausible size.
+    """
+    k = length_factor(units)
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CurveFormatError(f"cannot read points file {str(path)!r}: {exc}") from exc
+    rows = []
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise CurveFormatError(f"points file {str(path)!r} is empty")
+    try:
+        dialect = csv.Sniffer().sniff(lines[0], delimiters=",;\t ")
+        delim = dialect.delimiter
+    except csv.Error:
+        delim = ","
+    for n, ln in enumerate(lines):
+        fields = [f for f in next(csv.reader(io.StringIO(ln), delimiter=delim)) if f.strip()]
+        if delim != " " and len(fields) < 2:
+            fields = ln.split()
+        try:
+            vals = [float(f) for f in fields[:2]]
+            if len(vals) < 2:
+                raise ValueError
+        except ValueError:
+            if n == 0:
+                continue  # header
+            raise CurveFormatError(
+                f"{str(path)!r} line {n + 1}: expected two numbers x, z, got {ln.strip()!r}"
+            ) from None
+        rows.append(vals)
+    if not rows:
+        raise CurveFormatError(f"points file {str(path)!r} has no numeric rows")
+    curve = PlanarCurve.from_points(np.array(rows) * k, name=path.stem, source=str(path))
+    curve = PlanarCurve(curve.func, name=curve.name, kind="points",
+                        params={**curve.params, "units": units})  # fmt: skip
+    if check_size:
+        check_curve_size(curve, units, k, f" from {path.name}")
+    return curve
+
+
+def _document_unit(svg) -> tuple[str | None, float]:
+    """(unit, metres per user unit) that the root's width and viewBox declare (None, 1.0 if no
+    absolute unit), from the attributes themselves (exact)."""
+    raw = str(svg.values.get("width") or "").strip().lower()
+    m = re.fullmatch(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:e[+-]?\d+)?)\s*([a-z]*)", raw)
+    if not m or m.group(2) not in _SVG_UNITS:
+        return None, 1.0
+    vb = svg.viewbox
+    if vb is None or not vb.width:
+        return m.group(2), _PX  # no viewBox: user units are CSS px
+    return m.group(2), float(m.group(1)) * _SVG_UNITS[m.group(2)] / float(vb.width)
+
+
+def _user_per_px(svg) -> float:
+    """User units per coordinate unit of svgelements' output (which maps the viewBox to px)."""
+    vb = svg.viewbox
+    if vb is None or not vb.width or svg.values.get("width") is None:
+        return 1.0
+    return float(vb.width) / float(svg.width)
+
+
+def read_svg_curve(ref, units: str | None = None, *, check_size: bool = True) -> PlanarCurve:
+    """Curve from an SVG file: ``"file.svg"`` (its first ``<path>``) or ``"file.svg#path-id"``.
+
+    Parameters
+    ----------
+    ref : str or Path
+        The file, optionally with ``#id`` of a path (or line, polyline, ...).
+    units : str, optional
+        Unit of one user unit of the drawing (one of :data:`LENGTH_UNITS`). Default: the
+        document's own size (``width="400mm"`` with its viewBox), or 1 m per user unit if it
+        states none.
+    check_size : bool
+        Warn about an implausible size (:func:`check_curve_size`).
+
+    The SVG y axis points down, so z = -y; the origin is moved to the path's first point.
+    """
+    from svgelements import SVG, Shape
+    from svgelements import Path as SvgPath
+
+    ref = str(ref)
+    file, _, pid = ref.partition("#")
+    try:
+        svg = SVG.parse(file, reify=True)
+    except Exception as exc:  # noqa: BLE001 - any parse failure is a bad file
+        raise CurveFormatError(f"cannot read SVG file {file!r}: {exc}") from exc
+    if pid:
+        el = svg.get_element_by_id(pid)
+        if not isinstance(el, Shape):
+            raise CurveFormatError(f"SVG file {file!r} has no <path id={pid!r}> (or other shape)")
+    else:
+        shapes = [e for e in svg.elements() if isinstance(e, Shape)]
+        paths = [e for e in shapes if isinstance(e, SvgPath)]
+        if not shapes:
+            raise CurveFormatError(f"SVG file {file!r} contains no <path> element")
+        el = (paths or shapes)[0]
+    doc_unit, doc_per_user = _document_unit(svg)
+    if units is None:
+        label, per_user = (doc_unit, doc_per_user) if doc_unit else ("m (no unit in the file)", 1.0)
+    else:
+        per_user = length_factor(units)
+        label = units
+        if doc_unit and not math.isclose(per_user, doc_per_user, rel_tol=1e-6):
+            warnings.warn(
+                f"SVG file {file!r} declares one user unit = {doc_per_user * 1e3:.6g} mm "
+                f"(width in {doc_unit}); read as 1 {units} as asked",
+                CurveUnitWarning,
+                stacklevel=2,
+            )
+    # svgelements maps the viewBox to CSS px: back to user units, then to metres
+    scale = _user_per_px(svg) * per_user
+    name = pid or Path(file).stem
+    curve = _curve_of(SvgPath(el), name, ref, scale)
+    curve = PlanarCurve(curve.func, name=name, kind="svg",
+                        params={**curve.params, "units": label})  # fmt: skip
+    if check_size:
+        check_curve_size(curve, label, per_user, f" from {Path(file).name}")
+    return curve
+
+
+def _curve_of(path, name: str, source: str, scale: float) -> PlanarCurve:
+    """Sample an svgelements Path (one subpath) densely; ``scale`` m per coordinate unit."""
+    from svgelements import Close, Move
+
+    segs = [s for s in path if not isinstance(s, Move)]
+    moves = sum(isinstance(s, Move) for s in path)
+    if moves > 1:
+        raise CurveFormatError(
+            f"SVG path {name!r} has {moves} subpaths; a curve is one line: draw it as one path"
+        )
+    if isinstance(segs[-1:] and segs[-1], Close) and segs[-1].length() == 0:
+        segs = segs[:-1]
+    if not segs:
+        raise CurveFormatError(f"SVG path {name!r} has no segments")
+    lengths = np.array([float(s.length()) for s in segs])
+    if not np.isfinite(lengths).all() or lengths.sum() <= 0:
+        raise CurveError(f"SVG path {name!r} has zero or non-finite length")
+    n_seg = np.maximum(2, np.ceil(2048 * lengths / lengths.sum()).astype(int))
+    pts = []
+    for seg, n, ln in zip(segs, n_seg, lengths, strict=True):
+        if ln <= 0:
+            continue
+        ts = np.linspace(0.0, 1.0, n + 1)[(1 if pts else 0) :]
+        pts.append(np.asarray(seg.npoint(ts), float).reshape(-1, 2))
+    xy = np.concatenate(pts) * scale
+    xz = np.column_stack([xy[:, 0], -xy[:, 1]])
+    xz -= xz[0]
+    return PlanarCurve.from_points(xz, name=name, degree=1, source=source)
