@@ -15,7 +15,13 @@ import lazy_loader
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
-        "auto": ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"],
+        "auto": [
+            "AutoFit",
+            "FitNotFoundError",
+            "fit_auto",
+            "DEFAULT_M_RANGE",
+            "PUBLISHED_MAX_WARP",
+        ],
         "curves": [
             "BUILTIN_CURVES",
             "CurveError",

@@ -3,10 +3,14 @@
 :func:`fit_auto` walks m upwards over ``m_range``; for each m it evaluates every offset
 (centre line, side line and closest-point error, without building the crease pattern), and
 stops at the first m where some offset meets the tolerance and gives a valid, non-overlapping
-strip. Among the offsets that meet the tolerance it prefers the **largest** (deepest
-corrugation: the most turning at the centre-line vertices, so the smallest side-line shifts
-W_s cot(phi); the paper's stiffest arches also have large offsets), unless
-``prefer="smallest-error"``.
+strip whose quads warp no more than ``max_warp`` (default :data:`PUBLISHED_MAX_WARP`, the
+largest warp of the 3000 published arch designs: 3.47 %, docs/strip-fit.md §4.2) and, with
+``panel_thickness`` and ``crease_width``, whose folded thick panels do not overlap
+(:func:`~holofold.geometry.clearance.printability`) when ``require_no_overlap``. Among the
+offsets that qualify it prefers the **largest** (deepest corrugation: the most turning at the
+centre-line vertices, so the smallest side-line shifts W_s cot(phi); the paper's stiffest arches
+also have large offsets), unless ``prefer="smallest-error"``. Deep corrugations warp the quads
+most, so the warp limit is what keeps the largest offset from running away.
 """
 
 from __future__ import annotations
@@ -23,14 +27,21 @@ from holofold.fitting.error import closest_point_error, index_matched_error
 from holofold.fitting.strip import (
     check_m,
     check_sampling,
+    quad_warp,
     side_line,
+    strip_faces,
+    strip_nodes,
     strip_samples,
     zigzag_centre_line,
 )
 from holofold.fitting.strip_fit import StripFit, fit_strip
+from holofold.geometry.clearance import printability
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 
-__all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE"]
+__all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE", "PUBLISHED_MAX_WARP"]
+
+#: largest relative quad warp of the 3000 published arch designs (0.0347, rounded up)
+PUBLISHED_MAX_WARP = 0.035
 
 log = logging.getLogger(__name__)
 
@@ -66,6 +77,10 @@ def fit_auto(
     sampling: str | None = None,
     metric: str = "max",
     prefer: str = "largest-offset",
+    max_warp: float | None = PUBLISHED_MAX_WARP,
+    panel_thickness: float | None = None,
+    crease_width: float | None = None,
+    require_no_overlap: bool = False,
 ) -> AutoFit:
     """Smallest m (and an offset) whose strip's closest-point error meets ``tolerance``.
 
@@ -88,13 +103,20 @@ def fit_auto(
         Which closest-point error (centre line -> curve) must be <= tolerance.
     prefer : {"largest-offset", "smallest-error"}
         Which qualifying offset to take at the smallest m.
+    max_warp : float or None
+        Largest allowed relative quad warp (diagonal distance / mean diagonal; None: any).
+    panel_thickness, crease_width : float, optional
+        t and W, m: the folded thick panels' ``overlap`` (m^3) and ``clearance`` (m) are
+        reported for the candidates built.
+    require_no_overlap : bool
+        Refuse candidates whose thick panels overlap (needs both of the above).
 
     Returns
     -------
     AutoFit
         ``strip`` (:class:`StripFit`) and ``candidates`` (DataFrame with columns m, offset,
-        strip_width, extrude, closest_mean, closest_max, index_error, valid, meets, chosen,
-        reason), one row per candidate tried.
+        strip_width, extrude, closest_mean, closest_max, index_error, warp_max, valid, meets,
+        chosen, reason, and overlap, clearance with a thickness), one row per candidate tried.
 
     Raises
     ------
@@ -126,10 +148,21 @@ def fit_auto(
     )
     sampling = check_sampling(sampling, curve)
     col = "closest_max" if metric == "max" else "closest_mean"
+    if max_warp is not None:
+        max_warp = check_range("max_warp", max_warp, 0.0, None, low_open=True)
+    thick = (panel_thickness, crease_width)
+    if any(v is not None for v in thick):
+        if any(v is None for v in thick):
+            raise ParameterError("overlap needs both a panel thickness and a crease width")
+        panel_thickness = check_range("panel_thickness", panel_thickness, 0.0, None, low_open=True)
+        crease_width = check_range("crease_width", crease_width, 0.0, None)
+    if require_no_overlap and panel_thickness is None:
+        raise ParameterError("require_no_overlap needs a panel thickness and a crease width")
 
     rows: list[dict] = []
     for m in ms:
         t, samples = strip_samples(curve, m, sampling)
+        faces = strip_faces(m)
         start = len(rows)
         for off in offs:
             ws = off / 8.0 if strip_width is None else strip_width
@@ -140,15 +173,24 @@ def fit_auto(
                 closest_mean=err.mean,
                 closest_max=err.max,
                 index_error=index_matched_error(curve, P, t),
+                warp_max=float("nan"),
                 valid=True,
                 meets=(err.max if metric == "max" else err.mean) <= tol * (1 + _SLACK),
                 chosen=False,
                 reason="",
             )
             try:
-                side_line(P, ws)
+                S = side_line(P, ws)
             except DegenerateGeometryError as exc:
                 row.update(valid=False, meets=False, reason=str(exc))
+            else:
+                row["warp_max"] = float(quad_warp(strip_nodes(P, S, le), faces).max())
+                if max_warp is not None and row["warp_max"] > max_warp:
+                    row.update(
+                        meets=False,
+                        reason=f"quads warp {100 * row['warp_max']:.3g} % > max_warp "
+                        f"{100 * max_warp:.3g} %",
+                    )
             rows.append(row)
         # candidates of this m that meet the tolerance, best first
         ok = [r for r in rows[start:] if r["meets"]]
@@ -162,8 +204,15 @@ def fit_auto(
             except DegenerateGeometryError as exc:
                 r.update(valid=False, meets=False, reason=str(exc))
                 continue
+            if panel_thickness is not None:
+                pr = printability(fit.pattern, panel_thickness, crease_width)
+                r.update(overlap=pr.overlap, clearance=pr.clearance)
+                if require_no_overlap and pr.overlap > 0:
+                    r.update(meets=False, reason=f"thick panels overlap ({pr.overlap:.3g} m^3)")
+                    continue
             r["chosen"] = True
-            log.info("fit_auto: m=%d offset=%.4g %s=%.4g", m, r["offset"], col, r[col])
+            log.info("fit_auto: m=%d offset=%.4g %s=%.4g warp=%.3g", m, r["offset"], col, r[col],
+                     r["warp_max"])  # fmt: skip
             return AutoFit(fit, pd.DataFrame(rows))
     table = pd.DataFrame(rows)
     good = table[table["valid"]]
@@ -177,4 +226,12 @@ def fit_auto(
         )
     else:
         msg = f"no valid strip in the ranges tried ({table['reason'].iloc[0]})"
+    close = table[table["valid"] & (table[col] <= tol * (1 + _SLACK))]
+    if len(close):  # the tolerance was met, a limit was not
+        why = close["reason"].iloc[int(np.argmin(close["warp_max"].to_numpy()))]
+        msg = (
+            f"no strip with m in {ms[0]}..{ms[-1]} meets {col} <= {tol:.4g} m within the limits: "
+            f"the least warped one that meets the tolerance is refused because {why}; allow a "
+            "larger max_warp, other m or offsets, or thinner panels"
+        )
     raise FitNotFoundError(msg, table)

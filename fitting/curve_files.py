@@ -121,7 +121,7 @@ def read_points_csv(path, units: str = "m", *, check_size: bool = True) -> Plana
         raise CurveFormatError(f"points file {str(path)!r} has no numeric rows")
     curve = PlanarCurve.from_points(np.array(rows) * k, name=path.stem, source=str(path))
     curve = PlanarCurve(curve.func, name=curve.name, kind="points",
-                        params={**curve.params, "units": units})  # fmt: skip
+                        params={**curve.params, "units": units, "metres_per_unit": k})  # fmt: skip
     if check_size:
         check_curve_size(curve, units, k, f" from {path.name}")
     return curve
@@ -200,8 +200,8 @@ def read_svg_curve(ref, units: str | None = None, *, check_size: bool = True) ->
     scale = _user_per_px(svg) * per_user
     name = pid or Path(file).stem
     curve = _curve_of(SvgPath(el), name, ref, scale)
-    curve = PlanarCurve(curve.func, name=name, kind="svg",
-                        params={**curve.params, "units": label})  # fmt: skip
+    params = {**curve.params, "units": label, "metres_per_unit": per_user}
+    curve = PlanarCurve(curve.func, name=name, kind="svg", params=params)
     if check_size:
         check_curve_size(curve, label, per_user, f" from {Path(file).name}")
     return curve

@@ -80,6 +80,49 @@ def test_fit_auto(tmp_path, capsys):
     assert s["m"] in range(2, 25, 2)
 
 
+def test_fit_auto_warp_limit_no_overlap_printable_in_metres(tmp_path, capsys):
+    out = tmp_path / "auto"
+    args = ["fit", "--curve", "parabola:span=4,height=1", "--auto", "--tolerance", "0.05",
+            "--strip-width", "0.02", "--extrude", "0.1", "--panel-thickness", "0.002",
+            "--crease-width", "0.003", "--crease-thickness", "0.0008", "--printable",
+            "--no-overlap", "--units", "m", "-o", str(out)]  # fmt: skip
+    assert main(args) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    s = json.loads(lines[-1])
+    assert s["warp_max"] <= 0.035 and "(limit 3.5 %)" in lines[-2]
+    assert f"quads warp up to {100 * s['warp_max']:.3g} %" in lines[-2]
+    assert s["units"]["mesh files"] == "m" and s["units"]["strip.fold"] == "m"
+    table = __import__("pandas").read_csv(out / "candidates.csv")
+    chosen = table[table["chosen"]].iloc[0]
+    assert chosen["overlap"] == 0.0 and chosen["warp_max"] == pytest.approx(s["warp_max"])
+    part = trimesh.load(out / "printable.stl")
+    assert part.is_watertight and part.body_count == 1
+    np.testing.assert_allclose(part.bounds[:, 2], [0.0, 0.002], atol=1e-9)  # metres
+    strip = trimesh.load(out / "strip.stl")
+    assert 3.9 < np.ptp(strip.bounds[:, 0]) < 4.2
+
+
+def test_fit_csv_in_mm_and_a_warning_for_an_svg_in_mm_read_as_metres(tmp_path, capsys):
+    t = np.linspace(0, 1, 15)
+    csv = tmp_path / "mm.csv"
+    csv.write_text("\n".join(f"{4000 * a:.12g},{4000 * a * (1 - a):.12g}" for a in t))
+    args = ["--m", "6", "--offset", "0.15", "--strip-width", "0.01", "--extrude", "0.1"]
+    assert main(["fit", "--curve", str(csv), "--curve-units", "mm", *args,
+                 "-o", str(tmp_path / "a")]) == 0  # fmt: skip
+    cap = capsys.readouterr()
+    assert cap.err == ""  # a 4 m curve: plausible, no warning
+    fold = json.loads((tmp_path / "a" / "strip.fold").read_text())
+    X = np.array(fold["file_frames"][0]["vertices_coords"])
+    np.testing.assert_allclose(X[[0, 12], 0], [0.0, 4.0], atol=1e-9)
+    svg = tmp_path / "arch.svg"  # a drawing without units: its 400 user units read as metres
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="400" height="200">'
+                   '<path d="M 0 200 Q 200 -200 400 200"/></svg>')  # fmt: skip
+    assert main(["fit", "--curve", str(svg), *args, "-o", str(tmp_path / "b")]) in (0, 2)
+    err = capsys.readouterr().err
+    assert "warning: curve 'arch' from arch.svg is 400 m across" in err
+    assert "--curve-units mm" in err
+
+
 def test_thick_solid(tmp_path, capsys):
     out = tmp_path / "solid"
     thick = ["--panel-thickness", "0.004", "--crease-width", "0.002"]
@@ -139,6 +182,22 @@ def test_plan_view_svg_without_layout():
         ([*BASE, "--m", "12"], "missing --offset"),
         ([*BASE, "--auto"], "--auto needs --tolerance"),
         ([*BASE, *DESIGN, "--panel-thickness", "0.001"], "both --panel-thickness"),
+        (
+            [
+                *BASE,
+                *DESIGN,
+                "--printable",
+                "--panel-thickness",
+                "0.002",
+                "--crease-width",
+                "0.002",
+            ],
+            "--printable needs --crease-thickness",
+        ),
+        ([*BASE, *DESIGN, "--crease-thickness", "0.001"], "add --printable"),
+        ([*BASE, *DESIGN, "--no-overlap"], "--no-overlap needs --auto"),
+        ([*BASE, "--auto", "--tolerance", "0.05", "--max-warp", "0"], "--max-warp"),
+        ([*BASE, *DESIGN, "--curve-scale", "-1"], "--curve-scale"),
     ],
 )
 def test_bad_input_writes_nothing(tmp_path, capsys, argv, match):

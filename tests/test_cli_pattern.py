@@ -53,6 +53,10 @@ def test_tmp_pattern(tmp_path):
          "--thickness"),
         (["miura", "--gamma", "60", "--ext", "0.5", "--size", "0.2", "--thickness", "1e-3",
           "--crease-width", "0.2"], "wider than panel"),
+        (["miura", "--gamma", "60", "--ext", "0.5", "--size", "0.2", "--printable",
+          "--thickness", "1e-3"], "--printable needs --crease-thickness, --crease-width > 0"),
+        (["miura", "--gamma", "60", "--ext", "0.5", "--size", "0.2", "--crease-thickness",
+          "1e-3"], "add --printable"),
     ],
 )  # fmt: skip
 def test_bad_arguments_exit_nonzero_and_write_nothing(tmp_path, capsys, extra, message):
@@ -87,3 +91,21 @@ def test_overlapping_thick_tmp_is_refused_and_mild_overlap_is_a_one_line_warning
         err.startswith("holofold pattern: warning: thick panels intersect") and err.count("\n") == 1
     )
     assert (ok / "thick.stl").is_file()
+
+
+def test_printable_part_in_mm_and_folded_surface_in_metres(tmp_path, capsys):
+    out = tmp_path / "p"
+    argv = ["pattern", "miura", "--m", "4", "--n", "4", "--gamma", "60", "--ext", "0.6",
+            "--a", "0.02", "--b", "0.02", "--printable", "--panel-thickness", "2e-3",
+            "--crease-thickness", "0.6e-3", "--crease-width", "2e-3", "-o", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    assert "printable.stl" in capsys.readouterr().out
+    part = trimesh.load(out / "printable.stl")
+    assert part.is_watertight and part.body_count == 1
+    np.testing.assert_allclose(part.bounds[:, 2], [0.0, 2.0], atol=1e-5)  # mm
+    # the flat sheet's area in mm^2, covered by panels (2 mm) and hinges (0.6 mm)
+    area = 16 * 20 * 20 * np.sin(np.radians(60))
+    assert 0.6 * area < part.volume < 2.0 * area
+    assert main([*argv[:-2], "--units", "m", "-o", str(tmp_path / "m")]) == 0
+    folded = trimesh.load(tmp_path / "m" / "folded.stl")
+    assert np.ptp(folded.bounds[:, 0]) < 0.1  # metres

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from holofold.fitting import fit_strip
-from holofold.fitting.auto import FitNotFoundError, fit_auto
+from holofold.fitting.auto import PUBLISHED_MAX_WARP, FitNotFoundError, fit_auto
 from holofold.fitting.curves import parse_curve_spec
 from holofold.geometry.errors import ParameterError
 
@@ -78,3 +78,48 @@ def test_no_fit_found_reports_best():
 def test_bad_input(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         fit_auto(HALF, **kwargs)
+
+
+def test_max_warp_keeps_the_choice_within_the_published_designs():
+    kw = {"strip_width": 0.02, "extrude": 0.1}
+    free = fit_auto("parabola:span=4,height=1", 0.05, max_warp=None, **kw)
+    assert (free.strip.m, free.strip.offset) == (4, pytest.approx(0.04))
+    assert free.strip.warp.max() == pytest.approx(0.0938, abs=5e-4)  # what the issue saw
+    held = fit_auto("parabola:span=4,height=1", 0.05, **kw)  # default: PUBLISHED_MAX_WARP
+    assert held.strip.warp.max() <= PUBLISHED_MAX_WARP
+    assert (held.strip.m, held.strip.offset) == (8, pytest.approx(0.05))
+    t = held.candidates
+    assert t.loc[t["chosen"], "warp_max"].iloc[0] == pytest.approx(held.strip.warp.max())
+    refused = t[(t["m"] == 4) & t["reason"].str.contains("max_warp")]
+    assert len(refused) and (refused["warp_max"] > PUBLISHED_MAX_WARP).all()
+    with pytest.raises(FitNotFoundError, match="refused because quads warp"):
+        fit_auto("parabola:span=4,height=1", 0.05, m_range=[4], max_warp=0.01, **kw)
+
+
+def test_no_overlap_of_the_folded_thick_panels():
+    res = fit_auto(HALF, 0.1, m_range=[4, 6, 8], panel_thickness=6e-3, crease_width=1e-3,
+                   require_no_overlap=True)  # fmt: skip
+    t = res.candidates
+    chosen = t[t["chosen"]].iloc[0]
+    assert chosen["overlap"] == 0.0 and chosen["clearance"] > 0
+    over = t[t["reason"].str.contains("thick panels overlap", na=False)]
+    assert len(over) and (over["overlap"] > 0).all()  # deeper corrugations collide
+    assert chosen["offset"] < over["offset"].max() or chosen["m"] > over["m"].min()
+    with pytest.raises(ParameterError, match="needs a panel thickness"):
+        fit_auto(HALF, 0.1, require_no_overlap=True)
+
+
+@pytest.mark.slow
+def test_published_max_warp_is_what_the_published_arches_reach(reference_data):
+    from holofold.fitting.strip import quad_warp, strip_geometry
+
+    rows = reference_data.load("data3_ShapeFit")
+    worst = max(
+        quad_warp(g.nodes, g.faces).max()
+        for g in (
+            strip_geometry(HALF, int(r.m), r.offset, r.stripeWidth, r.extrude, "paper")
+            for r in rows.itertuples()
+        )
+    )
+    assert worst == pytest.approx(0.0347, abs=5e-5)
+    assert worst <= PUBLISHED_MAX_WARP < worst + 1e-3

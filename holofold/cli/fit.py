@@ -5,18 +5,25 @@ Examples::
     holofold fit --curve half-circle:radius=2 --m 12 --offset 0.2 --strip-width 0.02 \\
         --extrude 0.1 -o out/
     holofold fit --curve points.csv --m 8 --offset 0.1 --strip-width 0.01 --extrude 0.1 -o out/
-    holofold fit --curve drawing.svg#arch --curve-scale 0.01 --auto --tolerance 0.05 -o out/
+    holofold fit --curve drawing.svg#arch --auto --tolerance 0.05 -o out/
+    holofold fit --curve points_mm.csv --curve-units mm --auto --tolerance 0.005 \
+        --panel-thickness 0.002 --crease-width 0.002 --crease-thickness 0.0006 --printable \
+        --no-overlap -o out/
 
-Writes ``strip.fold`` (FOLD 1.2: the flat sector-angle development as crease pattern plus the
-3-D strip as a folded-form frame, published node numbering; side-B panel loops are reversed so
-that every panel is counter-clockwise in the layout), ``strip.svg`` (that development as an
-Origami-Simulator-coloured crease pattern in mm; the x-z plan view of centre and side lines if
-no development exists), ``strip.stl`` and ``strip.obj`` (the 3-D strip surface, each quad
-fanned from its centre), ``candidates.csv`` with ``--auto``, and ``strip_solid.stl`` (panel
-prisms with hinge gaps, geometry.solid) when ``--panel-thickness`` and ``--crease-width`` are
-given. The last line printed is a JSON object
-with the fit parameters, the errors and the files written. All inputs are validated before any
-file is created.
+Writes ``strip.fold`` (FOLD 1.2, metres: the flat sector-angle development as crease pattern
+plus the 3-D strip as a folded-form frame, published node numbering; side-B panel loops are
+reversed so that every panel is counter-clockwise in the layout), ``strip.svg`` (that
+development as an Origami-Simulator-coloured crease pattern in mm; the x-z plan view of centre
+and side lines if no development exists), ``strip.stl`` and ``strip.obj`` (the 3-D strip
+surface, each quad fanned from its centre), ``candidates.csv`` with ``--auto``,
+``strip_solid.stl`` (the folded panel prisms with hinge gaps, loose bodies) when
+``--panel-thickness`` and ``--crease-width`` are given, and ``printable.stl`` (the flat part to
+print and fold: panels joined by hinge strips of ``--crease-thickness``) with ``--printable``.
+Meshes are in ``--units`` (default mm, what slicers read). An SVG curve is read in its
+document's units (``width="400mm"``, viewBox and transforms applied); ``--curve-units`` says
+what one unit of a CSV or of the SVG's user coordinates is. The last line printed is a JSON
+object with the fit parameters, the errors (warp relative), the units and the files written.
+All inputs are validated before any file is created.
 """
 
 from __future__ import annotations
@@ -25,8 +32,8 @@ import argparse
 import math
 from pathlib import Path
 
-from holofold.fitting import DEFAULT_M_RANGE, SAMPLINGS
-from holofold.geometry import ParameterError, check_range
+from holofold.fitting import DEFAULT_M_RANGE, PUBLISHED_MAX_WARP, SAMPLINGS
+from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -40,10 +47,17 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--curve", required=True, help="built-in spec, points.csv or drawing.svg[#id]")
     p.add_argument(
+        "--curve-units",
+        choices=tuple(LENGTH_UNITS),
+        default=None,
+        help="unit of the numbers of a CSV (default m) or of an SVG's user units (default: "
+        "the SVG's own width/height units, else m)",
+    )
+    p.add_argument(
         "--curve-scale",
         type=float,
         default=1.0,
-        help="scale factor applied to the curve (e.g. SVG units to metres; default 1)",
+        help="further scale factor applied to the curve (e.g. a 1:10 model; default 1)",
     )
     p.add_argument("--m", type=float, help="number of Miura units (integer >= 2)")
     p.add_argument("--offset", type=float, help="offset l_o of the middle vertices, m")
@@ -68,8 +82,34 @@ def register(subparsers) -> argparse.ArgumentParser:
         default="max",
         help="closest-point error that --auto compares with --tolerance (default max)",
     )
-    p.add_argument("--panel-thickness", type=float, help="write a thick solid of this thickness, m")
-    p.add_argument("--crease-width", type=float, help="crease width of the thick solid, m")
+    p.add_argument(
+        "--max-warp",
+        type=float,
+        default=PUBLISHED_MAX_WARP,
+        help="largest relative quad warp --auto accepts (default %(default)s, the most the "
+        "published arch designs reach)",
+    )
+    p.add_argument(
+        "--no-overlap",
+        action="store_true",
+        help="--auto refuses strips whose folded thick panels overlap (needs --panel-thickness "
+        "and --crease-width)",
+    )
+    p.add_argument("--panel-thickness", type=float, help="panel thickness t_p, m")
+    p.add_argument("--crease-width", type=float, help="crease (hinge) width W, m")
+    p.add_argument("--crease-thickness", type=float, help="hinge thickness t_c, m (--printable)")
+    p.add_argument(
+        "--printable",
+        action="store_true",
+        help="write printable.stl: the flat part, panels joined by hinge strips (needs the "
+        "three thicknesses and widths)",
+    )
+    p.add_argument(
+        "--units",
+        choices=("mm", "m"),
+        default="mm",
+        help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
+    )
     p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
     return p
 
@@ -108,6 +148,7 @@ def _validate(args) -> dict:
         if args.m is not None or args.offset is not None:
             raise ParameterError("--auto chooses --m and --offset itself; do not give them")
         opts["m_range"] = _m_range(args.m_range)
+        check_range("--max-warp", args.max_warp, 0.0, None, low_open=True)
     else:
         missing = [
             f"--{n.replace('_', '-')}"
@@ -127,6 +168,20 @@ def _validate(args) -> dict:
         check_range("--panel-thickness", args.panel_thickness, 0.0, None, low_open=True)
         check_range("--crease-width", args.crease_width, 0.0, None, low_open=True)
         opts["solid"] = True
+    if args.no_overlap and not (args.auto and opts.get("solid")):
+        raise ParameterError("--no-overlap needs --auto, --panel-thickness and --crease-width")
+    if args.printable:
+        missing = [
+            f"--{n.replace('_', '-')}"
+            for n in ("panel_thickness", "crease_width", "crease_thickness")
+            if getattr(args, n) is None
+        ]
+        if missing:
+            raise ParameterError(f"--printable needs {', '.join(missing)}")
+        check_range("--crease-thickness", args.crease_thickness, 0.0, None, low_open=True)
+    elif args.crease_thickness is not None:
+        raise ParameterError("--crease-thickness is for --printable; add --printable")
+    check_range("--curve-scale", args.curve_scale, 0.0, None, low_open=True)
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--output {str(out)!r} exists and is not a folder")
@@ -136,13 +191,24 @@ def _validate(args) -> dict:
 def run(args) -> int:
     import json
 
-    from holofold.fitting import export_strip_files, fit_auto, fit_strip, load_curve
+    from holofold.fitting import (
+        check_curve_size,
+        export_strip_files,
+        fit_auto,
+        fit_strip,
+        load_curve,
+    )
 
     opts = _validate(args)
-    curve = load_curve(args.curve)
-    if args.curve_scale != 1.0:
+    scaled = args.curve_scale != 1.0
+    curve = load_curve(args.curve, units=args.curve_units, check_size=not scaled)
+    if scaled:
+        per = curve.params.get("metres_per_unit", 1.0) * args.curve_scale
         curve = curve.scaled(args.curve_scale)
+        unit = curve.params.get("units", "m")
+        check_curve_size(curve, f"{unit} x {args.curve_scale:g}", per, "")
     table = None
+    thick = {"panel_thickness": args.panel_thickness, "crease_width": args.crease_width}
     if args.auto:
         res = fit_auto(
             curve,
@@ -152,6 +218,9 @@ def run(args) -> int:
             extrude=opts.get("extrude"),
             sampling=args.sampling,
             metric=args.metric,
+            max_warp=args.max_warp,
+            require_no_overlap=args.no_overlap,
+            **(thick if opts.get("solid") else {}),
         )
         fit, table = res.strip, res.candidates
     else:
@@ -162,11 +231,20 @@ def run(args) -> int:
     written = export_strip_files(
         fit,
         args.output,
-        panel_thickness=args.panel_thickness,
-        crease_width=args.crease_width,
+        **thick,
+        crease_thickness=args.crease_thickness if args.printable else None,
         candidates=table,
+        units=args.units,
     )
-    summary = {**fit.parameters, **fit.errors, "files": [str(w) for w in written]}
-    print(f"fitted m={fit.m} strip ({fit.pattern.n_vertices} nodes) to {fit.curve.name}")
+    units = {"lengths": "m", "errors": "m", "warp": "relative (1 = 100 %)",
+             "mesh files": args.units, "strip.fold": "m", "strip.svg": "mm"}  # fmt: skip
+    summary = {**fit.parameters, **fit.errors, "units": units, "files": [str(w) for w in written]}
+    warp = fit.errors["warp_max"]
+    limit = f" (limit {100 * args.max_warp:.3g} %)" if args.auto else ""
+    print(
+        f"fitted m={fit.m} strip ({fit.pattern.n_vertices} nodes) to {fit.curve.name}: "
+        f"closest-point error max {fit.closest.max:.4g} m, quads warp up to {100 * warp:.3g} %"
+        + limit
+    )
     print(json.dumps(summary))
     return 0

@@ -6,10 +6,15 @@ Examples::
     holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --size 0.2 \\
         --thickness 0.5e-3 --crease-width 2e-3 -o out/
     holofold pattern tmp --m 6 --n 6 --size 0.2 --ext 0.6 -o out/
+    holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --size 0.1 --printable \
+        --panel-thickness 2e-3 --crease-thickness 0.6e-3 --crease-width 2e-3 -o out/
 
-Writes ``pattern.fold`` (flat crease pattern + folded frame), ``pattern.svg`` (cut/score
-layers), ``folded.stl`` and ``folded.obj`` (folded surface) and, with ``--thickness``,
-``thick.stl`` (printable panels with hinge gaps). Angles in degrees here, lengths in metres.
+Writes ``pattern.fold`` (flat crease pattern + folded frame, m), ``pattern.svg`` (cut/score
+layers, mm), ``folded.stl`` and ``folded.obj`` (folded surface) and, with ``--thickness``,
+``thick.stl`` (the folded panels with hinge gaps, loose bodies) and, with ``--printable``,
+``printable.stl``: the flat part to print and then fold, panels joined by hinge strips of
+``--crease-thickness`` and ``--crease-width``. Meshes in ``--units`` (default mm, what slicers
+read). Angles in degrees here, lengths in metres.
 """
 
 from __future__ import annotations
@@ -35,8 +40,23 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--size", type=float, help="sheet size L, m (Miura: b = L/m, a = (L - b cot g)/n)"
     )
-    p.add_argument("--thickness", type=float, help="panel thickness for thick.stl, m")
+    p.add_argument(
+        "--thickness", "--panel-thickness", dest="thickness", type=float,
+        help="panel thickness t_p for thick.stl and printable.stl, m",
+    )  # fmt: skip
     p.add_argument("--crease-width", type=float, default=0.0, help="hinge gap W, m (default 0)")
+    p.add_argument("--crease-thickness", type=float, help="hinge thickness t_c, m (--printable)")
+    p.add_argument(
+        "--printable",
+        action="store_true",
+        help="write printable.stl: the flat part, panels joined by hinge strips",
+    )
+    p.add_argument(
+        "--units",
+        choices=("mm", "m"),
+        default="mm",
+        help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
+    )
     p.add_argument("-o", "--output", required=True, help="output folder")
     return p
 
@@ -69,14 +89,29 @@ def _build(args):
 def run(args) -> int:
     import numpy as np
 
-    from holofold.geometry import check_range, export_pattern_files
+    from holofold.geometry import ParameterError, check_range, export_pattern_files
 
     pattern = _build(args)
     check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:
         check_range("--thickness", args.thickness, 0.0, None, low_open=True)
+    if args.printable:
+        given = {"--panel-thickness": args.thickness, "--crease-thickness": args.crease_thickness}
+        missing = [name for name, v in given.items() if v is None]
+        if args.crease_width <= 0:
+            missing.append("--crease-width > 0")
+        if missing:
+            raise ParameterError(f"--printable needs {', '.join(missing)}")
+        check_range("--crease-thickness", args.crease_thickness, 0.0, None, low_open=True)
+    elif args.crease_thickness is not None:
+        raise ParameterError("--crease-thickness is for --printable; add --printable")
     written = export_pattern_files(
-        pattern, args.output, thickness=args.thickness, crease_width=args.crease_width
+        pattern,
+        args.output,
+        thickness=args.thickness,
+        crease_width=args.crease_width,
+        crease_thickness=args.crease_thickness if args.printable else None,
+        units=args.units,
     )
     ext = np.ptp(pattern.coords, axis=0)
     print(
