@@ -2,9 +2,14 @@
 
 Colours follow Origami Simulator's import convention: mountain red ``#ff0000``, valley blue
 ``#0000ff``, border black, flat and join (facet) yellow ``#ffff00``, cut green ``#00ff00``,
-unassigned magenta ``#ff00ff``; ``stroke-opacity`` = |fold angle| / 180 for M and V (1 when a
-crease's fold angle is 0, i.e. a flat pattern whose M/V is known but not its target angle).
-Each line also carries ``data-assignment`` and ``data-foldAngle``.
+unassigned magenta ``#ff00ff``; ``stroke-opacity`` = |fold angle| / 180 for M and V, but at
+least ``min_opacity`` (default 0.3, so that shallow creases stay visible; 1 when a crease's fold
+angle is 0, i.e. a flat pattern whose M/V is known but not its target angle). Origami Simulator
+reads fold angles from the opacity: the exact angle of every line is its ``data-foldAngle``
+(and the FOLD file's), and ``min_opacity=0`` writes the plain encoding. A legend (mountain,
+valley, cut, boundary, as short ``<path>`` samples with labels, ``<g id="legend">``) sits above
+the pattern, outside it; ``legend=False`` leaves it out (e.g. for a cutter that cuts every
+black line).
 
 Lines are grouped for fabrication: ``<g id="cut">`` holds border and cut lines (to cut
 through), ``<g id="score">`` the creases (to score, perforate or plot). Coordinates are in
@@ -20,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.geometry.errors import FormatError
+from holofold.geometry.errors import FormatError, check_range
 from holofold.geometry.pattern import CreasePattern
 
 __all__ = ["COLOURS", "export_svg", "polylines_svg", "load_svg", "SvgLines"]
@@ -38,40 +43,80 @@ _CUT = ("B", "C")
 _SVG_NS = "http://www.w3.org/2000/svg"
 
 
+_LEGEND = (("M", "mountain"), ("V", "valley"), ("C", "cut"), ("B", "boundary"))
+
+
+def _legend(
+    x0: float, y0: float, font_mm: float, stroke_mm: float, min_opacity: float
+) -> tuple[str, float, float]:
+    """The legend group at (x0, y0) (mm), with its width and height."""
+    col = 36.0 * font_mm / 3.0
+    row = 1.6 * font_mm
+    items = []
+    for k, (code, label) in enumerate(_LEGEND):
+        x, y = x0 + (k % 2) * col, y0 + (k // 2) * row + font_mm
+        items.append(
+            f'<path d="M {x:.3f} {y - font_mm / 3:.3f} h {2.5 * font_mm:.3f}" '
+            f'stroke="{COLOURS[code]}" stroke-width="{2 * stroke_mm}"/>'
+            f'<text x="{x + 3.2 * font_mm:.3f}" y="{y:.3f}">{label}</text>'
+        )
+    text = f"opacity |fold angle| / 180, at least {min_opacity:g}; mm"
+    note = (
+        f'<text x="{x0:.3f}" y="{y0 + 2 * row + font_mm:.3f}" font-size="{0.8 * font_mm:.3g}">'
+        f"{text}</text>"
+    )
+    body = (
+        f'<g id="legend" fill="none" font-family="sans-serif" font-size="{font_mm:.3g}">\n  '
+        + "\n  ".join(items)
+        + f"\n  {note}\n</g>"
+    )
+    width = max(2 * col, 0.8 * font_mm * 0.55 * len(text))
+    return body.replace("<text", '<text fill="#000000"'), width, 3 * row
+
+
 def export_svg(
     pattern: CreasePattern,
     *,
     margin_mm: float = 5.0,
     stroke_mm: float = 0.2,
     show_facets: bool = False,
+    min_opacity: float = 0.3,
+    legend: bool = True,
 ) -> str:
     """SVG text of the flat crease pattern (metres in, millimetres out).
 
     ``show_facets`` also draws ``J`` edges (triangulation lines); they are left out by default
-    because they are neither cut nor folded.
+    because they are neither cut nor folded. ``min_opacity`` in [0, 1] keeps shallow creases
+    visible; ``legend`` adds the legend above the pattern.
     """
     if pattern.flat is None:
         raise ValueError(
             "this pattern has no flat layout to draw as a crease pattern; export FOLD instead"
         )
+    min_opacity = check_range("min_opacity", min_opacity, 0.0, 1.0)
     xy = pattern.flat * 1000.0  # mm
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     w, h = hi - lo + 2 * margin_mm
+    top = 0.0
+    if legend:
+        key, key_w, key_h = _legend(margin_mm, margin_mm, 3.0, stroke_mm, min_opacity)
+        top = key_h + margin_mm
+        w, h = max(w, key_w + 2 * margin_mm), h + top
     px = xy[:, 0] - lo[0] + margin_mm
-    py = hi[1] - xy[:, 1] + margin_mm  # flip: SVG y points down
+    py = hi[1] - xy[:, 1] + margin_mm + top  # flip: SVG y points down
     groups: dict[str, list[str]] = {"cut": [], "score": []}
     for i, (a, b) in enumerate(pattern.edges):
         code = str(pattern.assignment[i])
         if code == "J" and not show_facets:
             continue
         ang = float(pattern.fold_angle[i])
-        opacity = abs(ang) / 180.0 if code in ("M", "V") and ang != 0 else 1.0
+        opacity = max(abs(ang) / 180.0, min_opacity) if code in ("M", "V") and ang != 0 else 1.0
         groups["cut" if code in _CUT else "score"].append(
             f'<line x1="{px[a]:.6f}" y1="{py[a]:.6f}" x2="{px[b]:.6f}" y2="{py[b]:.6f}" '
             f'stroke="{COLOURS[code]}" stroke-opacity="{opacity:.6g}" '
             f'data-assignment="{code}" data-foldAngle="{ang:.12g}" data-edge="{i}"/>'
         )
-    body = []
+    body = [key] if legend else []
     for gid, lines in groups.items():
         body.append(
             f'<g id="{gid}" fill="none" stroke-width="{stroke_mm}" stroke-linecap="round">\n  '
@@ -162,6 +207,8 @@ def load_svg(text: str | bytes) -> SvgLines:
     def walk(el, group):
         for child in el:
             tag = child.tag.rsplit("}", 1)[-1]
+            if tag == "g" and child.get("id") == "legend":
+                continue
             if tag == "g":
                 walk(child, child.get("id", group))
             elif tag == "line":

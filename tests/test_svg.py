@@ -72,3 +72,36 @@ def test_errors(miura):
 
     with pytest.raises(ValueError, match="no flat layout"):
         export_svg(replace(miura, flat=None))
+
+
+def test_shallow_creases_stay_visible_and_the_legend_sits_outside():
+    nearly_flat = miura_sheet(3, 3, a=0.02, b=0.03, gamma=math.radians(60), ext=0.99)
+    text = export_svg(nearly_flat)
+    root = ET.fromstring(text)
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    score = root.find(".//s:g[@id='score']", ns)
+    angles = np.array([abs(float(el.get("data-foldAngle"))) for el in score])
+    opacity = np.array([float(el.get("stroke-opacity")) for el in score])
+    assert angles.max() < 40  # |angle| / 180 alone would be < 0.22: barely visible
+    np.testing.assert_allclose(opacity, np.maximum(angles / 180, 0.3))
+    legend = root.find(".//s:g[@id='legend']", ns)
+    labels = [t.text for t in legend.iterfind("s:text", ns)]
+    assert labels[:4] == ["mountain", "valley", "cut", "boundary"]
+    samples = [el.get("stroke") for el in legend.iterfind("s:path", ns)]
+    assert samples == [COLOURS[c] for c in "MVCB"]
+    legend_y = [float(t.get("y")) for t in legend.iterfind("s:text", ns)]
+    line_y = [float(el.get(k)) for el in root.iterfind(".//s:line", ns) for k in ("y1", "y2")]
+    assert max(legend_y) < min(line_y)  # above the pattern, not on it
+    width = float(root.get("viewBox").split()[2])
+    assert all(float(t.get("x")) < width for t in legend.iterfind("s:text", ns))
+    # reading back ignores the legend and keeps the exact angles
+    lines = load_svg(text)
+    assert len(lines.edge) == nearly_flat.n_edges
+    order = np.argsort(lines.edge)
+    np.testing.assert_allclose(lines.fold_angle[order], nearly_flat.fold_angle, atol=1e-9)
+    plain = ET.fromstring(export_svg(nearly_flat, min_opacity=0.0, legend=False))
+    assert plain.find(".//s:g[@id='legend']", ns) is None
+    enc = [float(el.get("stroke-opacity")) for el in plain.find(".//s:g[@id='score']", ns)]
+    np.testing.assert_allclose(enc, angles / 180)  # Origami Simulator's plain encoding
+    with pytest.raises(ValueError, match="min_opacity"):
+        export_svg(nearly_flat, min_opacity=2.0)
