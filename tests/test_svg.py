@@ -83,7 +83,7 @@ def test_shallow_creases_stay_visible_and_the_legend_sits_outside():
     angles = np.array([abs(float(el.get("data-foldAngle"))) for el in score])
     opacity = np.array([float(el.get("stroke-opacity")) for el in score])
     assert angles.max() < 40  # |angle| / 180 alone would be < 0.22: barely visible
-    np.testing.assert_allclose(opacity, np.maximum(angles / 180, 0.3))
+    np.testing.assert_allclose(opacity, np.maximum(angles / 180, 0.3), rtol=1e-5)
     legend = root.find(".//s:g[@id='legend']", ns)
     labels = [t.text for t in legend.iterfind("s:text", ns)]
     assert labels[:4] == ["mountain", "valley", "cut", "boundary"]
@@ -102,6 +102,6 @@ def test_shallow_creases_stay_visible_and_the_legend_sits_outside():
     plain = ET.fromstring(export_svg(nearly_flat, min_opacity=0.0, legend=False))
     assert plain.find(".//s:g[@id='legend']", ns) is None
     enc = [float(el.get("stroke-opacity")) for el in plain.find(".//s:g[@id='score']", ns)]
-    np.testing.assert_allclose(enc, angles / 180)  # Origami Simulator's plain encoding
+    np.testing.assert_allclose(enc, angles / 180, rtol=1e-5)  # the plain encoding (6 digits)
     with pytest.raises(ValueError, match="min_opacity"):
         export_svg(nearly_flat, min_opacity=2.0)
