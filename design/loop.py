@@ -34,7 +34,7 @@ from holofold.design.mining import mine_rules
 from holofold.design.rulefile import rules_to_records, write_rules
 from holofold.design.rules import FewRulesWarning
 from holofold.design.runner import check_workers
-from holofold.design.sampling import sample_designs
+from holofold.design.sampling import MAX_SAMPLES, sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.store import build_database, load_database
 from holofold.design.tables import ColumnRoles, write_table
@@ -326,6 +326,12 @@ def run_design(
                          ("top", top, 1), ("refine", refine, 1 if rounds else 0)):  # fmt: skip
         if int(v) != v or v < low:
             raise ValueError(f"{name} = {v!r} must be an integer >= {low}")
+    total = samples + rounds * refine + (rounds + 1) * top * verify
+    if total > MAX_SAMPLES:
+        raise ValueError(
+            f"{total:,} simulations asked for (samples + rounds x refine + (rounds + 1) x top x "
+            f"verify); at most {MAX_SAMPLES:,} in one run"
+        )
     workers = check_workers(workers)
     out = Path(folder)
     dbf = Path(db) if db is not None else out / "database"
