@@ -3,9 +3,11 @@
 The pattern (CSR ``indptr``/``indices`` and the data slot of every entry the element kernels
 produce) depends only on the connectivity, so it is computed once per topology and cached (keyed
 on a hash of the bar and spring connectivity: every sample of one Miura m x n or arch m shares
-it); each evaluation then fills the CSR data with ``np.bincount`` (bars; springs and the mirrors
-of their off-diagonal blocks). Supports are handled by elimination: the free-free slots, the
-reduced CSR pattern and the fill-reducing orderings are cached per support mask.
+it); each evaluation runs the compiled element kernels (:mod:`~holofold.mechanics._compiled`)
+and fills the CSR data, the dense free-free block or the band by one gather per target (bars,
+springs and the mirrors of their off-diagonal blocks, summed in ``np.bincount``'s order).
+Supports are handled by elimination: the free-free slots, the reduced CSR pattern, the
+fill-reducing orderings and the gather lists are cached per support mask.
 
 Linear solves on the free DOFs (:meth:`Assembler.evaluate_factorized`) pick the fastest path:
 dense LAPACK up to :data:`DENSE_MAX_DOF` free DOFs, then a banded Cholesky on a cached reverse
@@ -32,11 +34,11 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
+from scipy.linalg.lapack import dpbtrf, dpbtrs
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-from holofold.mechanics.bars import bar_kernel
-from holofold.mechanics.springs import SPRING_BLOCKS, arccos_shift, spring_kernel
+from holofold.mechanics.bars import ElementResponse
+from holofold.mechanics.springs import SPRING_BLOCKS, arccos_shift
 from holofold.mechanics.structure import Structure
 
 __all__ = [
@@ -56,7 +58,44 @@ DENSE_MAX_DOF = 200
 #: Sparse systems whose reverse Cuthill-McKee band costs at most this many flops
 #: (n * (bandwidth + 1)^2) first try a banded Cholesky factorisation; SuperLU (LU with a cached
 #: minimum-degree ordering) handles the rest and every matrix that is not positive definite.
-BANDED_MAX_WORK = 3e8
+#: Measured (benchmarks/bench_solvers.py, Miura sheets 24 x 8 to 96 x 32, work 1.3e7 to 2.8e9):
+#: banded Cholesky + solve is 1.6-3.9x faster than SuperLU at every size (72 x 24: 120 ms
+#: against 186 ms), so the banded path is taken up to the largest measured work (it was 3e8,
+#: which sent 60 x 20 and 72 x 24 to SuperLU).
+BANDED_MAX_WORK = 3e9
+
+
+_COMPILED = None
+
+
+def _ck():
+    """The compiled kernels (:mod:`holofold.mechanics._compiled`), imported on first use: numba
+    is imported only by a process that assembles."""
+    global _COMPILED
+    if _COMPILED is None:
+        from holofold.mechanics import _compiled
+
+        _COMPILED = _compiled
+    return _COMPILED
+
+
+def _family(pos: np.ndarray, n: int):
+    """Gather list ``(ptr (n + 1,), src)`` of one element family: ``pos`` gives the target
+    of every entry of the kernel's flat array (outside ``0..n-1``: dropped); each target's
+    sources stay in flat order, the order in which ``np.bincount`` adds them."""
+    keep = np.flatnonzero((pos >= 0) & (pos < n))
+    p = pos[keep]
+    order = np.argsort(p, kind="stable")
+    ptr = np.zeros(n + 1, np.intp)
+    ptr[1:] = np.cumsum(np.bincount(p, minlength=n))
+    return ptr, np.ascontiguousarray(keep[order], dtype=np.intp)
+
+
+def _no_family(n: int):
+    return np.zeros(n + 1, np.intp), np.zeros(0, np.intp)
+
+
+_NO_DEST = np.zeros(0, np.intp)
 
 
 class SingularSystemError(RuntimeError):
@@ -144,7 +183,8 @@ class ReducedPattern:
 
     @cached_property
     def banded_slots(self):
-        """(bar_ab, spring_ab, size): position in the flat upper banded storage of every bar
+        """(bar_ab, spring_ab, size): position in the flat upper banded storage (column-major,
+        element (r, c) of the (bw + 1, nf) band at ``c (bw + 1) + r``) of every bar
         entry (kernel layout (3, 3, 2, 2, nb)) and every distinct spring-block entry ((3, 3,
         10, ns)), ``size`` (= (bw + 1) nf) for entries that are dropped: supported DOFs and the
         duplicate halves of symmetric pairs (lower node blocks of bars, the strictly lower
@@ -163,7 +203,7 @@ class ReducedPattern:
             c = new[pat.indices[slots]]
             lo = np.minimum(r, c)
             hi = np.maximum(r, c)
-            pos = (bw + lo - hi) * nf + hi
+            pos = hi * (bw + 1) + (bw + lo - hi)  # column-major (LAPACK's own layout)
             ok = keep_mask & (lo >= 0)
             return np.where(ok, pos, size).astype(np.intp)
 
@@ -182,6 +222,32 @@ class ReducedPattern:
         keep_s = (~diag[None, None, :] | upper3[:, :, None])[..., None]
         keep_s = np.broadcast_to(keep_s, (3, 3, 10, ns)).ravel()
         return positions(pat.bar_slot, keep_b), positions(pat.spring_slot, keep_s), size
+
+    @cached_property
+    def dense_gather(self):
+        """Gather lists (bars, springs, spring mirrors) of the kept slots, in
+        :func:`holofold.mechanics._compiled.gather`'s form, for the flat dense free-free
+        block (targets ``dense``)."""
+        pat = self._pattern
+        kidx = np.full(pat.nnz + 1, -1, np.intp)
+        kidx[self.keep] = np.arange(self.keep.size)
+        n = self.keep.size
+        return (
+            *_family(kidx[pat.bar_slot], n),
+            *_family(kidx[pat.spring_slot], n),
+            *_family(kidx[pat.spring_slot_mirror], n),
+        )
+
+    @cached_property
+    def band_gather(self):
+        """Gather lists (bars, springs, none) of the column-major upper band (see
+        :attr:`banded_slots`)."""
+        bar_ab, spring_ab, size = self.banded_slots
+        return (
+            *_family(bar_ab, size),
+            *_family(spring_ab, size),
+            *_no_family(size),
+        )
 
     @cached_property
     def ordering(self):
@@ -283,6 +349,26 @@ class AssemblyPattern:
         self.spring_force_dofs = self.spring_dofs.reshape(-1, 4, 3).transpose(2, 1, 0).ravel()
         self._reduced: dict[bytes, ReducedPattern] = {}
 
+    @cached_property
+    def force_gather(self):
+        """Gather lists (bars, springs, none) of the internal force (targets: the DOFs)."""
+        n = self.n_dof
+        return (
+            *_family(self.bar_force_dofs, n),
+            *_family(self.spring_force_dofs, n),
+            *_no_family(n),
+        )
+
+    @cached_property
+    def data_gather(self):
+        """Gather lists (bars, springs, spring mirrors) of the CSR data (targets: the slots)."""
+        n = self.nnz
+        return (
+            *_family(self.bar_slot, n),
+            *_family(self.spring_slot, n),
+            *_family(self.spring_slot_mirror, n),
+        )
+
     def reduced(self, free_mask: np.ndarray) -> ReducedPattern:
         """The free-DOF reduction for a boolean (ndof,) mask (cached per mask)."""
         free_mask = np.asarray(free_mask, bool).ravel()
@@ -367,12 +453,18 @@ class Assembler:
         self.k = structure.spring_k
         self.theta0 = structure.spring_rest
         self.n_dof = structure.n_dof
-        self._XT = np.ascontiguousarray(self.X.T)
-        self._b0 = self.bars[:, 0].copy()
-        self._b1 = self.bars[:, 1].copy()
-        self._D0 = self._XT[:, self._b1] - self._XT[:, self._b0]  # (3, nb)
-        self._sT = np.ascontiguousarray(self.springs.T)  # (4, ns)
+        self._X = np.ascontiguousarray(self.X, dtype=float)
+        self._b0 = np.ascontiguousarray(self.bars[:, 0], dtype=np.intp)
+        self._b1 = np.ascontiguousarray(self.bars[:, 1], dtype=np.intp)
+        XT = self._X.T
+        self._D0 = np.ascontiguousarray(XT[:, self._b1] - XT[:, self._b0])  # (3, nb)
+        self._sT = np.ascontiguousarray(self.springs.T, dtype=np.intp)  # (4, ns)
+        self._L0 = np.ascontiguousarray(self.L0, dtype=float)
+        self._EA = np.ascontiguousarray(self.EA, dtype=float)
+        self._k = np.ascontiguousarray(self.k, dtype=float)
+        self._k_nonneg = bool(np.all(self._k >= 0.0))
         self._arccos = structure.profile.arccos_dihedral and len(self.springs) > 0
+        self._work = None
 
     @cached_property
     def reduction(self) -> ReducedPattern:
@@ -385,12 +477,18 @@ class Assembler:
         return self.reduction.free
 
     # ------------------------------------------------------------------ evaluation
-    def element_response(self, U, spring_rest=None, *, tangent: bool = True):
-        """Element-level bar and spring responses ``(bar, spring)`` in the kernels' layouts
-        (see :func:`~holofold.mechanics.bars.bar_kernel` and
-        :func:`~holofold.mechanics.springs.spring_kernel`)."""
-        UT = np.asarray(U, float).reshape(-1, 3).T
-        if UT.shape[1] != self.X.shape[0]:
+    def _buffers(self):
+        """Element arrays reused by every evaluation of this assembler (not thread-safe: one
+        assembler per thread)."""
+        if self._work is None:
+            self._work = _element_buffers(len(self.bars), len(self.springs))
+        return self._work
+
+    def _kernels(self, U, spring_rest, tangent, buffers):
+        """Run the compiled bar and spring kernels into ``buffers`` (:func:`_element_buffers`)."""
+        _compiled = _ck()
+        U = np.ascontiguousarray(np.asarray(U, dtype=float).reshape(-1, 3))
+        if U.shape[0] != self.X.shape[0]:
             raise ValueError(f"U must have shape ({self.X.shape[0]}, 3), got {np.shape(U)}")
         if spring_rest is None:
             theta0 = self.theta0
@@ -401,36 +499,62 @@ class Assembler:
                     f"spring_rest must have shape {self.theta0.shape}, got {theta0.shape}"
                 )
         if self._arccos:  # the reference's arccos angle (compat.Profile.arccos_dihedral)
-            theta0 = theta0 + arccos_shift(self.X + UT.T, self.springs)
-        rb = bar_kernel(
-            self._D0, UT[:, self._b1] - UT[:, self._b0], self.L0, self.EA, tangent=tangent
+            theta0 = theta0 + arccos_shift(self.X + U, self.springs)
+        theta0 = np.ascontiguousarray(theta0, dtype=float)
+        eb, fb, Kb, es, fs, Ks, th = buffers
+        _compiled.bar_elements(
+            self._X, U, self._b0, self._b1, self._D0, self._L0, self._EA, tangent, eb, fb, Kb
         )
-        rs, _ = spring_kernel((self._XT + UT)[:, self._sT], self.k, theta0, tangent=tangent)
-        return rb, rs
+        _compiled.spring_elements(
+            self._X, U, self._sT, self._k, theta0, self._k_nonneg, tangent, es, fs, Ks, th
+        )
+        return buffers
+
+    def element_response(self, U, spring_rest=None, *, tangent: bool = True):
+        """Element-level bar and spring responses ``(bar, spring)`` in the kernels' layouts
+        (see :func:`~holofold.mechanics.bars.bar_kernel` and
+        :func:`~holofold.mechanics.springs.spring_kernel`); new arrays on every call."""
+        eb, fb, Kb, es, fs, Ks, _ = self._kernels(
+            U, spring_rest, tangent, _element_buffers(len(self.bars), len(self.springs))
+        )
+        return (
+            ElementResponse(eb, fb, Kb if tangent else None),
+            ElementResponse(es, fs, Ks if tangent else None),
+        )
 
     def _elements(self, U, spring_rest, tangent=True):
-        rb, rs = self.element_response(U, spring_rest, tangent=tangent)
-        pat = self.pattern
-        n = self.n_dof
-        energy = float(rb.energy.sum() + rs.energy.sum())
-        f = np.bincount(pat.bar_force_dofs, weights=rb.force.ravel(), minlength=n)
-        if rs.force.size:
-            f += np.bincount(pat.spring_force_dofs, weights=rs.force.ravel(), minlength=n)
-        return energy, f, rb, rs
+        buffers = self._kernels(U, spring_rest, tangent, self._buffers())
+        eb, fb, _, es, fs, _, _ = buffers
+        energy = float(eb.sum() + es.sum())
+        f = np.empty(self.n_dof)
+        g = self.pattern.force_gather
+        _ck().gather(
+            g[0], g[1], fb.reshape(-1), g[2], g[3], fs.reshape(-1), g[4], g[5], fs.reshape(-1),
+            _NO_DEST, f,
+        )  # fmt: skip
+        return energy, f, buffers
 
-    def _scatter(self, rb, rs):
-        """CSR data of the full tangent from the element tangents."""
-        pat = self.pattern
-        data = np.bincount(pat.bar_slot, weights=rb.tangent.ravel(), minlength=pat.nnz)
-        if rs.tangent.size:
-            w = rs.tangent.ravel()
-            data += np.bincount(pat.spring_slot, weights=w, minlength=pat.nnz)
-            data += np.bincount(pat.spring_slot_mirror, weights=w, minlength=pat.nnz + 1)[:-1]
-        return data
+    def _fill(self, buffers, gather, out, dest=_NO_DEST):
+        """Fill ``out`` from the element tangents in ``buffers`` by ``gather`` lists."""
+        kb = buffers[2].reshape(-1)
+        ks = buffers[5].reshape(-1)
+        _ck().gather(gather[0], gather[1], kb, gather[2], gather[3], ks, gather[4],
+                          gather[5], ks, dest, out)  # fmt: skip
+        return out
+
+    def _scatter(self, buffers):
+        """CSR data (nnz,) of the full tangent."""
+        return self._fill(buffers, self.pattern.data_gather, np.empty(self.pattern.nnz))
+
+    def _dense(self, buffers, red):
+        """The free-free tangent block, dense (nf, nf)."""
+        nf = red.n_free
+        K = self._fill(buffers, red.dense_gather, np.zeros(nf * nf), red.dense)
+        return K.reshape(nf, nf)
 
     def _data(self, U, spring_rest, tangent=True):
-        energy, f, rb, rs = self._elements(U, spring_rest, tangent)
-        return energy, f, (self._scatter(rb, rs) if tangent else None)
+        energy, f, buffers = self._elements(U, spring_rest, tangent)
+        return energy, f, (self._scatter(buffers) if tangent else None)
 
     def internal_force(self, U, spring_rest=None) -> tuple[float, np.ndarray]:
         """Energy (J) and internal force (ndof,) N, without the tangent."""
@@ -459,16 +583,15 @@ class Assembler:
         ``nf <= dense_max``), otherwise a csr matrix. Its rows/columns follow
         :attr:`free_dofs`.
         """
-        energy, f, data = self._data(U, spring_rest)
+        energy, f, rb = self._elements(U, spring_rest)
         red = self.reduction
         nf = red.free.size
         if dense is None:
             dense = nf <= self.dense_max
         if dense:
-            K = np.zeros(nf * nf)
-            K[red.dense] = data[red.keep]
-            K = K.reshape(nf, nf)
+            K = self._dense(rb, red)
         else:
+            data = self._scatter(rb)
             K = sp.csr_matrix((data[red.keep], red.indices, red.indptr), shape=(nf, nf))
         return AssembledSystem(energy, f, K)
 
@@ -484,16 +607,13 @@ class Assembler:
             ``K_ff^-1 rhs``; one factorisation serves every call. Raises
             :class:`SingularSystemError` if ``K_ff`` is singular or the solution is not finite.
         """
-        energy, f, rb, rs = self._elements(U, spring_rest)
+        energy, f, rb = self._elements(U, spring_rest)
         red = self.reduction
         nf = red.free.size
         if nf == 0:
             return energy, f, lambda rhs: np.zeros_like(rhs, dtype=float)
         if nf <= self.dense_max:
-            data = self._scatter(rb, rs)
-            K = np.zeros(nf * nf)
-            K[red.dense] = data[red.keep]
-            K = K.reshape(nf, nf)
+            K = self._dense(rb, red)
 
             def solve(rhs):
                 try:
@@ -505,25 +625,23 @@ class Assembler:
             return energy, f, solve
         perm, bw, _, _ = red.banded
         if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK:
-            # upper band filled straight from the element values (one bincount per family)
-            bar_ab, spring_ab, size = red.banded_slots
-            ab = np.bincount(bar_ab, weights=rb.tangent.ravel(), minlength=size + 1)
-            if rs.tangent.size:
-                ab += np.bincount(spring_ab, weights=rs.tangent.ravel(), minlength=size + 1)
-            try:
-                c = cholesky_banded(ab[:size].reshape(bw + 1, nf), lower=False, check_finite=False)
-            except LinAlgError:
-                c = None  # not positive definite: LU below
-            if c is not None:
+            # upper band filled straight from the element values, column-major as LAPACK
+            # stores it
+            ab = self._fill(rb, red.band_gather, np.empty(nf * (bw + 1)))
+            c, info = dpbtrf(ab.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
+            if info == 0:
 
                 def solve(rhs):
-                    y = cho_solve_banded((c, False), rhs[perm], check_finite=False)
+                    y, info = dpbtrs(c, rhs[perm], lower=0)
+                    if info != 0:  # pragma: no cover - only for invalid arguments
+                        raise SingularSystemError(f"banded solve failed (LAPACK info {info})")
                     x = np.empty_like(y)
                     x[perm] = y
                     return _finite(x)
 
                 return energy, f, solve
-        data = self._scatter(rb, rs)
+            # not positive definite: LU below
+        data = self._scatter(rb)
         order, perm_keep, perm_indptr, perm_indices = red.ordering
         # csc from the permuted CSR arrays is Kp^T; factorise it and solve with trans='T'
         KpT = sp.csc_matrix((data[perm_keep], perm_indices, perm_indptr), shape=(nf, nf))
@@ -546,6 +664,16 @@ class Assembler:
             return _finite(x)
 
         return energy, f, solve
+
+
+def _element_buffers(nb: int, ns: int):
+    """Empty element arrays in the kernels' layouts: bar energy (nb,), force (3, 2, nb),
+    tangent (3, 3, 2, 2, nb); spring energy (ns,), force (3, 4, ns), tangent (3, 3, 10, ns),
+    angle (ns,)."""
+    return (
+        np.empty(nb), np.empty((3, 2, nb)), np.empty((3, 3, 2, 2, nb)),
+        np.empty(ns), np.empty((3, 4, ns)), np.empty((3, 3, 10, ns)), np.empty(ns),
+    )  # fmt: skip
 
 
 def _finite(x):

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -125,6 +126,23 @@ class ThermalModel:
         s(self, "room_temp_nodes", np.unique(np.asarray(self.room_temp_nodes, np.intp)))
         if nt and (tri.min() < 0 or tri.max() >= self.n_nodes):
             raise ValueError(f"triangles reference nodes outside 0..{self.n_nodes - 1}")
+
+    # scatter maps of the mesh, built once per model (not per heating step)
+    @cached_property
+    def node_incidence(self) -> sp.csr_matrix:
+        """(nn, nt) csr: 1 where node v is a corner of triangle e; ``node_incidence @ g`` sums
+        per-triangle rows to the nodes in triangle order (as ``np.add.at`` would)."""
+        nt = len(self.triangles)
+        cols = np.repeat(np.arange(nt), 3)
+        ones = np.ones(3 * nt)
+        return sp.csr_matrix((ones, (self.triangles.ravel(), cols)), shape=(self.n_nodes, nt))
+
+    @cached_property
+    def dense_slots(self) -> np.ndarray:
+        """(9 nt,) int: flat position ``p n + q`` in a dense (nn, nn) matrix of every entry of
+        the element matrices (nt, 3, 3)."""
+        t = self.triangles
+        return (np.repeat(t, 3, axis=1) * self.n_nodes + np.tile(t, (1, 3))).ravel()
 
 
 def thermal_model(
@@ -262,10 +280,7 @@ def _air_links(model: ThermalModel, area, perim) -> np.ndarray:
 def _node_link_conductances(model: ThermalModel, x: np.ndarray, geometry=None) -> np.ndarray:
     """G_{v,q} = sum over triangles at v of g_e(q), (nn, L)."""
     _, area, perim = triangle_edges(model, x) if geometry is None else geometry
-    g = _air_links(model, area, perim)
-    out = np.zeros((model.n_nodes, model.env_layers))
-    np.add.at(out, model.triangles.ravel(), np.repeat(g, 3, axis=0))
-    return out
+    return model.node_incidence @ _air_links(model, area, perim)
 
 
 def chain_conductance(model: ThermalModel, x: np.ndarray, *, _geometry=None) -> np.ndarray:
@@ -311,8 +326,7 @@ def steady_temperature(
         geo = triangle_edges(model, x)
         G = chain_conductance(model, x, _geometry=geo)
         ke = _element_matrices(model, geo[0], geo[1])
-        idx = (np.repeat(model.triangles, 3, axis=1) * n + np.tile(model.triangles, (1, 3))).ravel()
-        A = np.bincount(idx, weights=ke.ravel(), minlength=n * n).reshape(n, n)
+        A = np.bincount(model.dense_slots, weights=ke.ravel(), minlength=n * n).reshape(n, n)
         A[np.diag_indices(n)] += G
         c = sla.cho_factor(A, lower=False, check_finite=False)
         return sla.cho_solve(c, q + G * RT, check_finite=False)

@@ -1,0 +1,281 @@
+"""Simulation time against its linear-algebra floor (issue 14): one table, every workload.
+
+For each workload the table gives the time per sample (min and median of ``--repeat`` runs,
+BLAS limited to one thread; CPU time of this thread, which a busy machine disturbs far less
+than the wall clock, and the wall-clock median) and its floor measured in the same run, in the
+same CPU time:
+
+    floor = sum over the Newton iterations of (cheapest factorisation + solve of the tangent)
+
+The tangents are the actual ones: every ``Assembler.evaluate_factorized`` call of one sample
+is counted and every ``--every``-th free-free tangent captured; each captured tangent is
+factorised and solved (one right-hand side) by every applicable LAPACK/SuperLU path called
+directly (dense Cholesky dpotrf/dpotrs, dense LU dgetrf/dgetrs, banded Cholesky dpbtrf/dpbtrs
+on the reverse Cuthill-McKee ordering, SuperLU with the cached minimum-degree ordering), the
+best of 5 timings each. A structure's floor per iteration is the mean over its captured
+tangents of the cheapest path, so a sample's floor is sum(iterations x that cost). ``solver``
+names the path the assembler takes; the gripper row also gives the floor with the solver it
+uses. The database row runs ``evaluate_designs`` on the 3000 published arch rows (data3) on 2
+worker processes and prints the floor beside it (per-row floors of 60 rows spread over the
+file, scaled to 3000 rows and divided by the 2 cores).
+
+    python benchmarks/bench_floor.py [--repeat 7] [--no-db] [--only arch]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.linalg import lapack
+from threadpoolctl import threadpool_limits
+
+import holofold.mechanics.assembly as assembly
+from holofold.design.scenarios import arch, canopy, gripper, single_miura
+
+ROOT = Path(__file__).resolve().parents[1]
+REF = Path(os.environ.get("HOLOFOLD_REFERENCE_DATA", ROOT.parent / "shared" / "reference-data"))
+MID = dict(tcrease=0.75e-3, tpanel=3.5e-3, W=2.5e-3)
+ARCH = dict(MID, offset=0.2, stripeWidth=0.025, extrude=0.15)
+GRIP = ["Pattern", "L1", "L2", "t1", "t2", "tpanel", "rate", "W"]
+#: issue 14 targets: time / floor
+TARGET = {
+    "arch m=24": 3.0,
+    "arch m=8": 3.0,
+    "single Miura": 3.0,
+    "gripper two-panel": 3.0,
+    "canopy Miura 36x12": 1.5,
+}
+
+
+def _published(stem: str, i: int, names) -> dict:
+    arr = np.loadtxt(REF / f"{stem}.txt", delimiter=",", ndmin=2)
+    return dict(zip(names, map(float, arr[i, : len(names)]), strict=True))
+
+
+def workloads():
+    out = {
+        "arch m=24": lambda: arch.evaluate(dict(ARCH, m=24)),
+        "arch m=8": lambda: arch.evaluate(dict(ARCH, m=8)),
+        "single Miura": lambda: single_miura.evaluate(dict(MID, gama=1.1)),
+        "canopy Miura 36x12": lambda: canopy.evaluate(
+            dict(MID, pattern=1, m=36, n=12, creaseE=2e9, panelE=2e9)
+        ),
+    }
+    if (REF / "data2_TwoPanel_sample.txt").exists():
+        row = _published("data2_TwoPanel_sample", 1, GRIP)
+        out["gripper two-panel"] = lambda: gripper.evaluate(row)
+    return out
+
+
+# ------------------------------------------------------------------------- capture
+class Capture:
+    """Counts ``evaluate_factorized`` calls per structure and keeps some free-free tangents."""
+
+    def __init__(self, every: int):
+        self.every = every
+        self.calls: dict = defaultdict(int)
+        self.K: dict = defaultdict(list)
+        self.red: dict = {}
+
+    def __enter__(self):
+        orig = self.orig = assembly.Assembler.evaluate_factorized
+        cap = self
+
+        def spy(asm, U, spring_rest=None):
+            key = (id(asm.reduction), asm.reduction.n_free)
+            n = cap.calls[key]
+            cap.calls[key] += 1
+            if n % cap.every == 0 and len(cap.K[key]) < 12:
+                _, _, K = asm.evaluate_reduced(U, spring_rest, dense=False)
+                cap.K[key].append(sp.csr_matrix(K))
+                cap.red[key] = asm.reduction
+            return orig(asm, U, spring_rest)
+
+        assembly.Assembler.evaluate_factorized = spy
+        return self
+
+    def __exit__(self, *exc):
+        assembly.Assembler.evaluate_factorized = self.orig
+
+
+clock = time.thread_time
+
+
+def _best(fn, n: int = 5) -> float:
+    """Best CPU time of ``n`` calls of ``fn`` (each timed over enough repetitions to be
+    longer than 0.2 ms)."""
+    reps = 1
+    t = clock()
+    fn()
+    one = clock() - t
+    if one < 2e-4:
+        reps = int(2e-4 / max(one, 1e-7)) + 1
+    ts = []
+    for _ in range(n):
+        t = clock()
+        for _ in range(reps):
+            fn()
+        ts.append((clock() - t) / reps)
+    return min(ts)
+
+
+def path_costs(K: sp.csr_matrix, red) -> dict:
+    """Seconds for factorisation + one solve of ``K`` by every applicable path."""
+    nf = K.shape[0]
+    b = np.ones(nf)
+    out = {}
+    if nf <= 1500:
+        A = np.asfortranarray(K.toarray())
+
+        def chol():
+            c, info = lapack.dpotrf(A, lower=0, clean=0, overwrite_a=0)
+            if info:
+                raise np.linalg.LinAlgError
+            lapack.dpotrs(c, b, lower=0)
+
+        def lu():
+            lu_, piv, _ = lapack.dgetrf(A, overwrite_a=0)
+            lapack.dgetrs(lu_, piv, b)
+
+        try:
+            chol()
+            out["dense Cholesky"] = _best(chol)
+        except np.linalg.LinAlgError:
+            pass
+        out["dense LU"] = _best(lu)
+    perm, bw, _, _ = red.banded
+    if nf * (bw + 1) ** 2 <= 2e10:
+        Kp = K[perm][:, perm].tocoo()
+        up = Kp.row <= Kp.col
+        ab = np.zeros((bw + 1, nf), order="F")
+        ab[bw + Kp.row[up] - Kp.col[up], Kp.col[up]] = Kp.data[up]
+
+        def band():
+            c, info = lapack.dpbtrf(ab, lower=0, overwrite_ab=0)
+            if info:
+                raise np.linalg.LinAlgError
+            lapack.dpbtrs(c, b, lower=0)
+
+        try:
+            band()
+            out["banded Cholesky"] = _best(band)
+        except np.linalg.LinAlgError:
+            pass
+    order = red.ordering[0]
+    Ko = sp.csc_matrix(K[order][:, order])
+
+    def slu():
+        lu_ = spla.splu(Ko, permc_spec="NATURAL", diag_pivot_thresh=0.01, relax=3,
+                        panel_size=10, options={"SymmetricMode": True})  # fmt: skip
+        lu_.solve(b)
+
+    out["SuperLU"] = _best(slu)
+    return out
+
+
+def solver_path(red) -> str:
+    nf = red.n_free
+    if nf <= assembly.DENSE_MAX_DOF:
+        return "dense LU"
+    _, bw, _, _ = red.banded
+    return "banded Cholesky" if nf * (bw + 1) ** 2 <= assembly.BANDED_MAX_WORK else "SuperLU"
+
+
+def floor_of(fn, every: int = 4):
+    """(iterations, floor s, floor s with the assembler's own path, paths used) of one call."""
+    with Capture(every) as cap:
+        fn()
+    iters = total = used_total = 0.0
+    used = set()
+    for key, n in cap.calls.items():
+        costs = [path_costs(K, cap.red[key]) for K in cap.K[key]]
+        best = statistics.mean(min(c.values()) for c in costs)
+        path = solver_path(cap.red[key])
+        used.add(path)
+        mine = statistics.mean(c.get(path, min(c.values())) for c in costs)
+        iters += n
+        total += n * best
+        used_total += n * mine
+    return int(iters), total, used_total, used
+
+
+def timed(fn, repeat: int) -> tuple[float, float, float]:
+    """(min CPU, median CPU, median wall) seconds of ``repeat`` calls after a warm-up."""
+    fn()  # warm-up: topology, sparse pattern and compiled-kernel caches
+    cpu, wall = [], []
+    for _ in range(repeat):
+        t, w = clock(), time.perf_counter()
+        fn()
+        cpu.append(clock() - t)
+        wall.append(time.perf_counter() - w)
+    return min(cpu), statistics.median(cpu), statistics.median(wall)
+
+
+def database(floor_rows: int = 60):
+    import pandas as pd
+
+    from holofold.design.runner import evaluate_designs
+
+    cols = open(REF / "data3_FeatureName.txt").read().split()
+    df = pd.DataFrame(np.loadtxt(REF / "data3_ShapeFit.txt", delimiter=","), columns=cols)
+    feats = [c.name for c in arch.SCENARIO.features]
+    table = df[feats]
+    t = time.perf_counter()
+    res = evaluate_designs("arch", table, workers=2, progress=False)
+    wall = time.perf_counter() - t
+    idx = np.linspace(0, len(table) - 1, floor_rows).astype(int)
+    floors = [floor_of(lambda r=r: arch.evaluate(r))[1] for r in table.iloc[idx].to_dict("records")]
+    floor = statistics.mean(floors) * len(table) / 2
+    ok = (res["status"] == "converged").mean()
+    return wall, floor, len(table), ok
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description="time per sample against its floor (issue 14)")
+    ap.add_argument("--repeat", type=int, default=7, help="timed runs per workload")
+    ap.add_argument("--no-db", action="store_true", help="skip the 3000-row arch database")
+    ap.add_argument("--only", default="", help="only workloads whose name contains this")
+    args = ap.parse_args(argv)
+    print(f"per sample, BLAS 1 thread, CPU time min / median of {args.repeat} runs (and wall")
+    print("median); floor = iterations x (cheapest factorisation + solve of the actual tangents),")
+    print("CPU time, measured in this run")
+    head = (
+        f"{'workload':<20} {'iters':>6} {'min ms':>9} {'median ms':>10} {'wall ms':>9} "
+        f"{'floor ms':>9} {'min/floor':>10} {'target':>7}  solver (floor with it)"
+    )
+    print(head)
+    print("-" * len(head))
+    with threadpool_limits(1):
+        for name, fn in workloads().items():
+            if args.only not in name:
+                continue
+            tmin, tmed, wall = timed(fn, args.repeat)
+            iters, floor, used_floor, used = floor_of(fn)
+            paths = ", ".join(sorted(used))
+            extra = f" ({1e3 * used_floor:.2f} ms)" if "gripper" in name else ""
+            print(
+                f"{name:<20} {iters:>6d} {1e3 * tmin:>9.2f} {1e3 * tmed:>10.2f} {1e3 * wall:>9.2f} "
+                f"{1e3 * floor:>9.2f} {tmin / floor:>10.1f} {TARGET.get(name, ''):>7}  "
+                f"{paths}{extra}",
+                flush=True,
+            )
+    if not args.no_db and not args.only:
+        wall, floor, n, ok = database()
+        print(
+            f"{'arch database':<20} {n:>6d} rows, 2 workers: {wall:.1f} s; floor {floor:.1f} s "
+            f"(ratio {wall / floor:.1f}; target <= 20 s); {100 * ok:.1f} % converged"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
