@@ -7,9 +7,11 @@ Origami-Simulator-coloured crease pattern in mm; the x-z plan view of centre and
 where no development exists), ``strip.stl`` and ``strip.obj`` (the 3-D strip surface),
 ``strip_solid.stl`` (the folded panel prisms with hinge gaps, loose bodies) when a panel
 thickness and crease width are given, ``printable.stl`` (the flat part to print: panels joined by
-hinge strips, :func:`~holofold.geometry.printable.printable_solid`) when a crease thickness is
-given too, and ``candidates.csv`` (the candidates of an automatic fit) when given. Meshes are in
-``units`` (default mm, what slicers and CAD read), FOLD in m, SVG in mm.
+hinge strips, :func:`~holofold.geometry.printable.printable_solid`) and
+``printable_folded.stl`` (that part folded, hinges bent; left out with a warning where it cannot
+be built) when a crease thickness is given too, and ``candidates.csv`` (the candidates of an
+automatic fit) when given. Meshes are in ``units`` (default mm, what slicers and CAD read), FOLD
+in m, SVG in mm.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.export import export
 from holofold.geometry.mesh import MESH_UNITS
 from holofold.geometry.outputs import atomic_write, write_text
-from holofold.geometry.printable import printable_solid
+from holofold.geometry.printable import folded_printable, printable_solid
 from holofold.geometry.solid import thick_solid
 from holofold.geometry.svg import polylines_svg
 from holofold.geometry.units import length_factor
@@ -50,7 +52,7 @@ def export_strip_files(
     """
     length_factor(units)
     thick = (panel_thickness, crease_width)
-    solid = part = None
+    solid = part = bent = None
     if crease_thickness is not None and any(v is None for v in thick):
         raise ParameterError(
             "a printable part needs a panel thickness and a crease width besides the crease "
@@ -70,6 +72,7 @@ def export_strip_files(
                 "this strip has no flat layout (its development overlaps): no printable part"
             )
         part = printable_solid(flat, t, tc, w)
+        bent = folded_printable(fit.pattern, t, tc, w)
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     fold_kw = {} if solid is None else {"panel_thickness": t, "crease_width": w}
@@ -88,6 +91,8 @@ def export_strip_files(
         written.append(export(solid, out / "strip_solid.stl", units=units))
     if part is not None:
         written.append(export(part, out / "printable.stl", units=units))
+    if bent is not None:
+        written.append(export(bent, out / "printable_folded.stl", units=units))
     if candidates is not None:
         path = out / "candidates.csv"
         written.append(atomic_write(path, lambda tmp: candidates.to_csv(tmp, index=False)))

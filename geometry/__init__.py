@@ -33,7 +33,12 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "miura": ["miura_cell", "miura_sheet", "miura_sheet_paper", "miura_nodes", "miura_faces"],
         "outputs": ["check_output_path", "atomic_write", "write_text", "write_json"],
         "pattern": ["CreasePattern", "ASSIGNMENTS"],
-        "printable": ["PrintableLayout", "printable_layout", "printable_solid"],
+        "printable": [
+            "PrintableLayout",
+            "printable_layout",
+            "printable_solid",
+            "folded_printable_solid",
+        ],
         "solid": ["thick_solid", "panel_solids", "shrunk_panels", "SolidWarning"],
         "svg": ["export_svg", "load_svg", "polylines_svg"],
         "tmp": ["tmp_sheet", "tmp_nodes", "tmp_faces"],

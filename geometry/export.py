@@ -84,15 +84,18 @@ def export_pattern_files(
     and, with ``thickness`` (m), ``thick.stl`` (the folded panels of that thickness with hinge
     gaps ``crease_width``, m, as loose bodies) and, with ``crease_thickness`` too (m),
     ``printable.stl``: the flat part to print, panels joined by hinge strips of that thickness
-    and width ``crease_width`` (:func:`~holofold.geometry.printable.printable_solid`). Meshes in
-    ``units`` (default mm). Everything is built, and can fail, before the first file is written.
+    and width ``crease_width`` (:func:`~holofold.geometry.printable.printable_solid`), and
+    ``printable_folded.stl``, the same part folded with its hinges bent
+    (:func:`~holofold.geometry.printable.folded_printable_solid`; left out, with a warning,
+    where the hinges are thicker than the panels). Meshes in ``units`` (default mm).
+    Everything is built, and can fail, before the first file is written.
     """
-    from holofold.geometry.printable import printable_solid
+    from holofold.geometry.printable import folded_printable, printable_solid
     from holofold.geometry.units import length_factor
 
     length_factor(units)
     W = check_range("crease_width", crease_width, 0.0, None)
-    solid = part = None
+    solid = part = bent = None
     if crease_thickness is not None:
         if thickness is None or W <= 0:
             raise ParameterError(
@@ -106,6 +109,7 @@ def export_pattern_files(
         solid = thick_solid(pattern, t, W)
         if crease_thickness is not None:
             part = printable_solid(pattern, t, tc, W)
+            bent = folded_printable(pattern, t, tc, W)
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     written = [
@@ -118,4 +122,6 @@ def export_pattern_files(
         written.append(export(solid, out / "thick.stl", units=units))
     if part is not None:
         written.append(export(part, out / "printable.stl", units=units))
+    if bent is not None:
+        written.append(export(bent, out / "printable_folded.stl", units=units))
     return written

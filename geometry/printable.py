@@ -20,6 +20,22 @@ Panels are ``panel_thickness`` thick, hinges and patches ``crease_thickness``; w
 ``"middle"`` they are centred on z = 0 (the mid-surface of the mechanics model). The prisms are
 unioned with manifold3d in double precision; the result has the volume
 ``panel_area * panel_thickness + hinge_area * crease_thickness`` (:class:`PrintableLayout`).
+
+:func:`folded_printable_solid` is the same part in the folded state (``pattern.coords``): the
+thick panels of :func:`~holofold.geometry.solid.thick_solid` (pulled back by W/2 in 3-D, centred
+on the mid-surface) and, across every fold line, the hinge bent: a strip of thickness t_c whose
+mid-surface is the quadratic Bezier from one panel's edge over the crease line to the other's
+(tangent to both panels; its length is W for a flat crease and, for a fold angle theta, about W
+(theta/2) cot(theta/2) of the circular arc: 0.79 W at 90 degrees), swept along the crease and
+run a quarter of W into both panels (along their sides, so the run-in stays inside them) so that
+the union is one body; the strips are the model's quadrilaterals, not clipped at inward corners
+of the outline. It is built from convex slabs (manifold3d hulls) and a union, which is robust;
+what it cannot give: a part without overlaps when the thick panels of the folded state run into
+each other (:func:`~holofold.geometry.clearance.printability` says by how much; the union then
+fuses them and a :class:`~holofold.geometry.solid.SolidWarning` says so), the vertex patches
+(the bent strips meet at a vertex in a saddle that no simple solid fills: the vertices stay
+open, as in the compliant-crease model), and the exact shape of a warped panel's hinge (the
+strip spans the warped prisms' edges, sunk into them).
 """
 
 from __future__ import annotations
@@ -38,7 +54,14 @@ from holofold.geometry.errors import (
 from holofold.geometry.pattern import CreasePattern
 from holofold.geometry.solid import corner_edges, offset_corners
 
-__all__ = ["PrintableLayout", "printable_layout", "printable_solid", "HINGE_ASSIGNMENTS"]
+__all__ = [
+    "PrintableLayout",
+    "printable_layout",
+    "printable_solid",
+    "folded_printable_solid",
+    "folded_printable",
+    "HINGE_ASSIGNMENTS",
+]
 
 #: assignments that fold through a compliant hinge
 HINGE_ASSIGNMENTS = ("M", "V", "F", "U")
@@ -259,3 +282,162 @@ def printable_solid(
     out.metadata["layout"] = lay
     out.metadata["name"] = "printable part (flat)"
     return out
+
+
+def folded_printable_solid(
+    pattern: CreasePattern,
+    panel_thickness: float,
+    crease_thickness: float,
+    crease_width,
+    *,
+    segments: int = 6,
+) -> trimesh.Trimesh:
+    """The printable part in the folded state, hinges bent (see the module docstring), metres.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Folded state in ``coords``.
+    panel_thickness, crease_thickness : float
+        t_p and t_c, m (t_c <= t_p: the hinges run inside the panels).
+    crease_width : float or (ne,) float
+        W, m (> 0 on fold lines).
+    segments : int
+        Slabs per bent hinge (>= 1).
+    """
+    import warnings
+
+    import manifold3d as m3d
+
+    from holofold.geometry.pattern import orient_faces
+    from holofold.geometry.solid import SolidWarning
+
+    tp = check_range("panel_thickness", panel_thickness, 0.0, None, low_open=True)
+    tc = check_range("crease_thickness", crease_thickness, 0.0, tp, low_open=True)
+    n_seg = int(check_range("segments", segments, 1, 64))
+    ne = pattern.n_edges
+    W = np.broadcast_to(np.asarray(crease_width, float), (ne,)).copy()
+    hinge = pattern.interior & np.isin(pattern.assignment, HINGE_ASSIGNMENTS)
+    if hinge.any():
+        check_range("crease_width", float(W[hinge].min()), 0.0, None, low_open=True)
+    faces = orient_faces(pattern.faces)
+    side = corner_edges(pattern, faces)
+    half = np.where(pattern.interior, W / 2, 0.0)
+    S = offset_corners(pattern.coords, faces, half[side])  # (N, 3) pulled back in 3-D
+    sizes = np.array([len(f) for f in faces])
+    fv = np.concatenate(faces)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    nxt = np.arange(len(fv)) + 1
+    nxt[starts + sizes - 1] = starts
+    normals = np.stack([_unit_normal(S[a : a + k]) for a, k in zip(starts, sizes, strict=True)])
+    owner = np.repeat(np.arange(len(faces)), sizes)
+    prev = np.empty_like(nxt)
+    prev[nxt] = np.arange(len(fv))
+
+    parts = []
+    for f, (a, k) in enumerate(zip(starts, sizes, strict=True)):  # the thick panels
+        c = S[a : a + k]
+        h = normals[f] * tp / 2
+        parts.append(m3d.Manifold.hull_points(np.vstack([c + h, c - h])))
+    # the two corner sides of every hinge edge (faces consistently oriented: opposite ways)
+    order = np.argsort(side, kind="stable")
+    srt = side[order]
+    head = np.concatenate([[True], srt[1:] != srt[:-1]])
+    first = np.full(ne, -1)
+    second = np.full(ne, -1)
+    first[srt[head]] = order[head]
+    second[srt[~head]] = order[~head]
+    X = pattern.coords
+    knots = np.concatenate([[-1.0], np.linspace(0.0, 1.0, n_seg + 1), [2.0]])
+    lo = np.concatenate([knots[:-1] - 0.1 / n_seg])  # each slab overlaps its neighbours
+    hi = np.concatenate([knots[1:] + 0.1 / n_seg])
+    lo[0], hi[-1] = -1.0, 2.0
+    for e in np.flatnonzero(hinge):
+        i1, i2 = first[e], second[e]
+        va, vb = fv[i1], fv[nxt[i1]]
+        d = X[vb] - X[va]
+        d = d / np.linalg.norm(d)
+        n1, n2 = normals[owner[i1]], normals[owner[i2]]
+        curves = []
+        # each end: panel 1's corner, panel 2's corner, and for each the direction of its
+        # other side (into the panel along its boundary: the run-in stays inside the panel)
+        for v, c1, o1, c2, o2 in (
+            (va, i1, prev[i1], nxt[i2], nxt[nxt[i2]]),
+            (vb, nxt[i1], nxt[nxt[i1]], i2, prev[i2]),
+        ):
+            p1, p2 = S[c1], S[c2]
+            ctrl = X[v] + d * ((0.5 * (p1 + p2) - X[v]) @ d)  # on the crease: tangents meet
+            g1 = (S[o1] - p1) / np.linalg.norm(S[o1] - p1)
+            g2 = (S[o2] - p2) / np.linalg.norm(S[o2] - p2)
+            curves.append((p1, ctrl, p2, g1, g2))
+
+        def point(u, c, w=W[e]):
+            """Mid-surface point at u: into panel 1 (u < 0), the bend (0..1), panel 2 (u > 1)."""
+            p1, ctrl, p2, g1, g2 = c
+            u = np.asarray(u, float)[:, None]
+            t = np.clip(u, 0.0, 1.0)
+            bend = (1 - t) ** 2 * p1 + 2 * t * (1 - t) * ctrl + t**2 * p2
+            return (
+                bend
+                + np.where(u < 0, -u, 0.0) * 0.25 * w * g1
+                + np.where(u > 1, u - 1, 0.0) * 0.25 * w * g2
+            )
+
+        for u0, u1 in zip(lo, hi, strict=True):
+            u = np.array([u0, u1])
+            w_ = np.clip(u, 0.0, 1.0)[:, None]
+            nrm = (1 - w_) * n1 + w_ * n2
+            h = nrm / np.linalg.norm(nrm, axis=1, keepdims=True) * tc / 2
+            A, B = point(u, curves[0]), point(u, curves[1])
+            parts.append(m3d.Manifold.hull_points(np.vstack([A + h, A - h, B + h, B - h])))
+    total_panels = sum(p.volume() for p in parts[: len(faces)])
+    panels = m3d.Manifold.batch_boolean(parts[: len(faces)], m3d.OpType.Add)
+    lost = 1.0 - panels.volume() / total_panels
+    if lost > 1e-6:
+        warnings.warn(
+            f"thick panels intersect in this folded state ({100 * lost:.3g} % of their volume "
+            "overlaps): the folded part fuses them",
+            SolidWarning,
+            stacklevel=2,
+        )
+    whole = m3d.Manifold.batch_boolean([panels, *parts[len(faces) :]], m3d.OpType.Add)
+    mesh = whole.to_mesh64()
+    out = trimesh.Trimesh(
+        vertices=np.asarray(mesh.vert_properties)[:, :3],
+        faces=np.asarray(mesh.tri_verts).astype(np.int64),
+        process=False,
+    )
+    bodies = len(whole.decompose())
+    if bodies != 1 or not out.is_watertight:
+        raise DegenerateGeometryError(
+            f"the folded printable part of this pattern has {bodies} separate bodies "
+            f"(watertight: {out.is_watertight}); every panel must be joined through fold lines"
+        )
+    out.metadata["name"] = "printable part (folded)"
+    return out
+
+
+def _unit_normal(corners: np.ndarray) -> np.ndarray:
+    from holofold.geometry.pattern import newell_normals
+
+    n = newell_normals(corners, [np.arange(len(corners))])[0]
+    return n / np.linalg.norm(n)
+
+
+def folded_printable(pattern, panel_thickness, crease_thickness, crease_width):
+    """:func:`folded_printable_solid`, or None with a warning where it cannot be built (hinges
+    thicker than the panels, or no single body): for writers of optional files."""
+    import warnings
+
+    if crease_thickness > panel_thickness:
+        warnings.warn(
+            "no folded printable part: the hinges are thicker than the panels",
+            UserWarning,
+            stacklevel=2,
+        )
+        return None
+    try:
+        return folded_printable_solid(pattern, panel_thickness, crease_thickness, crease_width)
+    except DegenerateGeometryError as exc:
+        warnings.warn(f"no folded printable part: {exc}", UserWarning, stacklevel=2)
+        return None

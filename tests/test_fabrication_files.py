@@ -56,7 +56,7 @@ def test_strip_files_in_metres_with_the_printable_part(tmp_path):
         fit, tmp_path / "s", panel_thickness=2e-3, crease_width=3e-3, crease_thickness=0.8e-3,
         units="m",
     )  # fmt: skip
-    assert [p.name for p in written][-1] == "printable.stl"
+    assert [p.name for p in written][-2:] == ["printable.stl", "printable_folded.stl"]
     mesh = trimesh.load(tmp_path / "s" / "strip.stl")
     np.testing.assert_allclose(mesh.bounds[:, [0, 2]], [[0.0, 0.0], [4.0, 2.0]], atol=0.25)
     part = trimesh.load(tmp_path / "s" / "printable.stl")
@@ -76,7 +76,11 @@ def test_pattern_files_with_the_printable_part_in_mm(tmp_path):
     written = export_pattern_files(
         sheet, tmp_path / "p", thickness=2e-3, crease_width=2e-3, crease_thickness=0.6e-3
     )
-    assert [p.name for p in written][-2:] == ["thick.stl", "printable.stl"]
+    assert [p.name for p in written][-3:] == [
+        "thick.stl", "printable.stl", "printable_folded.stl"
+    ]  # fmt: skip
+    bent = trimesh.load(tmp_path / "p" / "printable_folded.stl")
+    assert bent.is_watertight and bent.body_count == 1
     part = trimesh.load(tmp_path / "p" / "printable.stl")
     assert part.is_watertight and part.body_count == 1
     # the flat sheet: 2 x 4 parallelograms of 20 mm x 20 mm sin 60 ... in mm, 2 mm thick

@@ -12,6 +12,7 @@ from holofold.geometry import (
     DegenerateGeometryError,
     InvalidPatternError,
     ParameterError,
+    folded_printable_solid,
     miura_sheet,
     printable_layout,
     printable_solid,
@@ -148,3 +149,34 @@ def test_bad_input_is_one_clear_error():
     loose = CreasePattern(two.coords, two.faces, two.edges, asg, two.fold_angle, flat=two.flat)
     with pytest.raises(DegenerateGeometryError, match="4 separate bodies"):
         printable_solid(loose, TP, TC, W)
+
+
+def test_folded_part_at_ext_1_is_the_flat_part_without_vertex_patches():
+    flat = miura_sheet(3, 3, a=0.02, b=0.02, gamma=math.radians(60), ext=1.0)
+    bent = folded_printable_solid(flat, TP, TC, W)
+    lay = printable_layout(flat, W)
+    # the folded part keeps the model's quadrilateral strips (not clipped at inward corners)
+    strips = sum(_area(h[1:] if len(h) == 5 else h) for h in lay.hinges)
+    assert bent.body_count == 1 and bent.is_watertight
+    # to a sliver: where a run-in slab meets its panel's corner it cuts across by ~W^2 / 100
+    assert bent.volume == pytest.approx(lay.panel_area * TP + strips * TC, rel=1e-5)
+
+
+def test_folded_part_with_bent_hinges_is_one_body():
+    p = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
+    bent = folded_printable_solid(p, 0.5e-3, 0.3e-3, W)
+    assert bent.body_count == 1 and bent.is_watertight
+    panels = sum(_area3(c) for c in shrunk_panels(p, W)) * 0.5e-3
+    folds = p.interior
+    hinge_max = float((p.edge_lengths[folds] * W).sum()) * 0.3e-3
+    # the panels, plus bent hinges shorter than W (0.79 W at 90 degrees) and vertices left open
+    assert panels < bent.volume < panels + hinge_max
+    assert bent.volume - panels > 0.6 * hinge_max
+    with pytest.raises(ParameterError, match="crease_thickness"):
+        folded_printable_solid(p, 0.5e-3, 1e-3, W)  # hinges thicker than the panels
+    arch = fit_strip("half-circle", 8, 0.2, 0.02, 0.1).pattern  # warped quads, deep folds
+    assert folded_printable_solid(arch, 3e-3, 0.6e-3, 6e-3).body_count == 1
+
+
+def _area3(c):
+    return 0.5 * np.linalg.norm(np.cross(c, np.roll(c, -1, axis=0)).sum(axis=0))

@@ -119,6 +119,9 @@ def test_slicer_prints_the_fitted_arch_and_a_miura_sheet(slicer, tmp_path):
     height = np.ptp(trimesh.load(names["thick.stl"]).bounds[:, 2])  # mm: the file's unit
     assert 15 < height < 20 and abs(folded_layers - height / 0.2) <= 1 and folded_minutes
     print(f"Miura thick.stl (folded): {folded_layers} layers, {folded_minutes}")
+    bent_layers, bent_minutes, _ = _slice(slicer, names["printable_folded.stl"])
+    assert abs(bent_layers - folded_layers) <= 3 and bent_minutes  # the bends stand out < 0.6 mm
+    print(f"Miura printable_folded.stl: {bent_layers} layers, {bent_minutes}")
 
 
 def test_slicer_reads_the_strip_files_in_millimetres(slicer, tmp_path):
