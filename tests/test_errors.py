@@ -23,3 +23,17 @@ def test_check_range_names_argument_and_range(value, kw, fragment):
         check_range("ext", value, **kw)
     assert fragment in str(exc.value)
     assert isinstance(exc.value, ValueError)
+
+
+def test_atomically_written_files_get_normal_permissions(tmp_path):
+    import os
+
+    from holofold.geometry import write_text
+
+    old = os.umask(0o022)
+    try:
+        p = write_text(tmp_path / "a.txt", "x")
+    finally:
+        os.umask(old)
+    assert p.stat().st_mode & 0o777 == 0o644  # not mkstemp's 0600
+    assert not list(tmp_path.glob(".holofold-*"))
