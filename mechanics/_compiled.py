@@ -129,6 +129,7 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
     m = np.empty(3)
     n = np.empty(3)
     g = np.empty((4, 3))  # [node, component]
+    gk = np.empty((4, 3))
     a1 = np.empty(3)
     a2 = np.empty(3)
     b1 = np.empty(3)
@@ -187,15 +188,23 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
             continue
         # k g g' over the ten distinct blocks (0 ii, 1 ij, 2 ik, 3 ll, 4 lj, 5 lk, 6 jj, 7 jk,
         # 8 kk, 9 il)
-        sk = math.sqrt(kk) if k_nonneg else 0.0
-        for t in range(10):
-            ga = _GG_A[t]
-            gb = _GG_B[t]
-            for i in range(3):
-                for j in range(3):
-                    if k_nonneg:
-                        K[i, j, t, s] = (sk * g[ga, i]) * (sk * g[gb, j])
-                    else:
+        if k_nonneg:  # sqrt(k) g_a sqrt(k) g_b' keeps the diagonal blocks exactly symmetric
+            sk = math.sqrt(kk)
+            for a in range(4):
+                for c in range(3):
+                    gk[a, c] = sk * g[a, c]
+            for t in range(10):
+                ga = _GG_A[t]
+                gb = _GG_B[t]
+                for i in range(3):
+                    for j in range(3):
+                        K[i, j, t, s] = gk[ga, i] * gk[gb, j]
+        else:
+            for t in range(10):
+                ga = _GG_A[t]
+                gb = _GG_B[t]
+                for i in range(3):
+                    for j in range(3):
                         K[i, j, t, s] = kk * (g[ga, i] * g[gb, j])
         # Hessian (Liu & Paulino 2017) times M, in the numpy path's order of operations
         inv = 1.0 / dl2
@@ -257,14 +266,12 @@ _TD2 = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, -2.0, 
 
 @njit(**_OPTS)
 def gather(ptr_a, src_a, val_a, ptr_b, src_b, val_b, ptr_c, src_c, val_c, dest, out):
-    """``out[dest[p]] = (A_p + B_p) + C_p`` for every target p, where ``A_p`` is the sum of
-    ``val_a[src_a[ptr_a[p]:ptr_a[p + 1]]]`` from 0.0 in that order (likewise B, C); ``dest``
-    empty: ``out[p]``. With each family's sources listed in the order ``np.bincount`` meets
-    them, this is ``bincount(a) + bincount(b) + bincount(c)`` bit for bit, without the
-    scratch arrays and only for the targets asked for."""
-    n = ptr_a.shape[0] - 1
-    ident = dest.shape[0] == 0
-    for p in range(n):
+    """``out[dest[p]] = (A_p + B_p) + C_p`` for every listed target p, where ``A_p`` is the
+    sum of ``val_a[src_a[ptr_a[p]:ptr_a[p + 1]]]`` from 0.0 in that order (likewise B, C).
+    With each family's sources listed in the order ``np.bincount`` meets them, this is
+    ``bincount(a) + bincount(b) + bincount(c)`` bit for bit, without scratch arrays and only
+    for the targets that receive something (``out`` starts as zeros)."""
+    for p in range(dest.shape[0]):
         sa = 0.0
         for q in range(ptr_a[p], ptr_a[p + 1]):
             sa += val_a[src_a[q]]
@@ -274,8 +281,4 @@ def gather(ptr_a, src_a, val_a, ptr_b, src_b, val_b, ptr_c, src_c, val_c, dest, 
         sc = 0.0
         for q in range(ptr_c[p], ptr_c[p + 1]):
             sc += val_c[src_c[q]]
-        v = (sa + sb) + sc
-        if ident:
-            out[p] = v
-        else:
-            out[dest[p]] = v
+        out[dest[p]] = (sa + sb) + sc

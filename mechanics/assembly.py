@@ -91,11 +91,21 @@ def _family(pos: np.ndarray, n: int):
     return ptr, np.ascontiguousarray(keep[order], dtype=np.intp)
 
 
-def _no_family(n: int):
-    return np.zeros(n + 1, np.intp), np.zeros(0, np.intp)
-
-
-_NO_DEST = np.zeros(0, np.intp)
+def _gather_lists(families, n: int, dest=None):
+    """The arguments of :func:`holofold.mechanics._compiled.gather` for up to three families
+    ``(pos, n)`` -> targets ``0..n-1`` written to ``out[dest[t]]`` (default ``out[t]``): only
+    the targets that receive something are listed (``out`` must start as zeros)."""
+    lists = [_family(pos, n) for pos in families]
+    while len(lists) < 3:
+        lists.append((np.zeros(n + 1, np.intp), np.zeros(0, np.intp)))
+    counts = sum(np.diff(ptr) for ptr, _ in lists)
+    hit = np.flatnonzero(counts > 0)
+    out = []
+    for ptr, src in lists:
+        c = np.diff(ptr)[hit]
+        out += [np.concatenate([[0], np.cumsum(c)]).astype(np.intp), src]
+    where = hit if dest is None else np.asarray(dest, np.intp)[hit]
+    return (*out, np.ascontiguousarray(where, dtype=np.intp))
 
 
 class SingularSystemError(RuntimeError):
@@ -231,23 +241,15 @@ class ReducedPattern:
         pat = self._pattern
         kidx = np.full(pat.nnz + 1, -1, np.intp)
         kidx[self.keep] = np.arange(self.keep.size)
-        n = self.keep.size
-        return (
-            *_family(kidx[pat.bar_slot], n),
-            *_family(kidx[pat.spring_slot], n),
-            *_family(kidx[pat.spring_slot_mirror], n),
-        )
+        fams = (kidx[pat.bar_slot], kidx[pat.spring_slot], kidx[pat.spring_slot_mirror])
+        return _gather_lists(fams, self.keep.size, self.dense)
 
     @cached_property
     def band_gather(self):
         """Gather lists (bars, springs, none) of the column-major upper band (see
         :attr:`banded_slots`)."""
         bar_ab, spring_ab, size = self.banded_slots
-        return (
-            *_family(bar_ab, size),
-            *_family(spring_ab, size),
-            *_no_family(size),
-        )
+        return _gather_lists((bar_ab, spring_ab), size)
 
     @cached_property
     def ordering(self):
@@ -353,21 +355,13 @@ class AssemblyPattern:
     def force_gather(self):
         """Gather lists (bars, springs, none) of the internal force (targets: the DOFs)."""
         n = self.n_dof
-        return (
-            *_family(self.bar_force_dofs, n),
-            *_family(self.spring_force_dofs, n),
-            *_no_family(n),
-        )
+        return _gather_lists((self.bar_force_dofs, self.spring_force_dofs), n)
 
     @cached_property
     def data_gather(self):
         """Gather lists (bars, springs, spring mirrors) of the CSR data (targets: the slots)."""
         n = self.nnz
-        return (
-            *_family(self.bar_slot, n),
-            *_family(self.spring_slot, n),
-            *_family(self.spring_slot_mirror, n),
-        )
+        return _gather_lists((self.bar_slot, self.spring_slot, self.spring_slot_mirror), n)
 
     def reduced(self, free_mask: np.ndarray) -> ReducedPattern:
         """The free-DOF reduction for a boolean (ndof,) mask (cached per mask)."""
@@ -526,31 +520,17 @@ class Assembler:
         buffers = self._kernels(U, spring_rest, tangent, self._buffers())
         eb, fb, _, es, fs, _, _ = buffers
         energy = float(eb.sum() + es.sum())
-        f = np.empty(self.n_dof)
-        g = self.pattern.force_gather
-        _ck().gather(
-            g[0], g[1], fb.reshape(-1), g[2], g[3], fs.reshape(-1), g[4], g[5], fs.reshape(-1),
-            _NO_DEST, f,
-        )  # fmt: skip
+        f = _gather(self.pattern.force_gather, fb, fs, np.zeros(self.n_dof))
         return energy, f, buffers
-
-    def _fill(self, buffers, gather, out, dest=_NO_DEST):
-        """Fill ``out`` from the element tangents in ``buffers`` by ``gather`` lists."""
-        kb = buffers[2].reshape(-1)
-        ks = buffers[5].reshape(-1)
-        _ck().gather(gather[0], gather[1], kb, gather[2], gather[3], ks, gather[4],
-                          gather[5], ks, dest, out)  # fmt: skip
-        return out
 
     def _scatter(self, buffers):
         """CSR data (nnz,) of the full tangent."""
-        return self._fill(buffers, self.pattern.data_gather, np.empty(self.pattern.nnz))
+        return _gather(self.pattern.data_gather, buffers[2], buffers[5], np.zeros(self.pattern.nnz))
 
     def _dense(self, buffers, red):
         """The free-free tangent block, dense (nf, nf)."""
         nf = red.n_free
-        K = self._fill(buffers, red.dense_gather, np.zeros(nf * nf), red.dense)
-        return K.reshape(nf, nf)
+        return _gather(red.dense_gather, buffers[2], buffers[5], np.zeros(nf * nf)).reshape(nf, nf)
 
     def _data(self, U, spring_rest, tangent=True):
         energy, f, buffers = self._elements(U, spring_rest, tangent)
@@ -627,7 +607,7 @@ class Assembler:
         if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK:
             # upper band filled straight from the element values, column-major as LAPACK
             # stores it
-            ab = self._fill(rb, red.band_gather, np.empty(nf * (bw + 1)))
+            ab = _gather(red.band_gather, rb[2], rb[5], np.zeros(nf * (bw + 1)))
             c, info = dpbtrf(ab.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
             if info == 0:
 
@@ -664,6 +644,16 @@ class Assembler:
             return _finite(x)
 
         return energy, f, solve
+
+
+def _gather(lists, bar_values, spring_values, out):
+    """``out`` (zeros) filled by :func:`holofold.mechanics._compiled.gather` with ``lists``
+    (:func:`_gather_lists`: bars, springs, spring mirrors) from the element arrays."""
+    a, sa, b, sb, c, sc, dest = lists
+    vb = bar_values.reshape(-1)
+    vs = spring_values.reshape(-1)
+    _ck().gather(a, sa, vb, b, sb, vs, c, sc, vs, dest, out)
+    return out
 
 
 def _element_buffers(nb: int, ns: int):
