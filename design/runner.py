@@ -175,6 +175,39 @@ def _evaluate_one(scenario: Scenario, row: dict, limit_threads: bool) -> dict:
         return _failed(scenario, exc)
 
 
+#: rows per task when a scenario evaluates batches (``Scenario.evaluate_batch``): enough to
+#: amortise the per-iteration overhead, few enough to keep two workers busy to the end
+BATCH_ROWS = 16
+
+
+def _batches(scenario: Scenario, rows: list) -> list[list[int]]:
+    """Positions of ``rows`` in tasks: one row each, or up to :data:`BATCH_ROWS` rows with the
+    same ``scenario.batch_key`` when the scenario evaluates batches."""
+    if scenario.evaluate_batch is None or scenario.batch_key is None or len(rows) <= 1:
+        return [[i] for i in range(len(rows))]
+    groups: dict = {}
+    for i, r in enumerate(rows):
+        try:
+            key = scenario.batch_key(r)
+        except Exception:  # noqa: BLE001 - the row fails on its own in evaluate
+            key = ("row", i)
+        groups.setdefault(key, []).append(i)
+    return [g[j : j + BATCH_ROWS] for g in groups.values() for j in range(0, len(g), BATCH_ROWS)]
+
+
+def _evaluate_batch(scenario: Scenario, rows: list, limit_threads: bool) -> list[dict]:
+    """Evaluate rows of one batch key together; if that raises, each row on its own (so a
+    row whose simulation raises fails alone, as with :func:`_evaluate_one`)."""
+    if len(rows) == 1 or scenario.evaluate_batch is None:
+        return [_evaluate_one(scenario, r, limit_threads) for r in rows]
+    try:
+        with single_thread() if limit_threads else nullcontext():
+            outs = scenario.evaluate_batch(rows)
+        return [_checked_output(scenario, o) for o in outs]
+    except Exception:  # noqa: BLE001 - fall back to the rows one by one
+        return [_evaluate_one(scenario, r, limit_threads) for r in rows]
+
+
 def check_workers(workers) -> int:
     """``workers`` as an int: >= 1 processes, or -1 for every core (else ``ValueError``)."""
     w = int(workers)
@@ -319,21 +352,29 @@ def iter_results(
     """Simulate validated ``rows``, yielding ``(position, output)`` as each row finishes.
 
     ``address``: a running Dask scheduler (rows come in order of completion, see
-    :func:`dask_scheduler`); otherwise joblib processes (``workers``, -1 = every core; rows in
-    order). Each output has the performance columns and a :class:`Status`; a row whose
-    simulation raises is a failed row, never an exception. Close the iterator
-    (:func:`contextlib.closing`) to cancel what is still running.
+    :func:`dask_scheduler`); otherwise joblib processes (``workers``, -1 = every core). A
+    scenario with ``evaluate_batch`` gets its rows in tasks of up to :data:`BATCH_ROWS` rows of
+    one ``batch_key`` (their Newton solves in lockstep; each output the row's own), which come
+    in row order of their first rows; other scenarios' rows come in order. Each output has the
+    performance columns and a :class:`Status`; a row whose simulation raises is a failed row,
+    never an exception. Close the iterator (:func:`contextlib.closing`) to cancel what is
+    still running.
     """
     if address is not None:
         yield from _iter_on_dask(scenario, rows, limit_threads, address)
         return
-    if workers == 1 or len(rows) <= 1:
-        yield from enumerate(_evaluate_one(scenario, r, limit_threads) for r in rows)
-        return
-    from joblib import Parallel, delayed
+    tasks = _batches(scenario, rows)
+    if workers == 1 or len(tasks) <= 1:
+        outs = (_evaluate_batch(scenario, [rows[i] for i in t], limit_threads) for t in tasks)
+    else:
+        from joblib import Parallel, delayed
 
-    par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
-    yield from enumerate(par(delayed(_evaluate_one)(scenario, r, limit_threads) for r in rows))
+        par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
+        outs = par(
+            delayed(_evaluate_batch)(scenario, [rows[i] for i in t], limit_threads) for t in tasks
+        )
+    for task, out in zip(tasks, outs, strict=True):
+        yield from zip(task, out, strict=True)
 
 
 def progress_bar(total: int, desc: str, enabled: bool | None = None, initial: int = 0):

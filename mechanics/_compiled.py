@@ -282,3 +282,33 @@ def gather(ptr_a, src_a, val_a, ptr_b, src_b, val_b, ptr_c, src_c, val_c, dest, 
         for q in range(ptr_c[p], ptr_c[p + 1]):
             sc += val_c[src_c[q]]
         out[dest[p]] = (sa + sb) + sc
+
+
+# ------------------------------------------------------------------------ batches
+# A batch is S designs of one size: the arrays gain a leading sample axis and each listed
+# sample runs the single-design code above on one scratch set of element arrays, which stays
+# in cache between the kernels and the gathers (so each design's numbers are bit for bit those
+# of its own evaluation).
+
+
+@njit(**_OPTS)
+def assemble_batch(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    scratch, f_out, k_out,
+):  # fmt: skip
+    """For each sample ``s = idx[j]``: the kernels into ``scratch`` (the seven element arrays
+    of one sample), then ``f_out[j]`` by the ``force_lists`` and ``k_out[j]`` by the
+    ``tangent_lists`` (each the seven arguments of :func:`gather` but the values)."""
+    eb, fb, Kb, es, fs, Ks, th = scratch
+    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
+    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
+        spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
+        vfb = fb.reshape(-1)
+        vfs = fs.reshape(-1)
+        gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f_out[j])
+        vkb = Kb.reshape(-1)
+        vks = Ks.reshape(-1)
+        gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, k_out[j])

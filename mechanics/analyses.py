@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from holofold.geometry.errors import ParameterError
-from holofold.mechanics.solvers import solve_mgdcm, solve_newton
+from holofold.mechanics.solvers import solve_mgdcm, solve_newton, solve_newton_batch
 from holofold.mechanics.solvers.result import SolveResult
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.threads import single_threaded
@@ -25,6 +25,7 @@ __all__ = [
     "load_group",
     "load_along",
     "secant_stiffness",
+    "secant_stiffness_batch",
     "SnapCheck",
     "snap_check_mgdcm",
 ]
@@ -160,10 +161,39 @@ def secant_stiffness(
     res = solve_newton(
         structure, load, increments=increments, tol=tol, max_iter=max_iter, assembler=assembler
     )
+    return _stiffness(group, res, force_per_increment)
+
+
+def _stiffness(group: LoadGroup, res: SolveResult, force_per_increment: float) -> StiffnessResult:
     u = float(np.mean(np.abs(group.displacements(res.U))))
     total = force_per_increment * len(res.load_factor)
     k = total / u if u > 0 else float("inf")
     return StiffnessResult(stiffness=k, displacement=u, result=res)
+
+
+@single_threaded
+def secant_stiffness_batch(
+    structures,
+    groups,
+    *,
+    force_per_increment: float = 1.0,
+    increments: int,
+    tol: float,
+    max_iter: int = 30,
+    batch=None,
+) -> list[StiffnessResult]:
+    """:func:`secant_stiffness` of S structures of one topology and support mask, solved in
+    lockstep by :func:`~holofold.mechanics.solvers.solve_newton_batch` (``groups``: one
+    :class:`LoadGroup` per structure); each result is bit for bit the one-at-a-time one."""
+    structures = list(structures)
+    groups = list(groups)
+    loads = [
+        g.load(s.n_nodes, force_per_increment) for s, g in zip(structures, groups, strict=True)
+    ]
+    runs = solve_newton_batch(
+        structures, loads, increments=increments, tol=tol, max_iter=max_iter, batch=batch
+    )
+    return [_stiffness(g, r, force_per_increment) for g, r in zip(groups, runs, strict=True)]
 
 
 @dataclass(frozen=True)

@@ -44,12 +44,14 @@ from holofold.mechanics.structure import Structure
 __all__ = [
     "AssemblyPattern",
     "Assembler",
+    "BatchAssembler",
     "AssembledSystem",
     "ReducedPattern",
     "SingularSystemError",
     "assembly_pattern",
     "DENSE_MAX_DOF",
     "BANDED_MAX_WORK",
+    "solver_path",
 ]
 
 #: Reduced systems with at most this many free DOFs are assembled and solved densely (LAPACK);
@@ -589,61 +591,94 @@ class Assembler:
         """
         energy, f, rb = self._elements(U, spring_rest)
         red = self.reduction
-        nf = red.free.size
-        if nf == 0:
+        path = solver_path(red, self.dense_max)
+        if path == "none":
             return energy, f, lambda rhs: np.zeros_like(rhs, dtype=float)
-        if nf <= self.dense_max:
-            K = self._dense(rb, red)
-
-            def solve(rhs):
-                try:
-                    x = np.linalg.solve(K, rhs)
-                except np.linalg.LinAlgError as exc:
-                    raise SingularSystemError(f"singular stiffness matrix ({exc})") from None
-                return _finite(x)
-
-            return energy, f, solve
-        perm, bw, _, _ = red.banded
-        if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK:
-            # upper band filled straight from the element values, column-major as LAPACK
-            # stores it
-            ab = _gather(red.band_gather, rb[2], rb[5], np.zeros(nf * (bw + 1)))
-            c, info = dpbtrf(ab.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
-            if info == 0:
-
-                def solve(rhs):
-                    y, info = dpbtrs(c, rhs[perm], lower=0)
-                    if info != 0:  # pragma: no cover - only for invalid arguments
-                        raise SingularSystemError(f"banded solve failed (LAPACK info {info})")
-                    x = np.empty_like(y)
-                    x[perm] = y
-                    return _finite(x)
-
+        if path == "dense":
+            return energy, f, _dense_solver(self._dense(rb, red))
+        if path == "banded":
+            solve = _band_solver(_gather(red.band_gather, rb[2], rb[5], _band_zeros(red)), red)
+            if solve is not None:
                 return energy, f, solve
             # not positive definite: LU below
-        data = self._scatter(rb)
-        order, perm_keep, perm_indptr, perm_indices = red.ordering
-        # csc from the permuted CSR arrays is Kp^T; factorise it and solve with trans='T'
-        KpT = sp.csc_matrix((data[perm_keep], perm_indices, perm_indptr), shape=(nf, nf))
+        return energy, f, _lu_solver(self._scatter(rb), red)
+
+
+def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:
+    """The linear-solver path of a reduction: ``"none"`` (no free DOF), ``"dense"`` (LAPACK LU
+    up to ``dense_max`` free DOFs), ``"banded"`` (Cholesky, band work up to
+    :data:`BANDED_MAX_WORK`; SuperLU if the tangent is not positive definite) or ``"superlu"``."""
+    nf = red.n_free
+    if nf == 0:
+        return "none"
+    if nf <= dense_max:
+        return "dense"
+    _, bw, _, _ = red.banded
+    return "banded" if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK else "superlu"
+
+
+def _band_zeros(red: ReducedPattern) -> np.ndarray:
+    return np.zeros(_band_size(red))
+
+
+def _dense_solver(K: np.ndarray):
+    """``solve(rhs)`` by LAPACK LU of the dense (nf, nf) ``K``."""
+
+    def solve(rhs):
         try:
-            lu = spla.splu(
-                KpT,
-                permc_spec="NATURAL",
-                diag_pivot_thresh=0.01,
-                relax=3,
-                panel_size=10,
-                options={"SymmetricMode": True},
-            )
-        except RuntimeError as exc:
+            x = np.linalg.solve(K, rhs)
+        except np.linalg.LinAlgError as exc:
             raise SingularSystemError(f"singular stiffness matrix ({exc})") from None
+        return _finite(x)
 
-        def solve(rhs):
-            y = lu.solve(np.ascontiguousarray(rhs[order]), trans="T")
-            x = np.empty_like(y)
-            x[order] = y
-            return _finite(x)
+    return solve
 
-        return energy, f, solve
+
+def _band_solver(ab: np.ndarray, red: ReducedPattern):
+    """``solve(rhs)`` by banded Cholesky of the flat column-major upper band ``ab`` (factorised
+    in place), or None if the matrix is not positive definite."""
+    perm, bw, _, _ = red.banded
+    nf = red.n_free
+    c, info = dpbtrf(ab.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
+    if info != 0:
+        return None
+
+    def solve(rhs):
+        y, info = dpbtrs(c, rhs[perm], lower=0)
+        if info != 0:  # pragma: no cover - only for invalid arguments
+            raise SingularSystemError(f"banded solve failed (LAPACK info {info})")
+        x = np.empty_like(y)
+        x[perm] = y
+        return _finite(x)
+
+    return solve
+
+
+def _lu_solver(data: np.ndarray, red: ReducedPattern):
+    """``solve(rhs)`` by SuperLU of the free-free block of the CSR ``data`` (cached ordering)."""
+    nf = red.n_free
+    order, perm_keep, perm_indptr, perm_indices = red.ordering
+    # csc from the permuted CSR arrays is Kp^T; factorise it and solve with trans='T'
+    KpT = sp.csc_matrix((data[perm_keep], perm_indices, perm_indptr), shape=(nf, nf))
+    try:
+        lu = spla.splu(
+            KpT,
+            permc_spec="NATURAL",
+            diag_pivot_thresh=0.01,
+            relax=3,
+            panel_size=10,
+            options={"SymmetricMode": True},
+        )
+    except RuntimeError as exc:
+        raise SingularSystemError(f"singular stiffness matrix ({exc})") from None
+
+    def solve(rhs):
+        y = lu.solve(np.ascontiguousarray(rhs[order]), trans="T")
+        x = np.empty_like(y)
+        x[order] = y
+        return _finite(x)
+
+    return solve
 
 
 def _gather(lists, bar_values, spring_values, out):
@@ -670,3 +705,145 @@ def _finite(x):
     if not np.all(np.isfinite(x)):
         raise SingularSystemError("non-finite solution of the linear system (singular stiffness)")
     return x
+
+
+class BatchAssembler:
+    """S structures of one size and one support mask, evaluated together.
+
+    Every sample of an arch m or a Miura m x n sheet has the same nodes, bars and springs up to
+    the orientation of some springs (the polarity rule follows the geometry), hence one of a
+    few connectivities. One call of :meth:`factorized` runs the compiled kernels once for the
+    whole batch and one gather per connectivity (loops over the samples inside compiled code),
+    then factorises each active sample's tangent by the path :class:`Assembler` takes, so every
+    sample's numbers are bit for bit those of its own :class:`Assembler`.
+
+    Parameters
+    ----------
+    structures : sequence of Structure
+        Same numbers of nodes, bars and springs and the same supports (``ValueError``
+        otherwise).
+    dense_max : int
+        As for :class:`Assembler`.
+    """
+
+    def __init__(self, structures, *, dense_max: int = DENSE_MAX_DOF):
+        structures = list(structures)
+        if not structures:
+            raise ValueError("a batch needs at least one structure")
+        asms = [Assembler(s, dense_max=dense_max) for s in structures]
+        a0 = asms[0]
+        sizes = {(a.n_dof, len(a.bars), len(a.springs)) for a in asms}
+        masks = {a.structure.supports.tobytes() for a in asms}
+        if len(sizes) > 1 or len(masks) > 1:
+            raise ValueError("the structures of a batch need the same sizes and supports")
+        self.assemblers = asms
+        self.dense_max = int(dense_max)
+        self.n = len(asms)
+        self.n_dof = a0.n_dof
+        groups: dict[int, list[int]] = {}
+        for i, a in enumerate(asms):
+            groups.setdefault(id(a.pattern), []).append(i)
+        #: (pattern, reduction, samples) of each connectivity
+        self.groups = [
+            (asms[g[0]].pattern, asms[g[0]].reduction, np.array(g, np.intp))
+            for g in groups.values()
+        ]
+        stack = lambda name: np.stack([getattr(a, name) for a in asms])  # noqa: E731
+        self._X, self._D0, self._L0, self._EA, self._k = map(
+            stack, ("_X", "_D0", "_L0", "_EA", "_k")
+        )
+        self._b0, self._b1, self._sT = map(stack, ("_b0", "_b1", "_sT"))
+        self._theta0 = np.stack([np.asarray(a.theta0, float) for a in asms])
+        self._k_nonneg = np.array([a._k_nonneg for a in asms])
+        self._arccos = [a._arccos for a in asms]
+        self._scratch = _element_buffers(len(a0.bars), len(a0.springs))
+
+    @property
+    def free_dofs(self) -> np.ndarray:
+        return self.assemblers[0].free_dofs
+
+    def factorized(self, U, active, spring_rest=None):
+        """Internal forces and solvers of the ``active`` samples.
+
+        Parameters
+        ----------
+        U : (S, nn, 3) float
+            Displacements, m.
+        active : (S,) bool
+            Samples to evaluate (the others are left alone).
+        spring_rest : (S, ns) float, optional
+            Rest angles instead of the structures' own, rad.
+
+        Returns
+        -------
+        force : (S, ndof) float
+            Internal force of each active sample (rows of the others are zero), N.
+        solves : list
+            Per sample: ``solve(rhs)`` as from :meth:`Assembler.evaluate_factorized`, the
+            :class:`SingularSystemError` its factorisation raised, or None (inactive).
+        """
+        ck = _ck()
+        U = np.ascontiguousarray(np.asarray(U, dtype=float).reshape(self.n, -1, 3))
+        active = np.ascontiguousarray(active, dtype=bool)
+        rest = self._theta0 if spring_rest is None else np.array(spring_rest, dtype=float)
+        if rest.shape != self._theta0.shape:
+            raise ValueError(f"spring_rest must have shape {self._theta0.shape}")
+        theta0 = rest
+        if any(self._arccos):
+            theta0 = theta0.copy()
+            for s in np.flatnonzero(active):
+                if self._arccos[s]:
+                    a = self.assemblers[s]
+                    theta0[s] = theta0[s] + arccos_shift(a.X + U[s], a.springs)
+        theta0 = np.ascontiguousarray(theta0)
+        f = np.zeros((self.n, self.n_dof))
+        solves: list = [None] * self.n
+        for pat, red, members in self.groups:
+            idx = np.ascontiguousarray(members[active[members]], dtype=np.intp)
+            if idx.size == 0:
+                continue
+            path = solver_path(red, self.dense_max)
+            if path == "none":
+                for s in idx:
+                    solves[s] = lambda rhs: np.zeros_like(rhs, dtype=float)
+                continue
+            nf = red.n_free
+            lists, n = (
+                (red.dense_gather, nf * nf) if path == "dense"
+                else (red.band_gather, _band_size(red)) if path == "banded"
+                else (pat.data_gather, pat.nnz)
+            )  # fmt: skip
+            fj = np.zeros((idx.size, self.n_dof))
+            kj = np.zeros((idx.size, n))
+            ck.assemble_batch(
+                self._X, U, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
+                self._k, theta0, self._k_nonneg, idx, pat.force_gather, lists, self._scratch,
+                fj, kj,
+            )  # fmt: skip
+            f[idx] = fj
+            for j, s in enumerate(idx):
+                solves[s] = self._solver(s, path, red, kj[j], U[s], rest[s])
+        return f, solves
+
+    def _solver(self, s, path, red, values, U, rest):
+        """The solver of sample ``s`` from its dense block, band or CSR data ``values``
+        (``rest``: its rest angles, for the LU fallback's own evaluation)."""
+        if path == "dense":
+            return _dense_solver(values.reshape(red.n_free, red.n_free))
+        if path == "banded":
+            solve = _band_solver(values, red)
+            if solve is not None:
+                return solve
+            # not positive definite: LU on the CSR data of this sample alone
+            a = self.assemblers[s]
+            buffers = a._kernels(U, rest, True, a._buffers())
+            values = a._scatter(buffers)
+        try:
+            return _lu_solver(values, red)
+        except SingularSystemError as exc:
+            return exc
+
+
+def _band_size(red: ReducedPattern) -> int:
+    _, bw, _, _ = red.banded
+    return red.n_free * (bw + 1)

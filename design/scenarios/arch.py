@@ -89,4 +89,6 @@ SCENARIO = Scenario(
     check=check,
     evaluate=evaluate,
     categorical=("m",),
+    evaluate_batch=_STRIP.evaluate_batch,
+    batch_key=_STRIP.batch_key,
 )

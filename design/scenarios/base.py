@@ -107,6 +107,12 @@ class Scenario:
         The design's stress-free folded pattern (for pictures and files).
     write_files : callable(row, folder) -> dict, optional
         Writes the design's fabrication files into ``folder``; returns label -> path.
+    evaluate_batch : callable(rows) -> list of dict, optional
+        Simulates several rows with the same ``batch_key`` together (their Newton solves in
+        lockstep); each output is the one ``evaluate`` gives the row alone. The runner uses it
+        for tables of many rows.
+    batch_key : callable(row) -> hashable, optional
+        Rows with equal keys have models of one size (e.g. the strip's ``m``).
     """
 
     name: str
@@ -121,6 +127,8 @@ class Scenario:
     source: str = ""
     shape: Callable | None = None
     write_files: Callable | None = None
+    evaluate_batch: Callable[[list], list] | None = None
+    batch_key: Callable[[Mapping[str, float]], object] | None = None
 
     @property
     def feature_names(self) -> list[str]:

@@ -94,5 +94,7 @@ SCENARIO = Scenario(
     performance=PERFORMANCE,
     check=check,
     evaluate=evaluate,
+    evaluate_batch=_SHEET.evaluate_batch,
+    batch_key=_SHEET.batch_key,
     categorical=("pattern", "m", "n"),
 )

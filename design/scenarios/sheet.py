@@ -59,8 +59,8 @@ from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.miura import miura_faces, miura_nodes, miura_sheet, rigid_fold_pattern
 from holofold.geometry.pattern import CreasePattern
 from holofold.geometry.tmp import tmp_faces, tmp_node_count, tmp_nodes
-from holofold.mechanics.analyses import load_along, secant_stiffness
-from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.analyses import load_along, secant_stiffness_batch
+from holofold.mechanics.assembly import BatchAssembler
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
 from holofold.mechanics.status import Outcome, Status
@@ -81,6 +81,8 @@ __all__ = [
     "sheet_mass",
     "check_sheet",
     "evaluate_sheet",
+    "evaluate_sheet_batch",
+    "sheet_batch_key",
     "sheet_shape",
     "write_sheet_files",
     "sheet_scenario",
@@ -391,30 +393,50 @@ def check_sheet(setting: SheetSetting, row) -> list[str]:
     return errs
 
 
-@single_threaded
 def evaluate_sheet(setting: SheetSetting, columns: Sequence[str], row) -> dict:
     """The ``columns`` of one design (see the module docstring) and a status."""
-    out, cases = {}, {}
-    for ext, (s, groups) in zip(setting.extensions, sheet_models(setting, row), strict=True):
+    return evaluate_sheet_batch(setting, columns, [row])[0]
+
+
+def sheet_batch_key(setting: SheetSetting, row) -> tuple[int, int, int]:
+    """Designs with the same key (pattern, m, n) have models of one size: one batch."""
+    pat, m, n, _ = _design(setting, row)
+    return pat, m, n
+
+
+@single_threaded
+def evaluate_sheet_batch(setting: SheetSetting, columns: Sequence[str], rows) -> list[dict]:
+    """:func:`evaluate_sheet` of several designs of one pattern, m and n, their Newton solves
+    run in lockstep per extension and load (:func:`secant_stiffness_batch`); each output is
+    bit for bit the design's own."""
+    models = [sheet_models(setting, row) for row in rows]
+    outs: list = [{} for _ in rows]
+    cases: list = [{} for _ in rows]
+    for e, ext in enumerate(setting.extensions):
         tag = extension_tag(ext)
-        asm = Assembler(s)  # one sparse pattern and reduction for every load case
-        for ld, grp in zip(setting.loads, groups, strict=True):
-            r = secant_stiffness(
-                s,
-                grp,
+        structures = [mod[e][0] for mod in models]
+        batch = BatchAssembler(structures)  # one pattern and reduction for every load case
+        for k, ld in enumerate(setting.loads):
+            runs = secant_stiffness_batch(
+                structures,
+                [mod[e][1][k] for mod in models],
                 force_per_increment=ld.force / ld.increments,
                 increments=ld.increments,
                 tol=setting.tol,
                 max_iter=setting.max_iter,
-                assembler=asm,
+                batch=batch,
             )
-            out[f"{ld.name}stiff{tag}"] = r.stiffness
-            cases[f"{ld.name} Ext {ext}"] = r.result.status
-    if "mass" in columns:
-        out["mass"] = sheet_mass(setting, row)
-    out = {c: out[c] for c in columns}
-    out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
-    return out
+            for i, r in enumerate(runs):
+                outs[i][f"{ld.name}stiff{tag}"] = r.stiffness
+                cases[i][f"{ld.name} Ext {ext}"] = r.result.status
+    result = []
+    for row, out, case in zip(rows, outs, cases, strict=True):
+        if "mass" in columns:
+            out["mass"] = sheet_mass(setting, row)
+        out = {c: out[c] for c in columns}
+        out["status"] = Status.gather(case, worst=Outcome.NOT_CONVERGED)
+        result.append(out)
+    return result
 
 
 def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreasePattern:
@@ -493,6 +515,8 @@ def sheet_scenario(
         performance=perf,
         check=partial(check_sheet, setting),
         evaluate=partial(evaluate_sheet, setting, tuple(c.name for c in perf)),
+        evaluate_batch=partial(evaluate_sheet_batch, setting, tuple(c.name for c in perf)),
+        batch_key=partial(sheet_batch_key, setting),
         categorical=tuple(c.name for c in features if c.choices),
         kind="sheet",
         setting=words,

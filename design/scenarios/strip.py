@@ -62,8 +62,8 @@ from holofold.fitting import (
 from holofold.geometry import LENGTH_UNITS, length_factor
 from holofold.geometry.errors import InvalidPatternError
 from holofold.geometry.pattern import CreasePattern
-from holofold.mechanics.analyses import load_along, secant_stiffness
-from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.analyses import load_along, secant_stiffness_batch
+from holofold.mechanics.assembly import BatchAssembler
 from holofold.mechanics.compat import PAPER
 from holofold.mechanics.hinges import build_concentrated
 from holofold.mechanics.status import Outcome, Status
@@ -78,6 +78,8 @@ __all__ = [
     "strip_model",
     "strip_columns",
     "evaluate_strip",
+    "evaluate_strip_batch",
+    "strip_batch_key",
     "check_strip",
     "loaded_node",
     "strip_shape",
@@ -278,47 +280,75 @@ def _mass(setting: StripSetting, g, row) -> float:
     return setting.density * (area.sum() * tp + fold_length * w * (tc - tp))
 
 
-@single_threaded
 def evaluate_strip(setting: StripSetting, columns: Sequence[str], row) -> dict:
     """The ``columns`` of one design (see the module docstring) and a status."""
-    s, g, err = strip_model(setting, row)
-    if setting.refuse_overlap:
-        try:
-            CreasePattern.from_faces(g.nodes, list(g.faces))
-        except InvalidPatternError as exc:
-            return {
-                **dict.fromkeys(columns, float("nan")),
-                "status": Status.failed(f"self-overlapping strip: {exc}"),
-            }
-    asm = Assembler(s)  # one sparse pattern and reduction for every load case
-    out: dict = {}
-    cases = {}
+    return evaluate_strip_batch(setting, columns, [row])[0]
+
+
+def strip_batch_key(row) -> int:
+    """Designs with the same key (their ``m``) have models of one size: one batch."""
+    return int(row["m"])
+
+
+@single_threaded
+def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) -> list[dict]:
+    """:func:`evaluate_strip` of several designs of one ``m``, their Newton solves run in
+    lockstep (:func:`~holofold.mechanics.analyses.secant_stiffness_batch`); each output is
+    bit for bit the design's own."""
+    outs: list = [None] * len(rows)
+    models = []
+    for i, row in enumerate(rows):
+        s, g, err = strip_model(setting, row)
+        if setting.refuse_overlap:
+            try:
+                CreasePattern.from_faces(g.nodes, list(g.faces))
+            except InvalidPatternError as exc:
+                outs[i] = {
+                    **dict.fromkeys(columns, float("nan")),
+                    "status": Status.failed(f"self-overlapping strip: {exc}"),
+                }
+                continue
+        models.append((i, s, g, err))
+    if not models:
+        return outs
+    structures = [s for _, s, _, _ in models]
+    batch = BatchAssembler(structures)  # one pattern and reduction for every load case
+    runs = {}
     for ld in setting.loads:
-        group = load_along([loaded_node(setting, g.m, ld.at, g.t)], ld.direction)
-        r = secant_stiffness(
-            s,
-            group,
+        groups = [load_along([loaded_node(setting, g.m, ld.at, g.t)], ld.direction)
+                  for _, _, g, _ in models]  # fmt: skip
+        runs[ld.name] = secant_stiffness_batch(
+            structures,
+            groups,
             force_per_increment=ld.force / ld.increments,
             increments=ld.increments,
             tol=setting.tol,
             max_iter=setting.max_iter,
-            assembler=asm,
+            batch=batch,
         )
-        out[f"{ld.name}stiff"] = r.stiffness
-        label = f"{ld.name} case"
-        if ld.snap_displacement is not None:
-            snap = r.displacement > ld.snap_displacement
-            out[f"{ld.name}snap"] = 1.0 if snap else 0.0
-            label += " (snap-through)" if snap else ""
-        cases[label] = r.result.status
-    out["error"] = err
-    if "closest_error" in columns:
-        out["closest_error"] = closest_point_error(setting.curve, g.centre_line, both=False).mean
-    if "mass" in columns:
-        out["mass"] = _mass(setting, g, row)
-    out = {c: out[c] for c in columns}
-    out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
-    return out
+    for j, (i, _, g, err) in enumerate(models):
+        out: dict = {}
+        cases = {}
+        for ld in setting.loads:
+            r = runs[ld.name][j]
+            out[f"{ld.name}stiff"] = r.stiffness
+            label = f"{ld.name} case"
+            if ld.snap_displacement is not None:
+                snap = r.displacement > ld.snap_displacement
+                out[f"{ld.name}snap"] = 1.0 if snap else 0.0
+                label += " (snap-through)" if snap else ""
+            cases[label] = r.result.status
+        out["error"] = err
+        if "closest_error" in columns:
+            out["closest_error"] = closest_point_error(
+                setting.curve, g.centre_line, both=False
+            ).mean
+        if "mass" in columns:
+            out["mass"] = _mass(setting, g, rows[i])
+        out = {c: out[c] for c in columns}
+        out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
+        outs[i] = out
+    return outs
 
 
 def strip_shape(setting: StripSetting, row) -> CreasePattern:
@@ -399,6 +429,8 @@ def strip_scenario(
         performance=perf,
         check=partial(check_strip, setting),
         evaluate=partial(evaluate_strip, setting, tuple(c.name for c in perf)),
+        evaluate_batch=partial(evaluate_strip_batch, setting, tuple(c.name for c in perf)),
+        batch_key=strip_batch_key,
         categorical=tuple(c.name for c in features if c.choices),
         kind="strip",
         setting=words,

@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from holofold.mechanics.assembly import Assembler, SingularSystemError
+from holofold.geometry.errors import ParameterError
+from holofold.mechanics.assembly import Assembler, BatchAssembler, SingularSystemError
 from holofold.mechanics.solvers._common import (
     History,
     check_controls,
@@ -33,7 +34,7 @@ from holofold.mechanics.solvers.result import SolveResult
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.threads import single_threaded
 
-__all__ = ["solve_newton"]
+__all__ = ["solve_newton", "solve_newton_batch"]
 
 
 @single_threaded
@@ -100,3 +101,87 @@ def solve_newton(
             break
         hist.record(U, i, R <= tol, step - 1, R)
     return hist.result(tol, "||dU||", F0v + i * P, structure.spring_rest, "solve_newton")
+
+
+@single_threaded
+def solve_newton_batch(
+    structures,
+    loads,
+    *,
+    increments: int,
+    tol: float = 1e-5,
+    max_iter: int = 30,
+    U0=None,
+    F0=None,
+    batch: BatchAssembler | None = None,
+) -> list[SolveResult]:
+    """:func:`solve_newton` for S structures of one topology and support mask, in lockstep.
+
+    Every iteration evaluates the samples still iterating together (one kernel call and one
+    gather for the batch, :class:`~holofold.mechanics.assembly.BatchAssembler`); each sample
+    keeps its own increment loop, convergence, iteration count and failure, and its
+    :class:`SolveResult` is bit for bit the one :func:`solve_newton` gives it alone.
+
+    Parameters
+    ----------
+    structures : sequence of Structure
+    loads : sequence of (nn, 3) float
+        Per-sample load per increment, N.
+    increments, tol, max_iter
+        As for :func:`solve_newton` (shared).
+    U0, F0 : sequence of (nn, 3) float, optional
+        Per-sample start displacement (m) and applied force (N); default 0.
+    batch : BatchAssembler, optional
+        Prebuilt for ``structures``.
+
+    Returns
+    -------
+    list of SolveResult
+    """
+    structures = list(structures)
+    B = BatchAssembler(structures) if batch is None else batch
+    if B.n != len(structures):
+        raise ParameterError(f"batch holds {B.n} structures, got {len(structures)}")
+    increments, tol, max_iter = check_controls(increments, tol, max_iter)
+    S = len(structures)
+    nn = structures[0].n_nodes
+    if len(loads) != S:
+        raise ParameterError(f"loads: {len(loads)} given for {S} structures")
+    P = np.stack([nodal_array("load", ld, nn).ravel() for ld in loads])
+    F0v = np.stack([nodal_array("F0", None if F0 is None else F0[s], nn).ravel() for s in range(S)])
+    U = np.stack([nodal_array("U0", None if U0 is None else U0[s], nn).ravel() for s in range(S)])
+    free = B.free_dofs
+    hists = [History(increments, nn) for _ in range(S)]
+    alive = np.ones(S, bool)
+    last = np.zeros(S, np.int64)
+    for i in range(1, increments + 1):
+        Fi = F0v + i * P
+        step = np.ones(S, np.int64)
+        R = np.full(S, np.inf)
+        last[alive] = i
+        while True:
+            it = alive & (step < max_iter) & (R > tol)
+            if not it.any():
+                break
+            f, solves = B.factorized(U.reshape(S, nn, 3), it)
+            for s in np.flatnonzero(it):
+                try:
+                    if isinstance(solves[s], SingularSystemError):
+                        raise solves[s]
+                    dU = solves[s]((Fi[s] - f[s])[free])
+                except SingularSystemError as exc:
+                    hists[s].failure = f"increment {i}, iteration {step[s]}: {exc}"
+                    hists[s].record(U[s], i, False, step[s] - 1, R[s])
+                    alive[s] = False
+                    continue
+                U[s, free] += dU
+                R[s] = float(np.sqrt(dU @ dU))
+                step[s] += 1
+        for s in np.flatnonzero(alive):
+            hists[s].record(U[s], i, R[s] <= tol, step[s] - 1, R[s])
+    return [
+        hists[s].result(
+            tol, "||dU||", F0v[s] + last[s] * P[s], structures[s].spring_rest, "solve_newton"
+        )
+        for s in range(S)
+    ]
