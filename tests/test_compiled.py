@@ -118,3 +118,18 @@ def test_element_response_keeps_the_kernel_layouts():
         assert np.array_equal(a, b)
     rb2, _ = asm.element_response(U)
     assert rb2.tangent is not rb.tangent  # new arrays on every call
+
+
+def test_dense_solver_is_numpy_solve_bit_for_bit():
+    # one right-hand side: LAPACK's dgetrf/dgetrs from scipy instead of np.linalg.solve
+    from holofold.mechanics.assembly import SingularSystemError, _dense_solver
+
+    rng = np.random.default_rng(7)
+    for n in (3, 30, 99, 150):
+        K = rng.normal(size=(n, n)) + n * np.eye(n)
+        K[0, 1] += 1e-3  # not symmetric, as an assembled tangent need not be to the bit
+        solve = _dense_solver(K)
+        for rhs in (rng.normal(size=n), rng.normal(size=(n, 2)), rng.normal(size=n)):
+            assert np.array_equal(solve(rhs), np.linalg.solve(K, rhs))
+    with pytest.raises(SingularSystemError, match="singular stiffness matrix"):
+        _dense_solver(np.zeros((4, 4)))(np.ones(4))
