@@ -198,6 +198,8 @@ def test_plan_view_svg_without_layout():
         ([*BASE, *DESIGN, "--no-overlap"], "--no-overlap needs --auto"),
         ([*BASE, "--auto", "--tolerance", "0.05", "--max-warp", "0"], "--max-warp"),
         ([*BASE, *DESIGN, "--curve-scale", "-1"], "--curve-scale"),
+        ([*BASE, "--m", "100000", *DESIGN[2:]], "more than 2000 units"),
+        ([*BASE, "--auto", "--tolerance", "0.05", "--m-range", "2:100000"], "beyond m = 2000"),
     ],
 )
 def test_bad_input_writes_nothing(tmp_path, capsys, argv, match):

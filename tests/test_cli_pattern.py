@@ -57,6 +57,8 @@ def test_tmp_pattern(tmp_path):
           "--thickness", "1e-3"], "--printable needs --crease-thickness, --crease-width > 0"),
         (["miura", "--gamma", "60", "--ext", "0.5", "--size", "0.2", "--crease-thickness",
           "1e-3"], "add --printable"),
+        (["miura", "--gamma", "60", "--ext", "0.5", "--size", "0.2", "--m", "100000"],
+         "600000 panels; at most 10000"),
     ],
 )  # fmt: skip
 def test_bad_arguments_exit_nonzero_and_write_nothing(tmp_path, capsys, extra, message):

@@ -115,6 +115,10 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 # ---------------------------------------------------------------------- validation
+#: the largest m the command fits (a strip of 4m panels; m = 2000 takes 4 s)
+MAX_M = 2000
+
+
 def _m_range(text: str | None) -> list[int]:
     if text is None:
         return list(DEFAULT_M_RANGE)
@@ -133,6 +137,8 @@ def _m_range(text: str | None) -> list[int]:
     values = list(range(nums[0], nums[1] + 1, step))
     if not values:
         raise ParameterError(f"--m-range {text!r} is empty")
+    if max(values) > MAX_M or len(values) > MAX_M:
+        raise ParameterError(f"--m-range {text!r} goes beyond m = {MAX_M} or {MAX_M} values")
     return values
 
 
@@ -160,6 +166,8 @@ def _validate(args) -> dict:
         m = args.m
         if not (math.isfinite(m) and m == round(m) and m >= 2):
             raise ParameterError(f"--m must be an integer >= 2, got {m!r}")
+        if m > MAX_M:
+            raise ParameterError(f"--m = {m:g} is more than {MAX_M} units (4m panels)")
         opts["m"] = int(m)
     thick = (args.panel_thickness, args.crease_width)
     if any(v is not None for v in thick):

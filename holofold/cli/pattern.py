@@ -61,10 +61,19 @@ def register(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+#: the largest sheet the command writes (panels): larger ones take minutes and gigabytes
+MAX_PANELS = 10_000
+
+
 def _build(args):
     """The pattern the arguments describe (checked in the options' own terms and units)."""
     from holofold.geometry import ParameterError, check_range, miura_sheet, tmp_sheet
 
+    if args.m > 0 and args.n > 0 and args.m * args.n > MAX_PANELS:
+        raise ParameterError(
+            f"--m {args.m} x --n {args.n} = {args.m * args.n} panels; at most {MAX_PANELS} "
+            "(a 100 x 100 sheet takes 2 s; use the Python API for larger ones)"
+        )
     check_range("--ext", args.ext, 0.0, 1.0, low_open=True)
     if args.kind == "miura":
         if args.gamma is None:
