@@ -91,33 +91,29 @@ def _unit_rows(a: np.ndarray, fallback: np.ndarray) -> np.ndarray:
     return np.where(ok, a / np.where(ok, norm, 1.0), fallback)
 
 
-def _sat_gap(P, pts, n, i, j) -> np.ndarray:
+def _sat_gap(P, pts, n, i, j, *, full: bool = True) -> np.ndarray:
     """Largest separation (m) of prisms i and j along the separating-axis candidates (P,).
 
     Positive: the prisms are apart by at least that much; <= 0: no candidate axis separates
-    them (they may intersect).
+    them (they may intersect). ``full=False`` tries only the cap and side normals (a cheap first
+    pass: a pair it separates is apart).
     """
     Pi, Pj = P[i], P[j]
     ei = np.roll(Pi, -1, axis=1) - Pi
     ej = np.roll(Pj, -1, axis=1) - Pj
     ni, nj = n[i][:, None, :], n[j][:, None, :]
     K = Pi.shape[1]
-    axes = np.concatenate(
-        [
-            ni,
-            nj,
-            np.cross(ei, ni),
-            np.cross(ej, nj),
+    axes = [ni, nj, np.cross(ei, ni), np.cross(ej, nj)]
+    if full:
+        axes += [
             np.cross(ei[:, :, None, :], ej[:, None, :, :]).reshape(len(i), K * K, 3),
             np.cross(ni, ej),
             np.cross(ei, nj),
             np.cross(ni, nj),
-        ],
-        axis=1,
-    )
-    axes = _unit_rows(axes, ni)
-    pi = np.einsum("pak,pvk->pav", axes, pts[i])
-    pj = np.einsum("pak,pvk->pav", axes, pts[j])
+        ]
+    axes = _unit_rows(np.concatenate(axes, axis=1), ni)
+    pi = np.matmul(axes, pts[i].transpose(0, 2, 1))  # (P, axes, 2K)
+    pj = np.matmul(axes, pts[j].transpose(0, 2, 1))
     gap = np.maximum(pj.min(axis=2) - pi.max(axis=2), pi.min(axis=2) - pj.max(axis=2))
     return gap.max(axis=1)
 
@@ -158,7 +154,9 @@ def _overlap(P, pts, n, sizes, t, pairs) -> tuple[float, np.ndarray]:
 
     if not len(pairs):
         return 0.0, np.zeros((0, 2), int)
-    pairs = pairs[_sat_gap(P, pts, n, pairs[:, 0], pairs[:, 1]) <= 0]
+    pairs = pairs[_sat_gap(P, pts, n, pairs[:, 0], pairs[:, 1], full=False) <= 0]
+    if len(pairs):
+        pairs = pairs[_sat_gap(P, pts, n, pairs[:, 0], pairs[:, 1]) <= 0]
     if not len(pairs):
         return 0.0, pairs
     g = nx.Graph()
@@ -176,7 +174,8 @@ def _overlap(P, pts, n, sizes, t, pairs) -> tuple[float, np.ndarray]:
 def _fan_triangles(P: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """(nf, K, 3, 3) fan triangles (centre, corner l, corner l+1) of the padded corners."""
     nf, K, _ = P.shape
-    c = np.stack([P[f, : sizes[f]].mean(axis=0) for f in range(nf)]) if nf else P[:, 0]
+    valid = np.arange(K)[None, :] < sizes[:, None]
+    c = (P * valid[:, :, None]).sum(axis=1) / sizes[:, None]
     lo = np.minimum(np.arange(K)[None, :], sizes[:, None] - 1)  # padding repeats the last one
     hi = (lo + 1) % sizes[:, None]
     rows = np.arange(nf)[:, None]
@@ -275,10 +274,11 @@ def _triangle_distance(A, B):
 
 def _plane_gap(A, B):
     """Distance of triangles B (n, 3, 3) from the planes of A where B lies on one side, else 0."""
-    nrm = np.cross(A[:, 1] - A[:, 0], A[:, 2] - A[:, 0])
-    nrm /= np.maximum(np.linalg.norm(nrm, axis=1), 1e-300)[:, None]
-    h = np.einsum("nvk,nk->nv", B - A[:, :1], nrm)
-    lo, hi = h.min(axis=1), h.max(axis=1)
+    a0, a1, a2 = (tuple(A[:, v, d] for d in range(3)) for v in range(3))
+    nrm = _cross(_sub(a1, a0), _sub(a2, a0))
+    ln = np.maximum(_norm(nrm), 1e-300)
+    h = np.stack([_dot(_sub(tuple(B[:, v, d] for d in range(3)), a0), nrm) for v in range(3)]) / ln
+    lo, hi = h.min(axis=0), h.max(axis=0)
     return np.where(lo > 0, lo, np.where(hi < 0, -hi, 0.0))
 
 
@@ -348,16 +348,16 @@ def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> P
     dG = np.linalg.norm(G[i][:, :, None] - G[j][:, None], axis=3)  # (n, K, K)
     upper = min(float(corner.min()), float((dG - half[:, None, None]).min()))
     low = dG - rho[i][:, :, None] - rho[j][:, None] - half[:, None, None]
-    p, a, b = np.nonzero(low <= upper)  # triangle pairs that can still be the closest
+    p, a, b = np.nonzero(low <= upper + 1e-9 * (abs(upper) + float(rho.max())))  # can be closest
     TA, TB = T[i[p], a], T[j[p], b]
     low = np.maximum(low[p, a, b], np.maximum(_plane_gap(TA, TB), _plane_gap(TB, TA)) - half[p])
-    keep = low <= upper
+    keep = low <= upper + 1e-9 * (abs(upper) + float(rho.max()))  # rounding: keep the equal
     p, a, b, low = p[keep], a[keep], b[keep], low[keep]
     order = np.argsort(low)
     p, a, b, low = p[order], a[order], b[order], low[order]
     best, at, done = math.inf, 0, 0
     while done < len(low) and low[done] < best:  # nearest first, in growing chunks
-        stop = min(len(low), done + max(256, done))
+        stop = min(len(low), done + max(4096, done))
         sl = slice(done, stop)
         gap = _triangle_distance(T[i[p[sl]], a[sl]], T[j[p[sl]], b[sl]]) - half[p[sl]]
         k = int(np.argmin(gap))

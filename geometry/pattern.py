@@ -171,15 +171,25 @@ def orient_faces(faces, n_vertices: int | None = None) -> tuple[np.ndarray, ...]
     same = pairs[i, 0] == pairs[j, 0]  # traversed in the same direction
     if not same.any():
         return faces  # already consistent
-    g = nx.Graph()
-    g.add_nodes_from(range(len(faces)))
-    for u, v, sm in zip(t.owner[i].tolist(), t.owner[j].tolist(), same.tolist(), strict=True):
-        g.add_edge(u, v, same=sm)
-    flip = np.zeros(len(faces), bool)
-    for comp in nx.connected_components(g):
-        root = min(comp)
-        for u, v in nx.bfs_edges(g, root):
-            flip[v] = flip[u] ^ g.edges[u, v]["same"]
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import breadth_first_order, connected_components
+
+    nf = len(faces)
+    fu, fw = t.owner[i], t.owner[j]
+    _, once = np.unique(np.minimum(fu, fw) * nf + np.maximum(fu, fw), return_index=True)
+    fu, fw, w = fu[once], fw[once], 1 + same[once]  # weight 1 + same (scipy drops zeros)
+    g = csr_matrix((np.concatenate([w, w]), (np.concatenate([fu, fw]), np.concatenate([fw, fu]))),
+                   shape=(nf, nf))  # fmt: skip
+    n_comp, label = connected_components(g, directed=False)
+    flip = np.zeros(nf, bool)
+    roots = np.full(n_comp, nf)
+    np.minimum.at(roots, label, np.arange(nf))
+    for root in roots:  # the first face of each component keeps its orientation
+        order, pred = breadth_first_order(g, int(root), directed=False)
+        step = np.asarray(g[pred[order[1:]], order[1:]]).ravel() == 2
+        for v, u, sm in zip(order[1:].tolist(), pred[order[1:]].tolist(), step.tolist(),
+                            strict=True):  # fmt: skip
+            flip[v] = flip[u] ^ sm
     bad = (flip[t.owner[i]] ^ flip[t.owner[j]]) != same
     if bad.any():
         u, v = int(t.owner[i][bad][0]), int(t.owner[j][bad][0])
