@@ -266,7 +266,13 @@ def printable_solid(
 
     parts = _prisms(list(lay.panels), *z(tp))
     parts += _prisms(list(lay.hinges) + list(lay.patches), *z(tc))
-    whole = m3d.Manifold.batch_boolean(parts, m3d.OpType.Add)
+    out = _one_body(m3d.Manifold.batch_boolean(parts, m3d.OpType.Add), "printable part (flat)")
+    out.metadata["layout"] = lay
+    return out
+
+
+def _one_body(whole, name: str) -> trimesh.Trimesh:
+    """The manifold3d solid as a trimesh (float64), refused unless one watertight body."""
     mesh = whole.to_mesh64()
     out = trimesh.Trimesh(
         vertices=np.asarray(mesh.vert_properties)[:, :3],
@@ -276,11 +282,10 @@ def printable_solid(
     bodies = len(whole.decompose())
     if bodies != 1 or not out.is_watertight:
         raise DegenerateGeometryError(
-            f"the printable part of this pattern has {bodies} separate bodies (watertight: "
+            f"the {name} of this pattern has {bodies} separate bodies (watertight: "
             f"{out.is_watertight}); every panel must be joined to the others through fold lines"
         )
-    out.metadata["layout"] = lay
-    out.metadata["name"] = "printable part (flat)"
+    out.metadata["name"] = name
     return out
 
 
@@ -401,20 +406,7 @@ def folded_printable_solid(
             stacklevel=2,
         )
     whole = m3d.Manifold.batch_boolean([panels, *parts[len(faces) :]], m3d.OpType.Add)
-    mesh = whole.to_mesh64()
-    out = trimesh.Trimesh(
-        vertices=np.asarray(mesh.vert_properties)[:, :3],
-        faces=np.asarray(mesh.tri_verts).astype(np.int64),
-        process=False,
-    )
-    bodies = len(whole.decompose())
-    if bodies != 1 or not out.is_watertight:
-        raise DegenerateGeometryError(
-            f"the folded printable part of this pattern has {bodies} separate bodies "
-            f"(watertight: {out.is_watertight}); every panel must be joined through fold lines"
-        )
-    out.metadata["name"] = "printable part (folded)"
-    return out
+    return _one_body(whole, "printable part (folded)")
 
 
 def _unit_normal(corners: np.ndarray) -> np.ndarray:
