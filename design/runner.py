@@ -290,8 +290,12 @@ def dask_scheduler(scheduler: str, workers: int = 1) -> Iterator[str]:
     level = quiet.level
     quiet.setLevel(max(level, logging.WARNING))
     try:
-        with LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
+        with LocalCluster(  # scheduler, workers and dashboard on loopback only
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address="127.0.0.1:0",
         ) as cluster:
             yield cluster.scheduler_address
     finally:

@@ -305,6 +305,7 @@ def test_worker_settings_of_the_commands(monkeypatch):
 
         def __init__(self, n_workers, **kw):
             seen["n"] = n_workers
+            seen["kw"] = kw
 
         def __enter__(self):
             return self
@@ -319,6 +320,9 @@ def test_worker_settings_of_the_commands(monkeypatch):
     for workers, n in ((1, 1), (3, 3), (-1, joblib.cpu_count())):
         with runner.dask_scheduler("local", workers) as address:
             assert address == "tcp://127.0.0.1:1" and seen["n"] == n
+            # nothing listens beyond this machine: scheduler, workers and dashboard on loopback
+            assert seen["kw"]["host"] == "127.0.0.1"
+            assert seen["kw"]["dashboard_address"].startswith("127.0.0.1:")
 
 
 def test_cli_refuses_workers_with_a_remote_scheduler(miura, tmp_path, capsys):
