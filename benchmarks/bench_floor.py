@@ -12,8 +12,9 @@ is counted and every ``--every``-th free-free tangent captured; each captured ta
 factorised and solved (one right-hand side) by every applicable LAPACK/SuperLU path called
 directly (dense Cholesky dpotrf/dpotrs, dense LU dgetrf/dgetrs, banded Cholesky dpbtrf/dpbtrs
 on the reverse Cuthill-McKee ordering, SuperLU with the cached minimum-degree ordering), the
-best of 5 timings each. A structure's floor per iteration is the mean over its captured
-tangents of the cheapest path, so a sample's floor is sum(iterations x that cost). ``solver``
+best of 5 timings each. A structure's floor per iteration is the cheapest path's best timing
+over its captured tangents (one size and sparsity: a busy machine only adds to a timing), so
+a sample's floor is sum(iterations x that cost). ``solver``
 names the path the assembler takes; the gripper row also gives the floor with the solver it
 uses. The database row runs ``evaluate_designs`` on the 3000 published arch rows (data3) on 2
 worker processes (wall clock, and the CPU time of the workers / 2, which other jobs on the
@@ -40,6 +41,7 @@ from scipy.linalg import lapack
 from threadpoolctl import threadpool_limits
 
 import holofold.mechanics.assembly as assembly
+from holofold import mechanics as threads
 from holofold.design.scenarios import arch, canopy, gripper, single_miura
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -87,25 +89,42 @@ class Capture:
         self.K: dict = defaultdict(list)
         self.red: dict = {}
 
+    def _record(self, asm, U, spring_rest):
+        key = (id(asm.reduction), asm.reduction.n_free)
+        n = self.calls[key]
+        self.calls[key] += 1
+        if n % self.every == 0 and len(self.K[key]) < 12:
+            _, _, K = asm.evaluate_reduced(U, spring_rest, dense=False)
+            self.K[key].append(sp.csr_matrix(K))
+            self.red[key] = asm.reduction
+
     def __enter__(self):
-        orig = self.orig = assembly.Assembler.evaluate_factorized
         cap = self
+        self.orig = assembly.Assembler.evaluate_factorized
 
         def spy(asm, U, spring_rest=None):
-            key = (id(asm.reduction), asm.reduction.n_free)
-            n = cap.calls[key]
-            cap.calls[key] += 1
-            if n % cap.every == 0 and len(cap.K[key]) < 12:
-                _, _, K = asm.evaluate_reduced(U, spring_rest, dense=False)
-                cap.K[key].append(sp.csr_matrix(K))
-                cap.red[key] = asm.reduction
-            return orig(asm, U, spring_rest)
+            cap._record(asm, U, spring_rest)
+            return cap.orig(asm, U, spring_rest)
 
         assembly.Assembler.evaluate_factorized = spy
+        batch = getattr(assembly, "BatchAssembler", None)  # the batched path (issue 14)
+        if batch is not None:
+            self.orig_batch = batch.factorized
+
+            def spy_batch(b, U, active, spring_rest=None):
+                U = np.asarray(U, float).reshape(b.n, -1, 3)
+                for s in np.flatnonzero(active):
+                    rest = None if spring_rest is None else spring_rest[s]
+                    cap._record(b.assemblers[s], U[s], rest)
+                return cap.orig_batch(b, U, active, spring_rest)
+
+            batch.factorized = spy_batch
         return self
 
     def __exit__(self, *exc):
         assembly.Assembler.evaluate_factorized = self.orig
+        if getattr(assembly, "BatchAssembler", None) is not None:
+            assembly.BatchAssembler.factorized = self.orig_batch
 
 
 clock = time.thread_time
@@ -206,10 +225,12 @@ def floor_of(fn, every: int = 4):
     used = set()
     for key, n in cap.calls.items():
         costs = [path_costs(K, cap.red[key]) for K in cap.K[key]]
-        best = statistics.mean(min(c.values()) for c in costs)
+        # the tangents of one structure have one size and sparsity: the best timing of any
+        # is the least disturbed estimate of the cost of each (a busy machine only adds)
+        best = min(min(c.values()) for c in costs)
         path = solver_path(cap.red[key])
         used.add(path)
-        mine = statistics.mean(c.get(path, min(c.values())) for c in costs)
+        mine = min(c.get(path, min(c.values())) for c in costs)
         iters += n
         total += n * best
         used_total += n * mine
@@ -297,6 +318,14 @@ def main(argv=None) -> int:
                 f"{paths}{extra}",
                 flush=True,
             )
+    limit = getattr(threads, "single_thread", None)
+    if limit is not None:  # the default BLAS limit of every simulating entry point
+        with threadpool_limits(2):
+            outer = _best(lambda: limit().__enter__() and limit().__exit__(None, None, None))
+            with limit():
+                inner = _best(lambda: limit().__enter__() and limit().__exit__(None, None, None))
+        print(f"single_thread(): {1e6 * outer:.1f} us outermost (BLAS 2 -> 1 -> 2 threads), "
+              f"{1e6 * inner:.2f} us nested")  # fmt: skip
     if not args.no_db and not args.only:
         wall, cpu, floor, n, ok = database()
         print(

@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from holofold.mechanics.assembly import BANDED_MAX_WORK, DENSE_MAX_DOF, Assembler
+from holofold.mechanics.assembly import BANDED_MAX_WORK, DENSE_MAX_DOF, Assembler, solver_path
 from holofold.mechanics.solvers import solve_newton
 from holofold.mechanics.springs import dihedral_angle
 from holofold.mechanics.structure import Structure
@@ -85,11 +85,7 @@ def _median_time(fn, repeat: int) -> tuple[float, float]:
 
 
 def _path(asm: Assembler) -> str:
-    nf = asm.free_dofs.size
-    if nf <= asm.dense_max:
-        return "dense"
-    _, bw, _, _ = asm.reduction.banded
-    return "banded" if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK else "superlu"
+    return solver_path(asm.reduction, asm.dense_max)
 
 
 def bench(name: str, s: Structure, repeat: int) -> str:
