@@ -96,7 +96,7 @@ def test_user_strip_from_a_csv_in_mm(tmp_path):
     assert cols["offset"].low == 0.05 and cols["offset"].high == 0.15
     assert cols["extrude"].low == cols["extrude"].high == 0.1  # fixed
     assert cols["tpanel"].low == 1e-3  # default range kept
-    curve = sc.evaluate.args[0].curve
+    curve = sc.shape.args[0].curve
     ref = builtin_curve("catenary", span=3.0, height=1.0)
     assert curve.length == pytest.approx(ref.length, rel=1e-4)  # mm read as mm
     row = {**ROW, "offset": 0.08}
@@ -111,7 +111,7 @@ def test_user_strip_from_a_csv_in_mm(tmp_path):
 
 def test_load_position_snaps_to_the_nearest_centre_line_vertex():
     sc = read_scenario(shipped_scenarios()["arch"])
-    setting = sc.evaluate.args[0]
+    setting = sc.shape.args[0]
     for m in (8, 12):
         assert loaded_node(setting, m, 0.5) == m  # the apex
         assert loaded_node(setting, m, 0.25) == m // 2  # a quarter of the half circle
@@ -145,7 +145,7 @@ def test_supports_choice_fixes_the_named_nodes(tmp_path):
     body = shipped_text("arch").replace('nodes = "ends"', 'nodes = "centre-ends"')
     body = body.replace('dofs = "xyz"', 'dofs = "xz"')
     sc = read_scenario(_user_file(tmp_path, body))
-    s, g, _ = strip_model(sc.evaluate.args[0], ROW)
+    s, g, _ = strip_model(sc.shape.args[0], ROW)
     fixed = np.flatnonzero(s.supports.any(axis=1))
     assert fixed.tolist() == [0, 2 * g.m]
     assert s.supports[fixed].tolist() == [[True, False, True]] * 2
@@ -294,3 +294,37 @@ def test_a_self_overlapping_strip_is_a_failed_row_not_a_number():
     assert out["status"].is_failed and "self-overlapping strip" in str(out["status"])
     assert all(math.isnan(out[c]) for c in ("Zstiff", "error", "mass"))
     assert get_scenario("arch").evaluate(bad)["status"].converged
+
+
+@pytest.mark.parametrize(
+    "name, change, match",
+    [("arch", {"m": 12.7}, "m = 12.7 must be an integer"), ("arch", {"m": 13}, "must be even"),
+     ("arch", {"offset": -0.1}, "offset = -0.1 must be"), ("arch", {"extrude": 0}, "extrude"),
+     ("arch", {"W": float("nan")}, "W = nan must be finite"), ("arch", {"tpanel": "2"}, "number"),
+     ("single-miura", {"gama": 60.0}, "give radians, not degrees"),
+     ("canopy", {"pattern": 3}, "pattern = 3")],
+)  # fmt: skip
+def test_scenario_evaluate_validates_the_row_itself(name, change, match):
+    """Called from Python, evaluate refuses what the runner refuses (it ran 12.7 as 12, gave
+    inf 'converged' for an angle in degrees)."""
+    base = {
+        "arch": ROW,
+        "single-miura": {"tcrease": 8e-4, "tpanel": 3e-3, "W": 2e-3, "gama": 1.2},
+        "canopy": {"pattern": 1, "m": 24, "n": 6, "tcrease": 8e-4, "tpanel": 3e-3, "W": 2e-3},
+    }[name]
+    with pytest.raises(ValueError, match=match) as err:
+        get_scenario(name).evaluate({**base, **change})
+    assert "\n" not in str(err.value) and str(err.value).startswith("invalid design")
+
+
+def test_a_non_finite_output_is_never_converged():
+    from holofold.design import Column, Scenario
+    from holofold.mechanics import CONVERGED
+
+    def evaluate(row):
+        return {"k": math.inf, "status": CONVERGED}
+
+    sc = Scenario("inf", "", (Column("a", "m", "", 0, 1),), (Column("k", "N/m"),),
+                  check=lambda r: [], evaluate=evaluate)  # fmt: skip
+    out = sc.evaluate({"a": 0.5})
+    assert not out["status"].converged and "non-finite k" in str(out["status"])

@@ -16,8 +16,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 
-__all__ = ["Column", "Scenario", "single_thread"]
+__all__ = ["Column", "Scenario", "single_thread", "check_row"]
 
 
 def single_thread():
@@ -95,10 +96,13 @@ class Scenario:
         Physical validity problems of one row (empty list if valid); run before any
         simulation.
     evaluate : callable(row) -> dict
-        Simulates one row; returns every performance column and ``status``.
+        Simulates one row; returns every performance column and ``status``. The scenario
+        wraps it so that every call validates the row first (:func:`check_row`: missing,
+        non-numeric or non-finite features, an angle above 2 pi rad, then ``check``), raising
+        one ValueError, and so that a non-finite output is never ``converged``.
     kind : str
         ``"strip"``, ``"sheet"`` or ``"gripper"`` for scenarios of those kinds (docs/scenarios.md
-        §6), else ``""``.
+        §8), else ``""``.
     setting : mapping
         The fixed setting in words and numbers (curve, material, supports, loads), for reports.
     source : str
@@ -129,6 +133,14 @@ class Scenario:
     write_files: Callable | None = None
     evaluate_batch: Callable[[list], list] | None = None
     batch_key: Callable[[Mapping[str, float]], object] | None = None
+
+    def __post_init__(self):
+        ev = self.evaluate
+        if isinstance(ev, partial) and ev.func is _validated_evaluate:
+            ev = ev.args[0]  # another scenario's wrapper: validate with this one's checks
+        wrapped = partial(_validated_evaluate, ev, self.check, self.features, self.name,
+                          tuple(c.name for c in self.performance))  # fmt: skip
+        object.__setattr__(self, "evaluate", wrapped)
 
     @property
     def feature_names(self) -> list[str]:
@@ -165,6 +177,53 @@ class Scenario:
             if w:
                 msgs.append(w)
         return msgs
+
+
+def check_row(features, check, row: Mapping, name: str = "scenario") -> list[str]:
+    """Problems of one design row: a missing, non-numeric or non-finite feature, an angle
+    (unit rad) above 2 pi (given in degrees?), then the scenario's own ``check``."""
+    problems = []
+    clean = dict(row)
+    for c in features:
+        v = row.get(c.name)
+        if v is None or (not c.required and _is_nan(v)):
+            if c.required:
+                problems.append(f"{c.name} is missing")
+            continue
+        if isinstance(v, bool) or not isinstance(v, (int, float)) and not hasattr(v, "__float__"):
+            problems.append(f"{c.name} = {v!r} is not a number")
+            continue
+        f = float(v)
+        if not math.isfinite(f):
+            problems.append(f"{c.name} = {v!r} must be finite")
+        elif c.unit == "rad" and abs(f) > 2 * math.pi:
+            problems.append(f"{c.name} = {f:g} rad is above 2 pi: give radians, not degrees")
+        clean[c.name] = f
+    if not problems:
+        problems = list(check(clean))
+    return problems
+
+
+def _validated_evaluate(evaluate, check, features, name, performance, row) -> dict:
+    problems = check_row(features, check, row, name)
+    if problems:
+        raise ValueError(f"invalid design for scenario {name!r}: " + "; ".join(problems))
+    out = evaluate(row)
+    status = out.get("status")
+    if status is not None and getattr(status, "converged", False):
+        bad = [c for c in performance if not _finite(out.get(c))]
+        if bad:
+            from holofold.mechanics.status import Status
+
+            out = {**out, "status": Status.not_converged(f"non-finite {', '.join(bad)}")}
+    return out
+
+
+def _finite(v) -> bool:
+    try:
+        return math.isfinite(float(v))
+    except (TypeError, ValueError):
+        return False
 
 
 def _is_nan(v) -> bool:
