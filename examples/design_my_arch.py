@@ -51,7 +51,7 @@ RESULT: dict = {}
 
 def my_arch():
     """The scenario object: the same problem as ``examples/my_arch.toml``."""
-    curve = read_points_csv(HERE / "data" / "catenary_span3m_mm.csv").scaled(1e-3)  # mm -> m
+    curve = read_points_csv(HERE / "data" / "catenary_span3m_mm.csv", units="mm")  # in m
     setting = StripSetting(
         curve=curve,
         loads=(
@@ -65,7 +65,8 @@ def my_arch():
         curve_label="catenary, span 3 m, rise 1.5 m (CSV in mm)",
     )
     ranges = {"m": (8, 10, 12, 16), "tpanel": (2e-3, 5e-3), "W": (2e-3, 4e-3),
-              "offset": (0.05, 0.20), "stripeWidth": (0.01, 0.03), "extrude": (0.05, 0.15)}  # fmt: skip
+              "offset": (0.05, 0.20), "stripeWidth": (0.01, 0.03),
+              "extrude": (0.05, 0.15)}  # fmt: skip
     features = tuple(
         replace(c, choices=tuple(map(float, ranges[c.name])))
         if c.name == "m"

@@ -59,7 +59,7 @@ from holofold.fitting import (
     read_svg_curve,
     strip_geometry,
 )
-from holofold.geometry import LENGTH_UNITS, length_factor
+from holofold.geometry import LENGTH_UNITS
 from holofold.geometry.errors import InvalidPatternError
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
@@ -458,18 +458,18 @@ def _read_curve(sec: Section) -> tuple[PlanarCurve, str, str | None]:
             label = key + "".join(f", {k} = {v:g}" for k, v in params.items())
             return curve, label, sampling
         unit = sec.choice("units", tuple(LENGTH_UNITS))
-        if unit is None:
-            raise sec.error(f"units = ... is required for a {given[0]} file; allowed: "
+        if unit is None and given[0] == "points":
+            raise sec.error("units = ... is required for a points file; allowed: "
                             + ", ".join(LENGTH_UNITS))  # fmt: skip
         file = sec.path(given[0])
         if given[0] == "points":
-            curve = read_points_csv(file)
-        else:
+            curve = read_points_csv(file, units=unit)
+        else:  # without units: the drawing's own (width/height units and viewBox)
             frag = sec.raw("svg").partition("#")[2]
-            curve = read_svg_curve(f"{file}#{frag}" if frag else file)
+            curve = read_svg_curve(f"{file}#{frag}" if frag else file, units=unit)
         sec.done(["svg" if given[0] == "svg" else "points", "units", "sampling"])
-        curve = curve.scaled(length_factor(unit))
-        return curve, f"{given[0]} from {file.name} ({unit})", sampling
+        shown = unit or "the drawing's units"
+        return curve, f"{given[0]} from {file.name} ({shown})", sampling
     except ValueError as exc:
         if str(exc).startswith(sec.where):
             raise
