@@ -90,7 +90,9 @@ def test_shipped_text_reads_back_as_toml_and_names_are_listed(capsys):
 def test_user_strip_from_a_csv_in_mm(tmp_path):
     _catenary_csv(tmp_path)
     sc = read_scenario(_user_file(tmp_path, CATENARY))
-    assert sc.performance_names == ["Vstiff", "Vsnap", "error", "closest_error", "mass"]
+    assert sc.performance_names == [
+        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance"
+    ]  # fmt: skip
     assert sc.categorical == ("m",)
     cols = {c.name: c for c in sc.features}
     assert cols["offset"].low == 0.05 and cols["offset"].high == 0.15
@@ -279,7 +281,9 @@ def test_evaluate_command_takes_a_scenario_file(tmp_path, capsys):
     import pandas as pd
 
     res = pd.read_csv(out)
-    assert list(res.columns[-6:]) == ["Vstiff", "Vsnap", "error", "closest_error", "mass", "status"]
+    assert list(res.columns[-8:]) == [
+        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance", "status"
+    ]  # fmt: skip
     direct = read_scenario(p).evaluate(ROW)
     assert math.isclose(res["Vstiff"][0], direct["Vstiff"], rel_tol=1e-12)
 
@@ -328,3 +332,20 @@ def test_a_non_finite_output_is_never_converged():
                   check=lambda r: [], evaluate=evaluate)  # fmt: skip
     out = sc.evaluate({"a": 0.5})
     assert not out["status"].converged and "non-finite k" in str(out["status"])
+
+
+def test_overlap_and_clearance_columns_say_whether_the_folded_part_can_be_built():
+    sc = read_scenario(shipped_scenarios()["arch"])
+    thick = {"m": 8, "tcrease": 9.4e-4, "tpanel": 5.07e-3, "W": 1.38e-3, "offset": 0.1,
+             "stripeWidth": 0.0206, "extrude": 0.1417}  # fmt: skip
+    a = sc.evaluate(thick)
+    b = sc.evaluate({**thick, "tpanel": 1e-3, "W": 4e-3})
+    assert a["overlap"] > 0 and b["overlap"] == 0.0  # thinner panels, wider hinge gaps
+    assert b["clearance"] > a["clearance"]
+    from holofold.geometry import printability
+
+    s, g, _ = strip_model(sc.shape.args[0], thick)
+    from holofold.geometry.pattern import CreasePattern
+
+    direct = printability(CreasePattern.from_faces(g.nodes, list(g.faces)), 5.07e-3, 1.38e-3)
+    assert a["overlap"] == direct.overlap and a["clearance"] == direct.clearance

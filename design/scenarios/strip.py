@@ -21,7 +21,14 @@ Columns, SI units:
 ``mass``
     density x (panel area x tpanel + hinge-strip area x (tcrease - tpanel)), kg: the flat
     sheet of panel thickness, thinned to the crease thickness over a strip of width W along
-    every fold line (the compliant crease the model represents).
+    every fold line (the compliant crease the model represents);
+``overlap``
+    volume where the folded thick panels (thickness tpanel, pulled back W/2 from the creases)
+    intersect, m^3 (0: the folded part can be built as designed);
+``clearance``
+    smallest gap between thick panels that share no vertex, m (negative where they run into
+    each other; 1000 m when every pair shares a vertex); see
+    :func:`holofold.geometry.printability`.
 
 The paper's arch (:mod:`~holofold.design.scenarios.arch`) is this kind with the half circle of
 radius 2 m, the six end nodes pinned and two 5 N loads at the apex.
@@ -59,7 +66,7 @@ from holofold.fitting import (
     read_svg_curve,
     strip_geometry,
 )
-from holofold.geometry import LENGTH_UNITS
+from holofold.geometry import LENGTH_UNITS, printability
 from holofold.geometry.errors import InvalidPatternError
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
@@ -184,6 +191,10 @@ class StripSetting:
         return self.sampling or self.curve.default_sampling
 
 
+#: clearance reported when no two panels are apart (every pair shares a vertex), m
+_NO_NEIGHBOUR = 1e3
+
+
 def strip_columns(setting: StripSetting, extras: bool = True) -> tuple[Column, ...]:
     """Performance columns of a setting: per load ``stiff`` (and ``snap``), then ``error``
     (and, with ``extras``, ``closest_error`` and ``mass``)."""
@@ -204,6 +215,8 @@ def strip_columns(setting: StripSetting, extras: bool = True) -> tuple[Column, .
     if extras:
         cols.append(Column("closest_error", "m", "mean closest-point distance to the curve"))
         cols.append(Column("mass", "kg", "mass of the strip (panels and hinge strips)"))
+        cols.append(Column("overlap", "m^3", "volume where the folded thick panels intersect"))
+        cols.append(Column("clearance", "m", "smallest gap between panels sharing no vertex"))
     return tuple(cols)
 
 
@@ -297,17 +310,20 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
     bit for bit the design's own."""
     outs: list = [None] * len(rows)
     models = []
+    printable = {}
     for i, row in enumerate(rows):
         s, g, err = strip_model(setting, row)
-        if setting.refuse_overlap:
+        if setting.refuse_overlap or "overlap" in columns:
             try:
-                CreasePattern.from_faces(g.nodes, list(g.faces))
+                pattern = CreasePattern.from_faces(g.nodes, list(g.faces))
             except InvalidPatternError as exc:
                 outs[i] = {
                     **dict.fromkeys(columns, float("nan")),
                     "status": Status.failed(f"self-overlapping strip: {exc}"),
                 }
                 continue
+            if "overlap" in columns:
+                printable[i] = printability(pattern, float(row["tpanel"]), float(row["W"]))
         models.append((i, s, g, err))
     if not models:
         return outs
@@ -345,6 +361,9 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
             ).mean
         if "mass" in columns:
             out["mass"] = _mass(setting, g, rows[i])
+        if i in printable:
+            out["overlap"] = printable[i].overlap
+            out["clearance"] = min(printable[i].clearance, _NO_NEIGHBOUR)
         out = {c: out[c] for c in columns}
         out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
         outs[i] = out
