@@ -32,7 +32,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],
         "miura": ["miura_cell", "miura_sheet", "miura_sheet_paper", "miura_nodes", "miura_faces"],
         "outputs": ["check_output_path", "atomic_write", "write_text", "write_json"],
-        "pattern": ["CreasePattern", "ASSIGNMENTS"],
+        "pattern": ["CreasePattern", "ASSIGNMENTS", "non_simple_faces"],
         "printable": [
             "PrintableLayout",
             "printable_layout",

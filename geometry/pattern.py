@@ -34,6 +34,7 @@ from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternErro
 __all__ = [
     "ASSIGNMENTS",
     "CreasePattern",
+    "non_simple_faces",
     "reference_edges",
     "orient_faces",
     "measure_fold_angles",
@@ -272,6 +273,16 @@ def _check_simple(t: _FaceTable, pts2d: np.ndarray) -> np.ndarray:
         hit = _segments_cross(P[:, i], Q[:, i], P[:, j], Q[:, j]).any(axis=1)
         bad.append(idx[hit])
     return np.sort(np.concatenate(bad)) if bad else np.zeros(0, np.int64)
+
+
+def non_simple_faces(coords, faces) -> np.ndarray:
+    """Ids of the faces that are not simple polygons (two of their sides cross) in their own
+    best-fit plane: the check :meth:`CreasePattern.from_faces` makes, alone and vectorised.
+
+    ``coords`` (n, 3) m; ``faces`` a sequence of vertex-id arrays (or an (nf, k) array).
+    """
+    t = _FaceTable(_as_faces(faces))
+    return _check_simple(t, _corner_points_2d(np.asarray(coords, float), t))
 
 
 def _corner_points_2d(coords: np.ndarray, t: _FaceTable) -> np.ndarray:

@@ -66,8 +66,7 @@ from holofold.fitting import (
     read_svg_curve,
     strip_geometry,
 )
-from holofold.geometry import LENGTH_UNITS, printability
-from holofold.geometry.errors import InvalidPatternError
+from holofold.geometry import LENGTH_UNITS, non_simple_faces, printability
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
@@ -313,17 +312,19 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
     printable = {}
     for i, row in enumerate(rows):
         s, g, err = strip_model(setting, row)
-        if setting.refuse_overlap or "overlap" in columns:
-            try:
-                pattern = CreasePattern.from_faces(g.nodes, list(g.faces))
-            except InvalidPatternError as exc:
-                outs[i] = {
-                    **dict.fromkeys(columns, float("nan")),
-                    "status": Status.failed(f"self-overlapping strip: {exc}"),
-                }
-                continue
-            if "overlap" in columns:
-                printable[i] = printability(pattern, float(row["tpanel"]), float(row["W"]))
+        bad = non_simple_faces(g.nodes, g.faces) if setting.refuse_overlap else ()
+        if len(bad):
+            outs[i] = {
+                **dict.fromkeys(columns, float("nan")),
+                "status": Status.failed(
+                    f"self-overlapping strip: panel {int(bad[0])} = {g.faces[bad[0]].tolist()} "
+                    "is not a simple polygon (its sides cross)"
+                ),
+            }
+            continue
+        if "overlap" in columns:
+            pattern = CreasePattern.from_faces(g.nodes, list(g.faces))
+            printable[i] = printability(pattern, float(row["tpanel"]), float(row["W"]))
         models.append((i, s, g, err))
     if not models:
         return outs
