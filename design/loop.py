@@ -41,6 +41,7 @@ from holofold.design.tables import ColumnRoles, write_table
 from holofold.design.targets import parse_target
 from holofold.design.verify import Verification, rule_mask, rule_ranges
 from holofold.geometry.outputs import write_json
+from holofold.geometry.units import length_factor
 from holofold.mechanics.status import converged_mask, failed_mask
 
 __all__ = ["run_design", "DesignOutcome", "refine_designs", "choose_design", "STAGES"]
@@ -286,6 +287,7 @@ def run_design(
     workers: int = 1,
     progress: bool | None = None,
     files: bool = True,
+    mesh_units: str = "mm",
     say: Callable[[str], None] = lambda text: None,
 ) -> DesignOutcome:
     """Run the design loop (module docstring) into ``folder``; resumable.
@@ -317,6 +319,8 @@ def run_design(
         Worker processes for the simulations.
     files : bool
         Write the chosen design's fabrication files, pictures and the report page.
+    mesh_units : {"mm", "m"}
+        Length unit of the mesh files (STL, OBJ); FOLD stays in m, SVG in mm.
     say : callable
         Receives one line of progress per stage.
     """
@@ -333,6 +337,7 @@ def run_design(
             f"verify); at most {MAX_SAMPLES:,} in one run"
         )
     workers = check_workers(workers)
+    length_factor(mesh_units)
     out = Path(folder)
     dbf = Path(db) if db is not None else out / "database"
     roles = _roles(sc)
@@ -454,7 +459,7 @@ def run_design(
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             summary["files"], summary["images"] = _write_files(
-                sc, row, out, mined, rule, table, tgt
+                sc, row, out, mined, rule, table, tgt, mesh_units
             )
         summary["warnings"] = list(dict.fromkeys(str(w.message) for w in caught))
         for w in summary["warnings"]:
@@ -498,7 +503,9 @@ def _scenario_summary(sc: Scenario) -> dict:
     }
 
 
-def _write_files(sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt):
+def _write_files(
+    sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt, mesh_units: str
+):
     from holofold.design.report import (
         plot_folded_design,
         plot_rule_boxes,
@@ -509,7 +516,7 @@ def _write_files(sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt)
     files, images = {}, {}
     design = {c.name: float(row[c.name]) for c in sc.features if c.name in row}
     if sc.write_files is not None:
-        for label, p in sc.write_files(design, out / "files").items():
+        for label, p in sc.write_files(design, out / "files", units=mesh_units).items():
             files[label] = os.path.relpath(p, out)
     if sc.shape is not None:
         pat = sc.shape(design)

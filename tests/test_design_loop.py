@@ -167,6 +167,9 @@ def test_design_loop_on_a_users_curve_writes_a_verified_design(designed):
         assert (folder / "out" / f).is_file(), f
     for label, rel in s["files"].items():
         assert (folder / "out" / rel).is_file(), label
+    assert (folder / "out" / "files" / "printable.stl").is_file()
+    with open(folder / "out" / "files" / "strip.stl", "rb") as fh:
+        assert b"mm" in fh.read(80)  # meshes in mm by default, as slicers read them
     stages = [line.split("]")[0] + "]" for line in said if line.startswith("[")]
     assert stages[:3] == ["[database]", "[mine]", "[verify]"] and "[refine]" in stages
     assert stages[-2:] == ["[choose]", "[files]"]

@@ -191,7 +191,10 @@ def test_user_sheet_shape_and_files(tmp_path):
     assert p.n_faces == 12 * 6 and p.meta["ext"] == 0.8  # the least folded state
     assert np.ptp(p.coords[:, 0]) == pytest.approx(0.3 * 0.8 * math.sin(math.radians(60)))
     files = sc.write_files(row, tmp_path / "out")
-    assert set(files) == {"pattern.fold", "pattern.svg", "folded.stl", "folded.obj", "thick.stl"}
+    assert set(files) == {"pattern.fold", "pattern.svg", "folded.stl", "folded.obj", "thick.stl",
+                          "printable.stl", "printable_folded.stl"}  # fmt: skip
+    with open(files["folded.stl"], "rb") as fh:
+        assert b"mm" in fh.read(80)  # the STL header states the unit
     assert all(f.is_file() and f.stat().st_size > 0 for f in files.values())
     # 6 mm panels folded to 0.3 overlap: every file but the thick solid, and a warning
     text = USER_SHEET.format(E=2e9, force=3.0).replace("[0.5, 0.8]", "[0.3]")

@@ -60,12 +60,14 @@ def gripper_shape(row) -> CreasePattern:
     return gripper_pattern(int(round(row["Pattern"])), row["L1"], row["L2"], row["rate"]).pattern
 
 
-def write_gripper_files(row, folder) -> dict:
+def write_gripper_files(row, folder, units: str = "mm") -> dict:
     """FOLD, SVG (cut and score lines), STL/OBJ and the thick solid of the flat gripper
-    (:func:`~holofold.geometry.export_pattern_files`). Returns label -> path."""
+    (:func:`~holofold.geometry.export_pattern_files`; meshes in ``units``). Returns label ->
+    path."""
     paths = export_pattern_files(
-        gripper_shape(row), folder, thickness=float(row["tpanel"]), crease_width=float(row["W"])
-    )
+        gripper_shape(row), folder, thickness=float(row["tpanel"]), crease_width=float(row["W"]),
+        units=units,
+    )  # fmt: skip
     return {p.name: p for p in paths}
 
 

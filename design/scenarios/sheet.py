@@ -458,20 +458,26 @@ def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreaseP
     )
 
 
-def write_sheet_files(setting: SheetSetting, row, folder, ext: float | None = None) -> dict:
-    """FOLD, SVG (cut and score lines), STL/OBJ of the sheet folded as :func:`sheet_shape` and
-    its thick solid (:func:`~holofold.geometry.export_pattern_files`); if the thick panels
-    overlap too much in that state, every file but ``thick.stl``, with a warning saying why.
+def write_sheet_files(
+    setting: SheetSetting, row, folder, ext: float | None = None, units: str = "mm"
+) -> dict:
+    """FOLD, SVG (cut and score lines), STL/OBJ of the sheet folded as :func:`sheet_shape`, its
+    thick solid and printable part (:func:`~holofold.geometry.export_pattern_files`; meshes in
+    ``units``); if the thick panels overlap too much in that state, every file but the solids,
+    with a warning saying why.
 
     Returns label -> path (the labels name the files).
     """
     shape = sheet_shape(setting, row, ext)
     W = float(row["W"])
     try:
-        paths = export_pattern_files(shape, folder, thickness=float(row["tpanel"]), crease_width=W)
+        paths = export_pattern_files(
+            shape, folder, thickness=float(row["tpanel"]), crease_width=W,
+            crease_thickness=float(row["tcrease"]), units=units,
+        )  # fmt: skip
     except DegenerateGeometryError as exc:
         warnings.warn(f"no thick.stl: {exc}", stacklevel=2)
-        paths = export_pattern_files(shape, folder, crease_width=W)
+        paths = export_pattern_files(shape, folder, crease_width=W, units=units)
     return {p.name: p for p in paths}
 
 

@@ -39,6 +39,10 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--top", type=int, default=3, help="rules kept and verified per round")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    p.add_argument(
+        "--units", choices=("mm", "m"), default="mm",
+        help="length unit of the STL/OBJ files (default mm, as slicers read them)",
+    )  # fmt: skip
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     return p
 
@@ -49,7 +53,7 @@ def run(args) -> int:
     run_design(
         args.scenario, args.target, args.output, samples=args.samples, rounds=args.rounds,
         refine=args.refine, verify=args.verify, top=args.top, db=args.db, seed=args.seed,
-        workers=args.workers, progress=False if args.no_progress else None,
+        workers=args.workers, progress=False if args.no_progress else None, mesh_units=args.units,
         say=lambda text: print(text, flush=True),
     )  # fmt: skip
     return 0
