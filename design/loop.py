@@ -529,6 +529,7 @@ def _write_files(
     X = mined.table[list(mined.features)]
     units = {c.name: c.unit for c in (*sc.features, *sc.performance)}
     fig = plot_rule_boxes(mined.miner, X, rule["rank"] - 1, units=units)
+    fig.tight_layout()  # long feature names stay inside the picture
     save_figure(fig, out / "rule.png")
     images["rule"] = "rule.png"
     cols = list(tgt.columns)

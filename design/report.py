@@ -194,6 +194,13 @@ def plot_rule_boxes(
         c = 1.0 if not math.isfinite(b[1]) else np.clip((b[1] - lo) / span, 0, 1)
         ax.barh(yk, c - a, left=a, height=0.5, color="tab:blue", alpha=0.7)
         u = units.get(name, "")
+        # the rule's thresholds, in the feature's unit, on the shaded bar
+        if b is not None and math.isfinite(b[0]):
+            ax.text(a, yk + 0.3, f"> {b[0] * s:.4g}", ha="left", va="bottom", fontsize=6.5,
+                    color="tab:blue")  # fmt: skip
+        if b is not None and math.isfinite(b[1]):
+            ax.text(c, yk + 0.3, f"<= {b[1] * s:.4g}", ha="right", va="bottom", fontsize=6.5,
+                    color="tab:blue")  # fmt: skip
         ax.text(-0.02, yk, f"{lo * s:.3g}", ha="right", va="center", fontsize=7)
         ax.text(1.02, yk, f"{hi * s:.3g} {u}".rstrip(), ha="left", va="center", fontsize=7)
     ax.set_yticks(range(len(names)))

@@ -304,3 +304,16 @@ def test_a_rare_target_is_refined_around_its_hits_before_any_rule_exists(tmp_pat
     with pytest.raises(ValueError, match="try more --rounds"):
         run_design(cheap, "double > 1.94", tmp_path / "p", samples=100, verify=5,
                    workers=1, progress=False, files=False)  # fmt: skip
+
+
+def test_the_rule_box_chart_shows_the_rules_thresholds():
+    from holofold.design import ForestRuleMiner, plot_rule_boxes
+
+    rng = np.random.default_rng(0)
+    X = pd.DataFrame({"a": rng.uniform(0, 1, 400), "b": rng.uniform(0, 1, 400)})
+    y = (X["a"] > 0.6).to_numpy()
+    miner = ForestRuleMiner(n_estimators=20, random_state=0).fit(X, y)
+    fig = plot_rule_boxes(miner, X, 0, units={"a": "m", "b": "m"})
+    texts = [t.get_text() for t in fig.axes[0].texts]
+    lo = miner.rule_bounds(0)[0][0]
+    assert f"> {lo:.4g}" in texts and any(t.endswith(" m") for t in texts)
