@@ -56,12 +56,13 @@ def _column_ids(m: int, n: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
     return A, B
 
 
-def tmp_nodes(m: int, n: int, L: float, ext: float) -> np.ndarray:
+def tmp_nodes(m: int, n: int, L: float, ext: float, L_y: float | None = None) -> np.ndarray:
     """Node coordinates of the folded TMP sheet, (tmp_node_count(m, n), 3), metres.
 
-    No validation (see :func:`tmp_sheet`).
+    ``L`` is the sheet's size along x and, unless ``L_y`` is given, along y (the paper's
+    square). No validation (see :func:`tmp_sheet`).
     """
-    a, b = L / n, L / m
+    a, b = (L if L_y is None else L_y) / n, L / m
     delta = b * math.sqrt(1.0 - ext**2)
     theta = math.atan(2.0 * delta / a)
     zs, ys = a * math.sin(2.0 * theta), a * math.cos(2.0 * theta)

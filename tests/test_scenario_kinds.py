@@ -16,7 +16,6 @@ import pytest
 
 from holofold.design.scenarios import get_scenario
 from holofold.design.scenarios.files import ScenarioFileError, read_scenario, shipped_text
-from holofold.design.scenarios.sheet import _tmp_nodes_xy
 from holofold.geometry.tmp import tmp_nodes
 
 pytestmark = pytest.mark.filterwarnings("ignore::RuntimeWarning")
@@ -206,8 +205,8 @@ def test_user_sheet_shape_and_files(tmp_path):
 
 def test_rectangular_tmp_nodes_repeat_the_geometry_formulas():
     for m, n, L, ext in [(24, 6, 0.2, 0.3), (30, 12, 0.2, 0.9), (4, 3, 1.0, 0.55)]:
-        assert np.array_equal(_tmp_nodes_xy(m, n, L, L, ext), tmp_nodes(m, n, L, ext))
-    X = _tmp_nodes_xy(4, 3, 0.4, 0.2, 1.0)  # flat: the footprint
+        assert np.array_equal(tmp_nodes(m, n, L, ext, L), tmp_nodes(m, n, L, ext))
+    X = tmp_nodes(4, 3, 0.4, 1.0, 0.2)  # flat: the footprint
     assert np.ptp(X[:, 0]) == pytest.approx(0.4) and np.ptp(X[:, 1]) == pytest.approx(0.2)
     assert np.abs(X[:, 2]).max() == 0.0
 

@@ -58,7 +58,7 @@ from holofold.geometry import export_pattern_files
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.miura import miura_faces, miura_nodes, miura_sheet, rigid_fold_pattern
 from holofold.geometry.pattern import CreasePattern
-from holofold.geometry.tmp import tmp_faces, tmp_node_count, tmp_nodes
+from holofold.geometry.tmp import tmp_faces, tmp_nodes
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
 from holofold.mechanics.compat import PAPER
@@ -252,36 +252,8 @@ def _topology(pattern: int, m: int, n: int) -> CreasePattern:
 
 def _tmp_nodes(m: int, n: int, size_x: float, size_y: float, ext: float) -> np.ndarray:
     """TMP nodes with b = size_x/m, a = size_y/n, (nv, 3) m: those of
-    :func:`holofold.geometry.tmp.tmp_nodes` for a square, :func:`_tmp_nodes_xy` otherwise."""
-    if size_x == size_y:
-        return tmp_nodes(m, n, size_x, ext)
-    return _tmp_nodes_xy(m, n, size_x, size_y, ext)
-
-
-def _tmp_nodes_xy(m: int, n: int, size_x: float, size_y: float, ext: float) -> np.ndarray:
-    """:func:`holofold.geometry.tmp.tmp_nodes` with a = size_y/n, b = size_x/m instead of L/n,
-    L/m (the same operations: bit for bit the same nodes for a square)."""
-    a, b = size_y / n, size_x / m
-    delta = b * math.sqrt(1.0 - ext**2)
-    theta = math.atan(2.0 * delta / a)
-    zs, ys = a * math.sin(2.0 * theta), a * math.cos(2.0 * theta)
-    p = a + 2.0 * ys
-    y0 = p * np.arange(n // 3)
-    ones = np.ones(n // 3)
-    ya = np.append(np.column_stack([y0, ys + y0, (a + ys) + y0]).ravel(), p + p * (n // 3 - 1))
-    za = np.append(
-        np.column_stack([(zs + delta) * ones, delta * ones, delta * ones]).ravel(), zs + delta
-    )
-    yb = np.column_stack([a / 2 + y0, (a / 2 + ys) + y0, (a / 2 + 2 * ys) + y0]).ravel()
-    zb = np.column_stack([zs * ones, 0.0 * ones, zs * ones]).ravel()
-    X = np.zeros((tmp_node_count(m, n), 3))
-    blk = 2 * n + 1
-    for i in range(m // 2 + 1):
-        X[i * blk + np.arange(n + 1)] = np.column_stack([np.full(n + 1, b * ext * (2 * i)), ya, za])
-    for i in range(m // 2):
-        x = np.full(n, b * ext * (2 * i) + b * ext)
-        X[i * blk + n + 1 + np.arange(n)] = np.column_stack([x, yb, zb])
-    return X
+    :func:`holofold.geometry.tmp.tmp_nodes` (with its ``L_y`` for a rectangle)."""
+    return tmp_nodes(m, n, size_x, ext, None if size_x == size_y else size_y)
 
 
 def _miura_sides(setting: SheetSetting, m: int, n: int, gamma: float) -> tuple[float, float]:
