@@ -503,9 +503,7 @@ def _scenario_summary(sc: Scenario) -> dict:
     }
 
 
-def _write_files(
-    sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt, mesh_units: str
-):
+def _write_files(sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt, mesh_units: str):
     from holofold.design.report import (
         plot_folded_design,
         plot_rule_boxes,
