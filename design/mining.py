@@ -11,11 +11,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pandas as pd
 
-from holofold.design.evaluation import HoldoutResult, holdout, split_indices
+from holofold.design.evaluation import (
+    HoldoutResult,
+    feature_dependence,
+    holdout,
+    split_indices,
+)
 from holofold.design.rules import ForestRuleMiner
 from holofold.design.tables import ColumnRoles
 from holofold.design.targets import Target, parse_target
@@ -63,6 +69,28 @@ class MinedRules:
         cols = ["test_precision", "test_recall", "test_support", "test_true_positives"]
         frame = self.holdout.rules[cols]
         return frame.rename(columns=lambda c: c.removeprefix("test_")).reset_index(drop=True)
+
+    @property
+    def estimates(self) -> pd.DataFrame:
+        """Each rule's estimate with the held-out rows added to its evidence (best first)."""
+        return self.miner.rule_estimates(self.test_scores)
+
+    @cached_property
+    def dependence(self) -> pd.DataFrame:
+        """Which features the target depends on, tested on the held-out rows.
+
+        :func:`holofold.design.evaluation.feature_dependence` of the fitted forest on the test
+        split: one row per feature with ``importance``, ``p_value`` and ``depends``.
+        """
+        test = self.holdout.test_index
+        X = self.table[list(self.features)].iloc[test]
+        return feature_dependence(self.miner, X, self.meets[test], random_state=0)
+
+    @property
+    def independent_features(self) -> tuple[str, ...]:
+        """The features the target shows no dependence on (see :attr:`dependence`)."""
+        d = self.dependence
+        return tuple(d.loc[~d["depends"], "feature"])
 
 
 def select_features(

@@ -62,7 +62,8 @@ def rules_to_text(
     ----------
     miner : fitted ForestRuleMiner
     test : DataFrame, optional
-        Test metrics per rule (``precision``, ``recall``, ``support``).
+        Held-out metrics per rule (``evaluation.rule_scores``: ``precision``, ``recall``,
+        ``support``, ``true_positives``); its rows also join the estimate's evidence.
     scale, units : dict, optional
         Display factor and unit per feature, e.g. ``{"W": 1e3}``, ``{"W": "mm"}``.
     digits : int, default=4
@@ -73,6 +74,8 @@ def rules_to_text(
             f"no rule reaches precision >= {miner.precision_min} with support >= "
             f"{miner.min_support} ({miner.n_candidates_} candidate boxes)"
         )
+    oob = rules["estimate_support"].to_numpy()
+    est = miner.rule_estimates(None if test is None else test.reset_index(drop=True))
     lines = []
     for i, row in rules.iterrows():
         text = format_rule(
@@ -84,14 +87,21 @@ def rules_to_text(
             units=units,
         )
         lines.append(f"rule {i + 1}: {text}")
+        e = est.iloc[i]
+        held = int(e["estimate_support"] - oob[i])
+        rows = f"{int(oob[i])} out-of-bag" + (f" + {held} held-out" if test is not None else "")
         lines.append(
-            f"    train: precision {row['precision']:.3f}  recall {row['recall']:.3f}  "
+            f"    estimate: precision {e['estimate']:.3f} (95 % interval "
+            f"{e['estimate_low']:.3f}-{e['estimate_high']:.3f}; from {rows} rows)"
+        )
+        lines.append(
+            f"    train:    precision {row['precision']:.3f}  recall {row['recall']:.3f}  "
             f"support {int(row['support'])}"
         )
         if test is not None:
             t = test.iloc[i]
             lines.append(
-                f"    test:  precision {t['precision']:.3f}  recall {t['recall']:.3f}  "
+                f"    held-out: precision {t['precision']:.3f}  recall {t['recall']:.3f}  "
                 f"support {int(t['support'])}"
             )
     if len(rules) < miner.n_rules:
@@ -118,8 +128,15 @@ def mining_summary(mined, source: str) -> str:
         f"split:    {len(h.train_index)} train / {len(h.test_index)} test rows "
         f"(seed {m.random_state}); {m.n_candidates_} candidate boxes, "
         f"{len(m.candidate_rules_)} pass the filters",
-        rules_to_text(m, mined.test_scores),
     ]
+    if len(h.test_index) >= 2:
+        free = mined.independent_features
+        lines.append(
+            "the target does not depend on: "
+            + (", ".join(free) if free else "(it depends on every feature)")
+            + " (held-out permutation test of the forest, 5 %)"
+        )
+    lines.append(rules_to_text(m, mined.test_scores))
     return "\n".join(lines)
 
 

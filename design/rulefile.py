@@ -2,10 +2,16 @@
 
 One record per rule, best first::
 
-    {"rank": 1, "rule": "W <= 0.0021 & m in {16, 24}",
+    {"rank": 1, "rule": "W <= 0.0021 and m in {16, 24}",
      "bounds": {"W": {"gt": null, "le": 0.0021}, "m": {"in": [16, 24]}},
+     "estimate": {"precision": .., "interval": [.., ..], "rows": ..},
      "train": {"precision": .., "recall": .., "support": .., "oob_precision": ..},
      "test": {"precision": .., "recall": .., "support": ..}}
+
+``estimate`` is the precision the rule is expected to have on new designs, with its 95 %
+interval and the rows behind it: training rows out of bag for the trees that found the rule and,
+when test scores are given, the held-out rows inside it (docs/rule-miner.md section 9);
+``train`` are the training rows, ``test`` the held-out rows.
 
 ``bounds`` constrains each feature by an interval ``gt < x <= le`` (null for an open side) or
 a set of categorical levels ``in``; values are SI. :func:`rules_to_records` makes the records
@@ -39,9 +45,13 @@ def rules_to_records(miner: ForestRuleMiner, test: pd.DataFrame | None = None) -
     """The kept rules, best first, as JSON-ready dicts.
 
     Each has ``rule`` (text), ``bounds`` (per constrained feature ``{"gt": .., "le": ..}``
-    with null for an open side, or ``{"in": [levels]}``), ``train`` (precision, recall,
-    support) and, when ``test`` is given, ``test``.
+    with null for an open side, or ``{"in": [levels]}``), ``estimate`` (``precision``, its
+    95 % ``interval``, the ``rows`` behind it: ``out_of_bag_rows`` plus ``held_out_rows``, the
+    latter from ``test``), ``train`` (precision, recall, support, oob_precision) and, when
+    ``test`` is given (``evaluation.rule_scores`` of held-out rows), ``test``.
     """
+    oob = miner.rules_["estimate_support"].to_numpy()
+    est = miner.rule_estimates(None if test is None else test.reset_index(drop=True))
     out = []
     for i, row in miner.rules_.iterrows():
         bounds = {}
@@ -56,14 +66,20 @@ def rules_to_records(miner: ForestRuleMiner, test: pd.DataFrame | None = None) -
             "rank": int(i) + 1,
             "rule": row["rule"],
             "bounds": bounds,
+            "estimate": {
+                "precision": float(est.loc[i, "estimate"]),
+                "interval": [float(est.loc[i, "estimate_low"]), float(est.loc[i, "estimate_high"])],
+                "rows": int(est.loc[i, "estimate_support"]),
+                "out_of_bag_rows": int(oob[i]),
+                "held_out_rows": int(est.loc[i, "estimate_support"] - oob[i]),
+            },
             "train": {
                 "precision": float(row["precision"]),
                 "recall": float(row["recall"]),
                 "support": int(row["support"]),
             },
         }
-        if "oob_precision" in row:
-            rec["train"]["oob_precision"] = float(row["oob_precision"])
+        rec["train"]["oob_precision"] = float(row["oob_precision"])
         if test is not None:
             t = test.iloc[i]
             rec["test"] = {

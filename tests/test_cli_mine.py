@@ -20,9 +20,14 @@ def test_mine_prints_the_summary_and_writes_strict_json(reference_data, tmp_path
     text = capsys.readouterr().out
     assert "met by 70 rows, 7.0 %" in text
     assert "600 train / 400 test rows (seed 2)" in text
-    assert text.count("    train: precision") == 3 and text.count("    test:  precision") == 3
+    assert text.count("    train:    precision") == 3 and text.count("    held-out: precision") == 3
+    assert text.count("    estimate: precision") == 3 and "95 % interval" in text
+    assert "the target does not depend on: " in text
     recs = read_rules(out)
     assert [r["rank"] for r in recs] == [1, 2, 3]
+    for r in recs:
+        lo, hi = r["estimate"]["interval"]
+        assert 0 <= lo <= r["estimate"]["precision"] <= hi <= 1 and r["estimate"]["rows"] > 0
     assert "axialstiff60" not in json.dumps([r["bounds"] for r in recs])
     assert "NaN" not in out.read_text() and "Infinity" not in out.read_text()
 
@@ -123,3 +128,26 @@ def test_headerless_txt_needs_columns(tmp_path, capsys):
     )
     assert rc == 0
     assert "rule 1:" in capsys.readouterr().out
+
+
+def test_the_papers_method_stays_selectable(reference_data, tmp_path, capsys):
+    """--scoring train --ranking fbeta is the paper's method: its ranking (the default) on
+    leaf bounds that are not tightened."""
+    from holofold.design import ForestRuleMiner, holdout, parse_target
+
+    db = reference_data.path("data0_SingleMiura")
+    out = tmp_path / "paper.json"
+    argv = ["mine", str(db), "--target", "axialstiff60 < 6000", "--seed", "1", "--json", str(out)]
+    assert main([*argv, "--scoring", "train", "--ranking", "fbeta"]) == 0
+    df = reference_data.load("data0_SingleMiura")
+    ref = holdout(
+        ForestRuleMiner(tighten=False),
+        df[["tcrease", "tpanel", "W", "gama"]],
+        parse_target("axialstiff60 < 6000").evaluate(df),
+        random_state=1,
+    )
+    assert ref.miner.get_params()["beta"] == 0.2
+    assert [r["rule"] for r in read_rules(out)] == ref.rules["rule"].tolist()
+    assert main(argv) == 0  # the default: the same ranking, bounds tightened
+    assert [r["rule"] for r in read_rules(out)] != ref.rules["rule"].tolist()
+    capsys.readouterr()
