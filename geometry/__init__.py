@@ -18,7 +18,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "check_range",
         ],
         "export": ["export", "export_pattern_files", "EXPORT_TYPES"],
-        "fold_io": ["export_fold", "fold_dict", "load_fold", "FoldWarning"],
+        "fold_io": ["export_fold", "fold_dict", "load_fold", "read_fold", "FoldWarning"],
         "gripper": [
             "GripperPattern",
             "gripper_pattern",
@@ -32,7 +32,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],
         "miura": ["miura_cell", "miura_sheet", "miura_sheet_paper", "miura_nodes", "miura_faces"],
         "outputs": ["check_output_path", "atomic_write", "write_text", "write_json"],
-        "pattern": ["CreasePattern", "ASSIGNMENTS", "non_simple_faces"],
+        "pattern": ["CreasePattern", "ASSIGNMENTS", "MAX_PANELS", "non_simple_faces"],
         "printable": [
             "PrintableLayout",
             "printable_layout",

@@ -18,15 +18,28 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 from typing import Any
 
 import numpy as np
 
 from holofold.geometry.errors import FormatError
-from holofold.geometry.pattern import ASSIGNMENTS, CreasePattern
+from holofold.geometry.pattern import ASSIGNMENTS, MAX_PANELS, CreasePattern
 
-__all__ = ["fold_dict", "export_fold", "load_fold", "FoldWarning"]
+__all__ = [
+    "fold_dict",
+    "export_fold",
+    "load_fold",
+    "read_fold",
+    "FoldWarning",
+    "MAX_FOLD_BYTES",
+    "MAX_FOLD_FACES",
+    "MAX_FOLD_VERTICES",
+    "MAX_FOLD_EDGES",
+    "MAX_NESTING",
+    "PLANAR_TOL",
+]
 
 _SPEC_KEYS = {
     "file_spec", "file_creator", "file_author", "file_title", "file_description",
@@ -138,42 +151,257 @@ def export_fold(pattern: CreasePattern, **kw) -> str:
     return json.dumps(fold_dict(pattern, **kw), indent=1)
 
 
+#: the largest FOLD file read (bytes): a 100 x 100 Miura sheet written by holofold is 2.8 MB
+MAX_FOLD_BYTES = 64 * 2**20
+#: at most this many faces (the pattern limit), vertices and edges (a planar graph has
+#: fewer than three edges per vertex)
+MAX_FOLD_FACES = MAX_PANELS
+MAX_FOLD_VERTICES = 4 * MAX_PANELS
+MAX_FOLD_EDGES = 3 * MAX_FOLD_VERTICES
+#: the deepest nesting of arrays and objects: FOLD arrays nest 2-3 deep (5 in file_frames);
+#: Python's json module recurses per level and fails near 1000
+MAX_NESTING = 64
+#: a face with a vertex farther than this fraction of the face's size (its largest vertex
+#: distance) from its least-squares plane is refused in a 3-D frame: a square saddle whose
+#: corners alternate by 0.57 of its side. Fitted strips' folded quads are warped: the
+#: published arch strips reach 0.020, the most warped of 360 fits swept over m 4-100, offset
+#: 0.05-0.8, width 0.02-0.3 and extrude 0.05-0.4 0.139. A crease pattern must be flat to 1e-6
+#: of its size.
+PLANAR_TOL = 0.2
+_FLAT_TOL = 1e-6
+
+_STRING = re.compile(r'"(?:[^"\\]|\\.)*+"', re.S)
+_KEY = re.compile(r'"((?:[^"\\]|\\.)*+)"\s*:', re.S)
+_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "in": 0.0254,
+          "pt": 0.0254 / 72, "unit": 1.0}  # fmt: skip
+
+
+class _Bad(Exception):
+    """A problem found while reading; :func:`load_fold` adds the file's name."""
+
+
 def _fail(msg: str):
-    raise FormatError(f"FOLD: {msg}")
+    raise _Bad(msg)
+
+
+def _show(value, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _kind(value) -> str:
+    names = {dict: "an object", list: "an array", str: "a string", bool: "a boolean",
+             int: "an integer", float: "a number", type(None): "null"}  # fmt: skip
+    return names.get(type(value), type(value).__name__)
+
+
+def _check_nesting(text: str) -> None:
+    """Refuse arrays and objects nested deeper than :data:`MAX_NESTING` before parsing: one
+    pass over the text with strings blanked (their brackets do not count), in numpy."""
+    if text.count("[") + text.count("{") <= MAX_NESTING:
+        return
+    blank = _STRING.sub(lambda m: '"' + " " * (len(m.group()) - 2) + '"', text)
+    b = np.frombuffer(blank.encode("ascii", "replace"), np.uint8)
+    step = (b == 91).astype(np.int32) + (b == 123) - (b == 93) - (b == 125)
+    depth = np.cumsum(step, dtype=np.int64)
+    if depth.max(initial=0) <= MAX_NESTING:
+        return
+    at = int(np.argmax(depth > MAX_NESTING))
+    key = None
+    for m in _KEY.finditer(text, 0, at):
+        if depth[m.start()] == 1:
+            key = m.group(1)
+    line = text.count("\n", 0, at) + 1
+    under = f" under key {key!r}" if key is not None else " at the top level"
+    _fail(
+        f"arrays nested {int(depth.max())} deep (line {line},{under}); expected FOLD arrays, "
+        f"nested at most {MAX_NESTING} deep"
+    )
+
+
+def _parse(source) -> dict:
+    if isinstance(source, bytes | bytearray | memoryview):
+        if len(source) > MAX_FOLD_BYTES:
+            _fail(f"{len(source)} bytes; expected at most {MAX_FOLD_BYTES} (64 MiB)")
+        try:
+            text = bytes(source).decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            _fail(f"not UTF-8 text ({exc.reason} at byte {exc.start}); expected FOLD JSON")
+    elif isinstance(source, str):
+        text = source.removeprefix("\ufeff")
+    else:
+        _fail(f"expected FOLD text, bytes or a dict, got {type(source).__name__}")
+    if len(text) > MAX_FOLD_BYTES:
+        _fail(f"{len(text)} characters; expected at most {MAX_FOLD_BYTES} (64 MiB)")
+    _check_nesting(text)
+    try:
+        return json.loads(text)
+    except RecursionError:  # a deep stack already: json recurses per level
+        _fail(f"nested too deeply for the JSON parser; expected at most {MAX_NESTING} levels")
+    except ValueError as exc:  # JSONDecodeError, or an integer of over 4300 digits
+        _fail(f"not valid JSON ({exc})")
+
+
+def _list(d: dict, key: str, what: str, limit: int | None = None) -> list:
+    raw = d[key]
+    if not isinstance(raw, list):
+        _fail(f"{key}: expected an array of {what}, got {_kind(raw)}")
+    if limit is not None and len(raw) > limit:
+        _fail(f"{key}: {len(raw)} entries; at most {limit} are read (docs/limits.md)")
+    return raw
+
+
+def _is_number(x) -> bool:
+    return type(x) is float or type(x) is int  # not bool, not str
 
 
 def _coords(raw, where: str) -> np.ndarray:
     if not isinstance(raw, list) or not raw:
-        _fail(f"{where} must be a non-empty list of [x, y] or [x, y, z]")
-    dims = {len(v) if isinstance(v, list) else -1 for v in raw}
-    if -1 in dims or not dims <= {2, 3}:
-        _fail(f"{where} entries must be [x, y] or [x, y, z] lists of numbers")
-    if len(dims) > 1:
-        _fail(f"{where} mixes 2-D and 3-D vertices; all must have the same dimension")
+        _fail(f"{where}: expected a non-empty array of [x, y] or [x, y, z], got {_kind(raw)}")
+    if len(raw) > MAX_FOLD_VERTICES:
+        _fail(f"{where}: {len(raw)} vertices; at most {MAX_FOLD_VERTICES} are read")
+    dim = None
+    for k, v in enumerate(raw):
+        if not isinstance(v, list) or len(v) not in (2, 3) or not all(map(_is_number, v)):
+            _fail(f"{where}[{k}] = {_show(v)}: expected [x, y] or [x, y, z] numbers")
+        if dim is None:
+            dim = len(v)
+        elif len(v) != dim:
+            _fail(f"{where}[{k}] has {len(v)} coordinates, vertex 0 has {dim}: mixes 2-D and 3-D")
     try:
         arr = np.array(raw, dtype=float)
-    except (TypeError, ValueError):
-        _fail(f"{where} holds a value that is not a number")
+    except OverflowError:  # an integer beyond float range
+        arr = np.array([[float("inf")] * dim if _huge(v) else v for v in raw], dtype=float)
     bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
     if bad.size:
-        _fail(f"{where}[{int(bad[0])}] is not finite")
+        _fail(f"{where}[{int(bad[0])}] = {_show(raw[bad[0]])}: expected finite numbers")
     return arr
 
 
-def load_fold(source: str | bytes | dict) -> CreasePattern:
-    """Read a FOLD file's text (or parsed dict) into a :class:`CreasePattern`, validating it."""
-    if isinstance(source, dict):
-        d = source
-    else:
-        try:
-            d = json.loads(source)
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            _fail(f"not valid JSON ({exc})")
+def _huge(v) -> bool:
+    try:
+        np.array(v, dtype=float)
+    except OverflowError:
+        return True
+    return False
+
+
+def _indices(raw: list, key: str, nv: int, *, pair: bool) -> None:
+    """Every entry of ``raw`` a list of vertex indices (integers in 0..nv-1), a pair if
+    ``pair``, else at least 3 distinct ones."""
+    what = "a pair [u, v] of vertex indices" if pair else "an array of >= 3 vertex indices"
+    for k, e in enumerate(raw):
+        if not isinstance(e, list) or (len(e) != 2 if pair else len(e) < 3):
+            _fail(f"{key}[{k}] = {_show(e)}: expected {what}")
+        for v in e:
+            if type(v) is not int:
+                _fail(f"{key}[{k}] = {_show(e)}: expected integer vertex indices, got {_show(v)}")
+            if not 0 <= v < nv:
+                _fail(f"{key}[{k}] = {_show(e)}: vertex {_show(v)} is outside 0..{nv - 1}")
+        if not pair and len(set(e)) != len(e):
+            _fail(f"{key}[{k}] = {_show(e)}: a face lists a vertex twice")
+
+
+def _numbers(d: dict, key: str, n: int, what: str, *, allow_null=False) -> list:
+    raw = _list(d, key, "numbers")
+    if len(raw) != n:
+        _fail(f"{key}: {len(raw)} entries; expected one per edge/face ({n})")
+    for k, a in enumerate(raw):
+        if (a is None and allow_null) or (_is_number(a) and math.isfinite(a)):
+            continue
+        _fail(f"{key}[{k}] = {_show(a)}: expected {what}")
+    return raw
+
+
+def _strings(d: dict, key: str) -> list[str]:
+    raw = d.get(key)
+    if raw is None:
+        return []
+    if not isinstance(raw, list) or not all(isinstance(c, str) for c in raw):
+        _fail(f"{key} = {_show(raw)}: expected an array of strings")
+    return raw
+
+
+def _nonplanar(coords: np.ndarray, faces: list[list[int]], tol: float) -> tuple[int, float]:
+    """(first face, its offset) of the faces with a vertex farther than ``tol`` x the face's
+    size (its largest vertex distance) from its least-squares plane; (-1, 0) if none. Faces of
+    one vertex count are done together."""
+    by_size: dict[int, list[int]] = {}
+    for k, f in enumerate(faces):
+        if len(f) > 3:
+            by_size.setdefault(len(f), []).append(k)
+    worst = (-1, 0.0)
+    for ks in by_size.values():
+        P = coords[np.array([faces[k] for k in ks])]  # (nf, n, 3)
+        C = P - P.mean(axis=1, keepdims=True)
+        normal = np.linalg.svd(C)[2][:, -1, :]  # (nf, 3)
+        off = np.abs(np.einsum("fnk,fk->fn", C, normal)).max(axis=1)
+        size = np.linalg.norm(P[:, :, None, :] - P[:, None, :, :], axis=-1).max(axis=(1, 2))
+        rel = off / np.maximum(size, 1e-300)
+        bad = np.flatnonzero(rel > tol)
+        if bad.size and (worst[0] < 0 or ks[bad[0]] < worst[0]):
+            worst = (ks[bad[0]], float(rel[bad[0]]))
+    return worst
+
+
+def read_fold(path) -> CreasePattern:
+    """Read a FOLD file into a :class:`CreasePattern`, validating it (see :func:`load_fold`).
+
+    Every problem raises :class:`FormatError` with one line naming the file, the place (key
+    and index) and what was expected; a file over :data:`MAX_FOLD_BYTES` is refused before it
+    is read.
+    """
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        if size > MAX_FOLD_BYTES:
+            limit = f"expected at most {MAX_FOLD_BYTES} (64 MiB)"
+            raise FormatError(f"FOLD file {str(path)!r}: {size} bytes; {limit}")
+        data = path.read_bytes()
+    except OSError as exc:
+        raise FormatError(f"FOLD file {str(path)!r}: cannot be read ({exc.strerror})") from None
+    return load_fold(data, name=str(path))
+
+
+def load_fold(source: str | bytes | dict, *, name: str | None = None) -> CreasePattern:
+    """Read a FOLD file's text (or bytes, or parsed dict) into a :class:`CreasePattern`.
+
+    Validates the list of docs/bar-and-hinge.md §1.2 and the limits of docs/limits.md, and
+    raises :class:`FormatError` with one line naming the file (``name``), the place and what
+    was expected: nesting deeper than :data:`MAX_NESTING` (checked before parsing), keys of
+    the wrong type, vertex indices that are not integers in range, coordinates that are not
+    finite numbers of one dimension (2 or 3), empty, repeated-vertex, duplicate or non-planar
+    faces (:data:`PLANAR_TOL`), assignments outside the FOLD set, arrays of one prefix with
+    different lengths, more than :data:`MAX_FOLD_FACES` faces, :data:`MAX_FOLD_VERTICES`
+    vertices or :data:`MAX_FOLD_EDGES` edges.
+    """
+    where = "FOLD" if name is None else f"FOLD file {name!r}"
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", FoldWarning)
+            pattern = _read(source)
+    except _Bad as exc:
+        raise FormatError(f"{where}: {exc}") from None
+    for w in caught:
+        if issubclass(w.category, FoldWarning):
+            msg = str(w.message).removeprefix("FOLD: ")
+            warnings.warn(f"{where}: {msg}", w.category, stacklevel=2)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return pattern
+
+
+def _read(source) -> CreasePattern:
+    d = source if isinstance(source, dict) else _parse(source)
     if not isinstance(d, dict):
-        _fail("the top level must be a JSON object")
+        _fail(f"the top level is {_kind(d)}; expected a JSON object {{...}} of FOLD keys")
     if "file_spec" not in d:
         warnings.warn("FOLD: no file_spec; assuming 1.2", FoldWarning, stacklevel=2)
     for key in d:
+        if not isinstance(key, str):
+            _fail(f"key {_show(key)} is not a string")
         if key not in _SPEC_KEYS and ":" not in key:
             warnings.warn(
                 f"FOLD: custom key {key!r} has no namespace colon", FoldWarning, stacklevel=2
@@ -189,16 +417,10 @@ def load_fold(source: str | bytes | dict) -> CreasePattern:
             _fail(f"arrays of one kind must have equal lengths: {desc}")
     key_coords = _coords(d["vertices_coords"], "vertices_coords")
     nv = len(key_coords)
-    try:
-        edges = np.array(d["edges_vertices"], dtype=np.int64)
-    except (TypeError, ValueError):
-        _fail("edges_vertices must be a list of [u, v] integer pairs")
-    if edges.ndim != 2 or edges.shape[1] != 2:
-        _fail("edges_vertices must be a list of [u, v] integer pairs")
+    raw_edges = _list(d, "edges_vertices", "[u, v] vertex pairs", MAX_FOLD_EDGES)
+    _indices(raw_edges, "edges_vertices", nv, pair=True)
+    edges = np.array(raw_edges, dtype=np.int64).reshape(-1, 2)
     ne = len(edges)
-    out = np.flatnonzero(((edges < 0) | (edges >= nv)).any(axis=1))
-    if out.size:
-        _fail(f"edges_vertices[{int(out[0])}] = {edges[out[0]].tolist()} is outside 0..{nv - 1}")
     circ = np.flatnonzero(edges[:, 0] == edges[:, 1])
     if circ.size:
         _fail(f"edges_vertices[{int(circ[0])}] is circular (joins a vertex to itself)")
@@ -210,35 +432,37 @@ def load_fold(source: str | bytes | dict) -> CreasePattern:
     used[edges.ravel()] = True
     if not used.all():
         _fail(f"vertex {int(np.flatnonzero(~used)[0])} is isolated (on no edge)")
-    faces = d["faces_vertices"]
-    if not isinstance(faces, list):
-        _fail("faces_vertices must be a list of vertex lists")
+    faces = _list(d, "faces_vertices", "vertex index arrays", MAX_FOLD_FACES)
+    _indices(faces, "faces_vertices", nv, pair=False)
+    seen: dict[tuple[int, ...], int] = {}
     for k, f in enumerate(faces):
-        if not isinstance(f, list) or len(f) < 3 or not all(isinstance(v, int) for v in f):
-            _fail(f"faces_vertices[{k}] must list at least 3 integer vertex ids")
-        if min(f) < 0 or max(f) >= nv:
-            _fail(f"faces_vertices[{k}] = {f} references a vertex outside 0..{nv - 1}")
-    asg = d.get("edges_assignment", ["U"] * ne)
-    if not all(isinstance(a, str) and a in ASSIGNMENTS for a in asg):
-        bad = next(a for a in asg if not (isinstance(a, str) and a in ASSIGNMENTS))
-        _fail(f"edges_assignment holds {bad!r}; allowed: {' '.join(ASSIGNMENTS)}")
-    asg = list(asg)
-    ang_raw = d.get("edges_foldAngle", d.get("edges_foldAngles"))
-    if ang_raw is None:
-        ang = np.zeros(ne)
+        j = seen.setdefault(tuple(sorted(f)), k)
+        if j != k:
+            _fail(f"faces_vertices[{k}] = {_show(f)} repeats face {j} (the same vertices)")
+    if "edges_assignment" in d:
+        asg = list(_list(d, "edges_assignment", "assignment letters"))
+        if len(asg) != ne:
+            _fail(f"edges_assignment: {len(asg)} entries; expected one per edge ({ne})")
+        for i, a in enumerate(asg):
+            if not (isinstance(a, str) and a in ASSIGNMENTS):
+                _fail(f"edges_assignment[{i}] = {_show(a)}; allowed: {' '.join(ASSIGNMENTS)}")
     else:
-        ang = np.zeros(ne)
+        asg = ["U"] * ne
+    ang = np.zeros(ne)
+    key = next((k for k in ("edges_foldAngle", "edges_foldAngles") if d.get(k) is not None), None)
+    if key is not None:
+        ang_raw = _numbers(d, key, ne, "a number in [-180, 180] degrees", allow_null=True)
         for i, a in enumerate(ang_raw):
             if a is None:  # Origami Simulator: null = undriven
                 asg[i] = "U" if asg[i] in ("M", "V") else asg[i]
                 continue
-            if not isinstance(a, int | float) or not math.isfinite(a) or abs(a) > 180:
-                _fail(f"edges_foldAngle[{i}] = {a!r} must be a number in [-180, 180] degrees")
+            if abs(a) > 180:
+                _fail(f"{key}[{i}] = {a!r}: expected a number in [-180, 180] degrees")
             ang[i] = float(a)
     for i, (a, x) in enumerate(zip(asg, ang, strict=True)):
         if (a == "M" and x > 0) or (a == "V" and x < 0) or (a in "BFC" and x != 0):
             _fail(f"edge {i}: assignment {a} does not match fold angle {x:g} (valley > 0)")
-    classes = d.get("frame_classes")
+    classes = _strings(d, "frame_classes") if d.get("frame_classes") is not None else None
     if classes is None:
         warnings.warn(
             "FOLD: no frame_classes; treating 2-D coordinates as a crease pattern",
@@ -252,17 +476,33 @@ def load_fold(source: str | bytes | dict) -> CreasePattern:
         and "foldedForm" not in classes
     )
     unit = d.get("frame_unit", "unit")
-    scale = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "nm": 1e-9, "in": 0.0254,
-             "pt": 0.0254 / 72, "unit": 1.0}.get(unit)  # fmt: skip
-    if scale is None:
-        _fail(f"frame_unit {unit!r} is not one of m cm mm um nm in pt unit")
+    if not isinstance(unit, str) or unit not in _UNITS:
+        _fail(f"frame_unit = {_show(unit)}; expected one of {' '.join(_UNITS)}")
+    scale = _UNITS[unit]
+    if is_cp and key_coords.shape[1] == 3:
+        span = max(float(np.ptp(key_coords[:, :2], axis=0).max()), 1e-300)
+        z = float(np.ptp(key_coords[:, 2]))
+        if z > _FLAT_TOL * span:
+            _fail(
+                f"vertices_coords: a crease pattern must be flat, its z spans {z:.4g} "
+                f"({z / span:.3g} of its size); expected z constant (or frame_classes "
+                "['foldedForm'])"
+            )
     flat = key_coords[:, :2] * scale if is_cp else None
     coords3 = None
-    for fr in d.get("file_frames", []) or []:
-        if isinstance(fr, dict) and "foldedForm" in (fr.get("frame_classes") or []):
-            c = _coords(fr.get("vertices_coords"), "file_frames[].vertices_coords")
+    frames = d.get("file_frames")
+    if frames is not None and not isinstance(frames, list):
+        _fail(f"file_frames: expected an array of frame objects, got {_kind(frames)}")
+    for n, fr in enumerate(frames or []):
+        if not isinstance(fr, dict):
+            _fail(f"file_frames[{n}]: expected a frame object, got {_kind(fr)}")
+        if "foldedForm" in _strings(fr, "frame_classes"):
+            c = _coords(fr.get("vertices_coords"), f"file_frames[{n}].vertices_coords")
             if len(c) != nv:
-                _fail("the folded frame's vertices_coords has another vertex count")
+                _fail(
+                    f"file_frames[{n}].vertices_coords: {len(c)} vertices; expected {nv}, as in "
+                    "the key frame"
+                )
             coords3 = np.column_stack([c, np.zeros(nv)]) if c.shape[1] == 2 else c
             coords3 = coords3 * scale
             break
@@ -270,6 +510,12 @@ def load_fold(source: str | bytes | dict) -> CreasePattern:
         coords3 = (
             np.column_stack([key_coords, np.zeros(nv)]) if key_coords.shape[1] == 2 else key_coords
         ) * scale
+    k, rel = _nonplanar(coords3, faces, PLANAR_TOL)
+    if k >= 0:
+        _fail(
+            f"faces_vertices[{k}] = {_show(faces[k])} is not planar: a vertex lies {rel:.3g} of "
+            f"the face's size off its plane in the 3-D frame; expected at most {PLANAR_TOL}"
+        )
     if flat is not None:
         span = max(float(np.ptp(flat, axis=0).max()), 1e-300)
         order = np.lexsort(flat.T)
@@ -296,11 +542,15 @@ def load_fold(source: str | bytes | dict) -> CreasePattern:
             )
     meta = d.get("holofold:meta", {})
     meta = dict(meta) if isinstance(meta, dict) else {}
-    for key in ("edges_holofold:creaseWidth", "edges_holofold:creaseThickness",
-                "faces_holofold:thickness"):  # fmt: skip
+    physical = (
+        ("edges_holofold:creaseWidth", ne, "a crease width, m"),
+        ("edges_holofold:creaseThickness", ne, "a crease thickness, m"),
+        ("faces_holofold:thickness", len(faces), "a panel thickness, m"),
+    )
+    for key, n, what in physical:
         if key in d:
-            meta[key.split(":", 1)[1]] = list(d[key])
+            meta[key.split(":", 1)[1]] = list(_numbers(d, key, n, what))
     try:
         return CreasePattern(coords3, faces, edges, asg, ang, flat=flat, meta=meta)
     except ValueError as exc:
-        raise FormatError(f"FOLD: {exc}") from None
+        _fail(str(exc))

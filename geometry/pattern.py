@@ -33,6 +33,7 @@ from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternErro
 
 __all__ = [
     "ASSIGNMENTS",
+    "MAX_PANELS",
     "CreasePattern",
     "non_simple_faces",
     "reference_edges",
@@ -43,6 +44,12 @@ __all__ = [
 
 #: FOLD 1.2 edge assignments: mountain, valley, border, flat, cut, join, unassigned.
 ASSIGNMENTS = ("M", "V", "B", "F", "C", "J", "U")
+
+#: the largest pattern (panels) the command line and the file readers take: ``holofold
+#: pattern`` generates a 100 x 100 sheet in 2 s and reads its FOLD file back in 1.4 s, and the
+#: sheet scenarios refuse more panels per design (docs/limits.md). The Python generators
+#: themselves take any size.
+MAX_PANELS = 10_000
 
 _REL_TOL = 1e-12  # relative tolerance for zero lengths and areas
 

@@ -61,14 +61,11 @@ def register(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-#: the largest sheet the command writes (panels): larger ones take minutes and gigabytes
-MAX_PANELS = 10_000
-
-
 def _build(args):
     """The pattern the arguments describe (checked in the options' own terms and units)."""
-    from holofold.geometry import ParameterError, check_range, miura_sheet, tmp_sheet
+    from holofold.geometry import MAX_PANELS, ParameterError, check_range, miura_sheet, tmp_sheet
 
+    # the largest sheet the command writes (geometry.MAX_PANELS): larger ones take minutes
     if args.m > 0 and args.n > 0 and args.m * args.n > MAX_PANELS:
         raise ParameterError(
             f"--m {args.m} x --n {args.n} = {args.m * args.n} panels; at most {MAX_PANELS} "
