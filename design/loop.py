@@ -239,6 +239,13 @@ def _rule_entry(rec: Mapping, v: Verification | None) -> dict:
         "test_precision": rec.get("test", {}).get("precision"),
         "test_support": rec.get("test", {}).get("support"),
     }
+    est = rec.get("estimate")
+    if isinstance(est, Mapping):
+        e |= {
+            "estimate": est.get("precision"),
+            "estimate_95ci": est.get("interval"),
+            "estimate_rows": est.get("rows"),
+        }
     if v is not None:
         s = v.summary()
         e |= {
@@ -410,8 +417,10 @@ def run_design(
         times["verify"] += time.perf_counter() - t0
         entries = [_rule_entry(rec, v) for rec, v in zip(records, checks, strict=True)]
         for e in entries:
-            test, ver = _fmt(e["test_precision"]), _fmt(e.get("verified_precision"))
-            say(f"  round {r} rule {e['rank']}: {e['rule']}  (test {test}, verified {ver})")
+            est, test = _fmt(e.get("estimate")), _fmt(e["test_precision"])
+            ver = _fmt(e.get("verified_precision"))
+            say(f"  round {r} rule {e['rank']}: {e['rule']}  "
+                f"(estimate {est}, test {test}, verified {ver})")  # fmt: skip
         for i, v in enumerate(checks, start=1):
             table = pd.concat(
                 [table, v.designs.drop(columns="meets_target").assign(origin=f"verify-{r}-{i}")],

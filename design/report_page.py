@@ -158,6 +158,19 @@ def _precision(p) -> str:
     return _percent(p) or _MISSING
 
 
+def _estimate(rule: Mapping) -> str:
+    """'91.0 % (95 % interval 85.0 % to 95.0 %)' or the missing mark."""
+    p = _percent(rule.get("estimate"))
+    if p is None:
+        return _MISSING
+    ci = rule.get("estimate_95ci")
+    if isinstance(ci, list | tuple) and len(ci) == 2:
+        lo, hi = (_percent(c) for c in ci)
+        if lo is not None and hi is not None:
+            return f"{p} ({lo} to {hi})"
+    return p
+
+
 def _verified(rule: Mapping, fallback=None) -> str:
     """'88.0 % (95 % interval 76.0 % to 94.0 %, n = 50)' or 'not verified'."""
     p = _percent(rule.get("verified_precision", fallback))
@@ -305,7 +318,9 @@ def _rounds(summary: Mapping) -> str:
         out.append("<p>No rules were mined.</p></section>")
         return "".join(out)
     out.append(
-        '<p class="note">Train and test precision: the share of database designs inside the '
+        '<p class="note">Estimate: the precision the miner expects on new designs inside the '
+        "rule, with its 95&nbsp;% interval, from database rows its trees did not train on. "
+        "Train and test precision: the share of database designs inside the "
         "rule that meet the target. Verified precision: the share of new designs sampled inside "
         "the rule and simulated that meet it, with its 95&nbsp;% interval and the number of "
         "new designs n.</p>"
@@ -328,6 +343,7 @@ def _rounds(summary: Mapping) -> str:
                         (_num(number), "num"),
                         (_num(r.get("rank")), "num"),
                         f"<code>{_esc(r.get('rule', ''))}</code>",
+                        (_estimate(r), "num"),
                         (_precision(r.get("train_precision")), "num"),
                         (_precision(r.get("test_precision")), "num"),
                         _verified(r),
@@ -335,7 +351,7 @@ def _rounds(summary: Mapping) -> str:
                 )
                 is_chosen = chosen_text is not None and r.get("rule") == chosen_text
                 classes.append("chosen" if is_chosen else "")
-            header = ["round", "rank", "rule", "train precision", "test precision"]
+            header = ["round", "rank", "rule", "estimate", "train precision", "test precision"]
             out.append(_table(header + ["verified precision"], rows, "rules", classes))
         else:
             out.append("<p>No rule reached the miner's precision and support thresholds.</p>")

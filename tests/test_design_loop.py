@@ -159,6 +159,8 @@ def test_design_loop_on_a_users_curve_writes_a_verified_design(designed):
             assert rule["verified_n"] + rule["verified_failed"] == 10
             lo, hi = rule["verified_95ci"]
             assert lo <= rule["verified_precision"] <= hi
+            lo, hi = rule["estimate_95ci"]  # what the miner expects, shown beside it
+            assert 0 <= lo <= rule["estimate"] <= hi <= 1 and rule["estimate_rows"] > 0
     # the chosen design lies inside the chosen rule
     row = pd.DataFrame([s["features"]])
     assert rule_mask(row, s["rule"]["bounds"])[0]

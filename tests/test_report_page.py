@@ -30,6 +30,9 @@ def make_summary() -> dict:
     rule0 = {
         "rank": 1,
         "rule": "offset <= 0.2 & m in {12, 16}",
+        "estimate": 0.86,
+        "estimate_95ci": [0.78, 0.92],
+        "estimate_rows": 60,
         "train_precision": 0.95,
         "test_precision": 0.9,
         "test_support": 40,
@@ -208,12 +211,13 @@ def test_page_problem_rules_and_timings(folder):
         "0",
         "1",
         "offset <= 0.2 & m in {12, 16}",
+        "86.0 % (78.0 % to 92.0 %)",
         "95.0 %",
         "90.0 %",
         "88.0 % (95 % interval 76.0 % to 94.0 %, n = 50)",
     ]
     assert rules[1][-1] == "not verified"
-    assert rules[2][:3] == ["1", "1", "offset <= 0.18 & m in {12, 16}"]
+    assert rules[2][:4] == ["1", "1", "offset <= 0.18 & m in {12, 16}", "–"]  # no estimate
     assert "Round 1: best verified precision 92.0\u00a0% (rank 1), up 4.0 points from round 0" in (
         page
     )
