@@ -32,6 +32,9 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "curve_files": [
             "CurveUnitWarning",
+            "CurveSelectionWarning",
+            "MAX_SVG_BYTES",
+            "MAX_SVG_NESTING",
             "PLAUSIBLE_SIZE",
             "check_curve_size",
             "read_points_csv",

@@ -31,6 +31,9 @@ from holofold.geometry.units import LENGTH_UNITS, length_factor
 
 __all__ = [
     "CurveUnitWarning",
+    "CurveSelectionWarning",
+    "MAX_SVG_BYTES",
+    "MAX_SVG_NESTING",
     "PLAUSIBLE_SIZE",
     "check_curve_size",
     "read_points_csv",
@@ -45,9 +48,19 @@ _SVG_UNITS = {"mm": 1e-3, "cm": 1e-2, "q": 0.25e-3, "in": 0.0254, "pt": 0.0254 /
               "pc": 0.0254 / 6, "px": 0.0254 / 96}  # fmt: skip
 _PX = 0.0254 / 96  # svgelements reports coordinates in CSS px
 
+#: the largest SVG file read (bytes)
+MAX_SVG_BYTES = 64 * 2**20
+#: the deepest element nesting read: drawings nest groups a few levels deep; svgelements
+#: recurses per level and fails near 1000 (at Python's default recursion limit)
+MAX_SVG_NESTING = 100
+
 
 class CurveUnitWarning(UserWarning):
     """A curve whose size is implausible in the unit it was read in (probably the wrong unit)."""
+
+
+class CurveSelectionWarning(UserWarning):
+    """An SVG file with several shapes read without ``#id``: the first was taken."""
 
 
 def check_curve_size(curve: PlanarCurve, unit: str, per_unit: float, where: str = "") -> None:
@@ -163,14 +176,24 @@ def read_svg_curve(ref, units: str | None = None, *, check_size: bool = True) ->
         Warn about an implausible size (:func:`check_curve_size`).
 
     The SVG y axis points down, so z = -y; the origin is moved to the path's first point.
+    Without ``#id`` a file with several paths gives a :class:`CurveSelectionWarning` naming
+    them; a path of several subpaths (M commands) is refused, not joined. Files over
+    :data:`MAX_SVG_BYTES` or nested deeper than :data:`MAX_SVG_NESTING` are refused before
+    parsing; every problem is one :class:`~holofold.fitting.curves.CurveFormatError` line.
     """
     from svgelements import SVG, Shape
     from svgelements import Path as SvgPath
 
     ref = str(ref)
     file, _, pid = ref.partition("#")
+    _check_svg_structure(file)
     try:
         svg = SVG.parse(file, reify=True)
+    except RecursionError:  # within MAX_SVG_NESTING, but called from a deep stack
+        raise CurveFormatError(
+            f"cannot read SVG file {file!r}: elements nested too deeply to read here; at most "
+            f"{MAX_SVG_NESTING} levels"
+        ) from None
     except Exception as exc:  # noqa: BLE001 - any parse failure is a bad file
         raise CurveFormatError(f"cannot read SVG file {file!r}: {exc}") from exc
     if pid:
@@ -182,7 +205,19 @@ def read_svg_curve(ref, units: str | None = None, *, check_size: bool = True) ->
         paths = [e for e in shapes if isinstance(e, SvgPath)]
         if not shapes:
             raise CurveFormatError(f"SVG file {file!r} contains no <path> element")
-        el = (paths or shapes)[0]
+        pool = paths or shapes
+        el = pool[0]
+        if len(pool) > 1:
+            ids = [str(e.id) for e in pool if e.id]
+            listed = ", ".join(ids[:5]) + (", ..." if len(ids) > 5 else "")
+            warnings.warn(
+                f"SVG file {file!r} has {len(pool)} {'paths' if paths else 'shapes'}"
+                + (f" (ids {listed})" if ids else " (none with an id)")
+                + f"; read the first{f' ({el.id!r})' if el.id else ''}: choose one with "
+                f"{Path(file).name}#id",
+                CurveSelectionWarning,
+                stacklevel=2,
+            )
     doc_unit, doc_per_user = _document_unit(svg)
     if units is None:
         label, per_user = (doc_unit, doc_per_user) if doc_unit else ("m (no unit in the file)", 1.0)
@@ -207,6 +242,54 @@ def read_svg_curve(ref, units: str | None = None, *, check_size: bool = True) ->
     return curve
 
 
+def _check_svg_structure(file: str) -> None:
+    """Refuse a file over :data:`MAX_SVG_BYTES` or nested deeper than :data:`MAX_SVG_NESTING`
+    before svgelements (which recurses per level) parses it: one streaming pass of expat."""
+    from xml.parsers import expat
+
+    try:
+        size = Path(file).stat().st_size
+    except OSError as exc:
+        raise CurveFormatError(f"cannot read SVG file {file!r}: {exc.strerror}") from None
+    if size > MAX_SVG_BYTES:
+        raise CurveFormatError(
+            f"cannot read SVG file {file!r}: {size} bytes; expected at most {MAX_SVG_BYTES} "
+            "(64 MiB)"
+        )
+    parser = expat.ParserCreate()
+    depth = [0]
+
+    class Deep(Exception):
+        pass
+
+    def start(name, attrs):
+        depth[0] += 1
+        if depth[0] > MAX_SVG_NESTING:
+            raise Deep(name)
+
+    def end(name):
+        depth[0] -= 1
+
+    parser.StartElementHandler, parser.EndElementHandler = start, end
+    try:
+        with open(file, "rb") as fh:
+            parser.ParseFile(fh)
+    except Deep as exc:
+        raise CurveFormatError(
+            f"cannot read SVG file {file!r}: elements nested over {MAX_SVG_NESTING} deep (line "
+            f"{parser.CurrentLineNumber}, <{exc}>); expected at most {MAX_SVG_NESTING} levels "
+            "of groups"
+        ) from None
+    except expat.ExpatError as exc:
+        why = expat.errors.messages[exc.code]
+        raise CurveFormatError(
+            f"cannot read SVG file {file!r}: not well-formed XML: {why} (line {exc.lineno}, "
+            f"column {exc.offset})"
+        ) from None
+    except OSError as exc:
+        raise CurveFormatError(f"cannot read SVG file {file!r}: {exc.strerror}") from None
+
+
 def _curve_of(path, name: str, source: str, scale: float) -> PlanarCurve:
     """Sample an svgelements Path (one subpath) densely; ``scale`` m per coordinate unit."""
     from svgelements import Close, Move
@@ -215,7 +298,8 @@ def _curve_of(path, name: str, source: str, scale: float) -> PlanarCurve:
     moves = sum(isinstance(s, Move) for s in path)
     if moves > 1:
         raise CurveFormatError(
-            f"SVG path {name!r} has {moves} subpaths; a curve is one line: draw it as one path"
+            f"SVG path {name!r} has {moves} subpaths (M commands); a curve is one line: put "
+            "the one to fit in a <path id=...> of its own and read it with file.svg#id"
         )
     if isinstance(segs[-1:] and segs[-1], Close) and segs[-1].length() == 0:
         segs = segs[:-1]
