@@ -49,6 +49,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "check_scheduler",
             "dask_scheduler",
         ],
+        "row_limits": ["RowTimeout", "ON_INVALID", "check_on_invalid", "resolve_row_timeout"],
         "sampling": ["sample_designs", "METHODS"],
         "scenarios.strip": ["StripSetting", "StripLoad", "strip_scenario", "STRIP_FEATURES"],
         "scenarios": [

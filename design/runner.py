@@ -7,6 +7,12 @@ evaluates the rows (optionally on several worker processes with joblib, or on a 
 given its scheduler address) and returns the rows in the same order with the performance columns
 and ``status``. A row whose simulation raises (or whose Dask worker dies) gets
 ``status = "failed: <reason>"`` and empty (NaN) outputs; the batch goes on.
+
+Per-row isolation (:mod:`~holofold.design.row_limits`): ``on_invalid="skip"`` records invalid
+rows as ``failed: invalid design: <the problems>`` in their place and simulates the others
+(``"fail"``, the default, refuses the table); each row has a time limit (``row_timeout``, by
+default the scenario's) past which it is recorded as ``failed: timeout after ... s`` and the
+run goes on.
 """
 
 from __future__ import annotations
@@ -15,14 +21,22 @@ import logging
 import math
 import re
 import sys
+import warnings
 from collections import Counter
 from collections.abc import Iterator
 from contextlib import closing, contextmanager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
+from holofold.design.row_limits import (
+    RowTimeout,
+    call_with_limit,
+    check_on_invalid,
+    resolve_row_timeout,
+    timeout_reason,
+)
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.scenarios.base import single_thread
 from holofold.mechanics.status import Status
@@ -58,13 +72,39 @@ class ValidatedTable:
     Attributes
     ----------
     rows : list of dict
-        One dict of feature -> float per row (optional features filled in).
+        One dict of feature -> float per valid row, in table order (optional features filled
+        in).
     warnings : list of str
         Summary lines for values outside the paper's sampling ranges.
+    invalid : dict
+        0-based table position -> its problems (``"; "``-joined) of each invalid row; empty
+        unless validated with ``on_invalid="skip"``.
     """
 
     rows: list
     warnings: list
+    invalid: dict = field(default_factory=dict)
+
+    @property
+    def positions(self) -> list[int]:
+        """0-based table position of each of :attr:`rows`."""
+        n = len(self.rows) + len(self.invalid)
+        return [i for i in range(n) if i not in self.invalid]
+
+    def invalid_outputs(self, scenario: Scenario) -> dict[int, dict]:
+        """Position -> the failed output recorded for each invalid row."""
+        return {i: _invalid_output(scenario, why) for i, why in self.invalid.items()}
+
+    def skipped_line(self) -> str | None:
+        """One line saying how many invalid rows were skipped (the first of them), or None."""
+        if not self.invalid:
+            return None
+        i, why = min(self.invalid.items())
+        n = len(self.rows) + len(self.invalid)
+        return (
+            f"{len(self.invalid)} of {n} row(s) invalid, recorded as failed and not simulated "
+            f"(first: row {i + 1}: {why})"
+        )
 
 
 def _as_number(v):
@@ -77,15 +117,21 @@ def _as_number(v):
     return f
 
 
-def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
+def validate_designs(
+    scenario: Scenario, table: pd.DataFrame, on_invalid: str = "fail"
+) -> ValidatedTable:
     """Check every row of ``table`` before any simulation.
+
+    ``on_invalid="skip"``: invalid rows are not refused but returned in
+    :attr:`ValidatedTable.invalid` (missing columns are still refused).
 
     Raises
     ------
     DesignTableError
-        Listing missing columns, or every invalid row (1-based data-row numbers, up to 20
-        listed).
+        Listing missing columns, or (``on_invalid="fail"``) every invalid row (1-based
+        data-row numbers, up to 20 listed).
     """
+    check_on_invalid(on_invalid)
     missing = [c for c in scenario.required_features if c not in table.columns]
     if missing:
         raise DesignTableError(
@@ -94,6 +140,7 @@ def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
         )
     present = [c.name for c in scenario.features if c.name in table.columns]
     problems: list[str] = []
+    invalid: dict[int, str] = {}
     rows: list[dict] = []
     warn_counts: Counter = Counter()
     warn_first: dict[str, tuple[int, str]] = {}
@@ -120,6 +167,7 @@ def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
             bad = scenario.check(row)
         if bad:
             problems.append(f"row {i}: " + "; ".join(bad))
+            invalid[i - 1] = "; ".join(bad)
             continue
         for c in scenario.features:
             v = row.get(c.name)
@@ -128,7 +176,7 @@ def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
                 warn_counts[c.name] += 1
                 warn_first.setdefault(c.name, (i, w))
         rows.append(row)
-    if problems:
+    if problems and on_invalid == "fail":
         head = problems[:_MAX_LISTED]
         more = len(problems) - len(head)
         tail = f"\n  ... and {more} more invalid row(s)" if more else ""
@@ -136,19 +184,29 @@ def validate_designs(scenario: Scenario, table: pd.DataFrame) -> ValidatedTable:
             f"{len(problems)} invalid row(s) for scenario {scenario.name!r}, nothing simulated:\n  "
             + "\n  ".join(head)
             + tail
+            + "\n(on_invalid='skip', --on-invalid skip: record them as failed rows, simulate "
+            "the others)"
         )
     warnings = [
         f"{warn_first[k][1]} (row {warn_first[k][0]}; {n} row(s) in all)"
         for k, n in warn_counts.items()
     ]
-    return ValidatedTable(rows=rows, warnings=warnings)
+    return ValidatedTable(rows=rows, warnings=warnings, invalid=invalid)
+
+
+def _failed_output(scenario: Scenario, status: Status) -> dict:
+    """NaN outputs and ``status``."""
+    return {**dict.fromkeys(scenario.performance_names, float("nan")), "status": status}
+
+
+def _invalid_output(scenario: Scenario, why: str) -> dict:
+    """NaN outputs and ``status = "failed: invalid design: <problems>"``."""
+    return _failed_output(scenario, Status.failed(f"invalid design: {why}"))
 
 
 def _failed(scenario: Scenario, exc: BaseException) -> dict:
     """NaN outputs and ``status = "failed: <ExceptionName>: <first line of the message>"``."""
-    out: dict = {c: float("nan") for c in scenario.performance_names}
-    out["status"] = Status.from_exception(exc)
-    return out
+    return _failed_output(scenario, Status.from_exception(exc))
 
 
 def _checked_output(scenario: Scenario, out: dict) -> dict:
@@ -162,15 +220,17 @@ def _checked_output(scenario: Scenario, out: dict) -> dict:
     return {**out, "status": status}
 
 
-def _evaluate_one(scenario: Scenario, row: dict, limit_threads: bool) -> dict:
-    """Evaluate one row; any exception becomes a ``failed: ...`` status."""
+def _evaluate_one(
+    scenario: Scenario, row: dict, limit_threads: bool, timeout: float | None = None
+) -> dict:
+    """Evaluate one row within ``timeout`` seconds (None: no limit); any exception becomes a
+    ``failed: ...`` status, running past the limit ``failed: timeout after ... s``."""
     try:
-        if limit_threads:
-            with single_thread():
-                out = scenario.evaluate(row)
-        else:
-            out = scenario.evaluate(row)
+        with single_thread() if limit_threads else nullcontext():
+            out = call_with_limit(timeout, scenario.evaluate, row)
         return _checked_output(scenario, out)
+    except RowTimeout:
+        return _failed_output(scenario, Status.failed(timeout_reason(timeout)))
     except Exception as exc:  # noqa: BLE001 - a failed row must not stop the batch
         return _failed(scenario, exc)
 
@@ -195,17 +255,21 @@ def _batches(scenario: Scenario, rows: list) -> list[list[int]]:
     return [g[j : j + BATCH_ROWS] for g in groups.values() for j in range(0, len(g), BATCH_ROWS)]
 
 
-def _evaluate_batch(scenario: Scenario, rows: list, limit_threads: bool) -> list[dict]:
-    """Evaluate rows of one batch key together; if that raises, each row on its own (so a
-    row whose simulation raises fails alone, as with :func:`_evaluate_one`)."""
+def _evaluate_batch(
+    scenario: Scenario, rows: list, limit_threads: bool, timeout: float | None = None
+) -> list[dict]:
+    """Evaluate rows of one batch key together, within ``len(rows) * timeout`` seconds; if
+    that raises or runs past its limit, each row on its own with its own limit (so a row
+    whose simulation raises or hangs fails alone, as with :func:`_evaluate_one`)."""
     if len(rows) == 1 or scenario.evaluate_batch is None:
-        return [_evaluate_one(scenario, r, limit_threads) for r in rows]
+        return [_evaluate_one(scenario, r, limit_threads, timeout) for r in rows]
+    limit = None if timeout is None else timeout * len(rows)
     try:
         with single_thread() if limit_threads else nullcontext():
-            outs = scenario.evaluate_batch(rows)
+            outs = call_with_limit(limit, scenario.evaluate_batch, rows)
         return [_checked_output(scenario, o) for o in outs]
-    except Exception:  # noqa: BLE001 - fall back to the rows one by one
-        return [_evaluate_one(scenario, r, limit_threads) for r in rows]
+    except (Exception, RowTimeout):  # noqa: BLE001 - fall back to the rows one by one
+        return [_evaluate_one(scenario, r, limit_threads, timeout) for r in rows]
 
 
 def check_workers(workers) -> int:
@@ -308,7 +372,7 @@ def _worker_ready(scenario: Scenario) -> str:
 
 
 def _iter_on_dask(
-    scenario: Scenario, rows: list, limit_threads: bool, address: str
+    scenario: Scenario, rows: list, limit_threads: bool, address: str, timeout: float | None
 ) -> Iterator[tuple[int, dict]]:
     """Evaluate ``rows`` on the Dask scheduler at ``address``, yielding results as they finish.
 
@@ -334,7 +398,9 @@ def _iter_on_dask(
             ) from None
         if not ready:
             log.warning("no Dask workers at %s yet: the designs wait for some to join", address)
-        futures = client.map(_evaluate_one, [scenario] * n, rows, [limit_threads] * n, pure=False)
+        futures = client.map(
+            _evaluate_one, [scenario] * n, rows, [limit_threads] * n, [timeout] * n, pure=False
+        )
         where = {f.key: i for i, f in enumerate(futures)}
         try:
             for f in as_completed(futures, loop=client.loop):
@@ -352,6 +418,7 @@ def iter_results(
     workers: int = 1,
     address: str | None = None,
     limit_threads: bool = True,
+    row_timeout: float | None = None,
 ) -> Iterator[tuple[int, dict]]:
     """Simulate validated ``rows``, yielding ``(position, output)`` as each row finishes.
 
@@ -362,21 +429,22 @@ def iter_results(
     in row order of their first rows; other scenarios' rows come in order. Each output has the
     performance columns and a :class:`Status`; a row whose simulation raises is a failed row,
     never an exception. Close the iterator (:func:`contextlib.closing`) to cancel what is
-    still running.
+    still running. ``row_timeout``: seconds per row (None: no limit; a batch of k rows has
+    k times as long, and past it its rows run again one by one); a row past its limit is
+    ``failed: timeout after ... s``.
     """
     if address is not None:
-        yield from _iter_on_dask(scenario, rows, limit_threads, address)
+        yield from _iter_on_dask(scenario, rows, limit_threads, address, row_timeout)
         return
     tasks = _batches(scenario, rows)
+    args = (limit_threads, row_timeout)
     if workers == 1 or len(tasks) <= 1:
-        outs = (_evaluate_batch(scenario, [rows[i] for i in t], limit_threads) for t in tasks)
+        outs = (_evaluate_batch(scenario, [rows[i] for i in t], *args) for t in tasks)
     else:
         from joblib import Parallel, delayed
 
         par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
-        outs = par(
-            delayed(_evaluate_batch)(scenario, [rows[i] for i in t], limit_threads) for t in tasks
-        )
+        outs = par(delayed(_evaluate_batch)(scenario, [rows[i] for i in t], *args) for t in tasks)
     for task, out in zip(tasks, outs, strict=True):
         yield from zip(task, out, strict=True)
 
@@ -401,6 +469,8 @@ def evaluate_designs(
     limit_threads: bool = True,
     log_warnings: bool = True,
     scheduler: str | None = None,
+    on_invalid: str = "fail",
+    row_timeout: float | str | None = None,
 ) -> pd.DataFrame:
     """Simulate every row of ``table`` with ``scenario``.
 
@@ -421,12 +491,21 @@ def evaluate_designs(
         Limit BLAS to one thread per evaluation (the small dense solves are much slower
         when several threads contend for the cores).
     log_warnings : bool
-        Log values outside the paper's sampling ranges (callers that report
-        ``validate_designs(...).warnings`` themselves pass False).
+        Log values outside the paper's sampling ranges and warn how many invalid rows were
+        skipped (callers that report ``validate_designs(...).warnings`` and
+        ``.skipped_line()`` themselves pass False).
     scheduler : str, optional
         Run on a Dask cluster instead of joblib: its scheduler address
         (``tcp://host:8786``), or ``"local"`` for a local cluster started for this call (see
         :func:`dask_scheduler`). Needs the ``cluster`` extra.
+    on_invalid : {"fail", "skip"}
+        ``"fail"``: an invalid row refuses the whole table (:class:`DesignTableError`, nothing
+        simulated). ``"skip"``: invalid rows get ``status = "failed: invalid design: <their
+        problems>"`` and NaN outputs in their place, the others are simulated.
+    row_timeout : float, optional
+        Time limit per row, seconds; a row past it gets ``status = "failed: timeout after
+        ... s"`` and the run goes on. None: the scenario's ``row_timeout``; 0 or ``"none"``:
+        no limit.
 
     Returns
     -------
@@ -438,21 +517,27 @@ def evaluate_designs(
     workers = check_workers(workers)
     if scheduler is not None:
         scheduler = check_scheduler(scheduler)
-    checked = validate_designs(scenario, table)
+    timeout = resolve_row_timeout(scenario.row_timeout, row_timeout)
+    checked = validate_designs(scenario, table, on_invalid)
     for w in checked.warnings if log_warnings else ():
         log.warning("outside the paper's sampling ranges: %s", w)
-    rows = checked.rows
-    outs: list = [None] * len(rows)
+    if log_warnings and checked.invalid:
+        warnings.warn(checked.skipped_line(), stacklevel=2)
+    rows, where = checked.rows, checked.positions
+    outs: list = [None] * len(table)
+    for i, out in checked.invalid_outputs(scenario).items():
+        outs[i] = out
     cluster = dask_scheduler(scheduler, workers) if scheduler and rows else nullcontext()
     bar = progress_bar(len(rows), scenario.name, progress)
     try:
         with cluster as address:
             results = iter_results(
-                scenario, rows, workers=workers, address=address, limit_threads=limit_threads
-            )
+                scenario, rows, workers=workers, address=address, limit_threads=limit_threads,
+                row_timeout=timeout,
+            )  # fmt: skip
             with closing(results):
                 for i, out in results:
-                    outs[i] = out
+                    outs[where[i]] = out
                     if bar is not None:
                         bar.update(1)
     finally:

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.design.row_limits import resolve_row_timeout
 from holofold.design.runner import (
     check_scheduler,
     check_workers,
@@ -80,6 +81,8 @@ def build_database(
     progress: bool | None = None,
     meta: dict | None = None,
     scheduler: str | None = None,
+    on_invalid: str = "fail",
+    row_timeout: float | str | None = None,
 ) -> pd.DataFrame:
     """Simulate ``designs`` into ``folder``, resuming whatever an earlier run left there.
 
@@ -107,6 +110,11 @@ def build_database(
         Every row of the missing chunks is submitted at once and each chunk is written as
         soon as its last row is done (chunks may be written out of order), so no worker
         waits for the slowest row of a chunk. The results are the same as without it.
+    on_invalid, row_timeout
+        Per-row isolation, as in :func:`holofold.design.runner.evaluate_designs`: with
+        ``"skip"`` invalid rows are stored as failed rows with their reason; a row past its
+        time limit is stored as ``failed: timeout after ... s`` (a resume keeps it: chunks on
+        disk are never simulated again).
 
     Returns
     -------
@@ -122,7 +130,9 @@ def build_database(
     workers = check_workers(workers)
     if scheduler is not None:
         scheduler = check_scheduler(scheduler)
-    checked = validate_designs(scenario, designs)  # every row checked before anything runs
+    timeout = resolve_row_timeout(scenario.row_timeout, row_timeout)
+    # every row checked before anything runs
+    checked = validate_designs(scenario, designs, on_invalid)
     folder = Path(folder)
     chunks = folder / "chunks"
     chunks.mkdir(parents=True, exist_ok=True)
@@ -170,6 +180,8 @@ def build_database(
     if len(todo) < n_chunks:
         log.info("resuming: %d of %d chunks already done", n_chunks - len(todo), n_chunks)
     bar = None
+    if todo and checked.invalid:
+        warnings.warn(checked.skipped_line(), stacklevel=2)
     if todo:
         left = sum(min(chunk_size, len(designs) - k * chunk_size) for k in todo)
         bar = progress_bar(len(designs), scenario.name, progress, initial=len(designs) - left)
@@ -180,12 +192,15 @@ def build_database(
             # one cluster for the whole run; every missing row is submitted at once
             with dask_scheduler(scheduler, workers) as address:
                 _build_on_dask(
-                    scenario, designs, checked.rows, todo, chunk_size, chunks, address, bar
+                    scenario, designs, checked, todo, chunk_size, chunks, address, bar, timeout
                 )
         else:
             for k in todo:
                 part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
-                res = evaluate_designs(scenario, part, workers=workers, progress=False)
+                res = evaluate_designs(
+                    scenario, part, workers=workers, progress=False, log_warnings=False,
+                    on_invalid=on_invalid, row_timeout=timeout or 0,
+                )  # fmt: skip
                 write_chunk(res, chunks, k)
                 if bar is not None:
                     bar.update(len(part))
@@ -321,12 +336,13 @@ def _content_problem(data: bytes, part: pd.DataFrame) -> str | None:
 def _build_on_dask(
     scenario: Scenario,
     designs: pd.DataFrame,
-    rows: list,
+    checked,
     todo: list,
     chunk_size: int,
     chunks: Path,
     address: str,
     bar,
+    timeout: float | None,
 ) -> None:
     """Simulate the chunks ``todo`` on the Dask scheduler at ``address``.
 
@@ -337,30 +353,46 @@ def _build_on_dask(
     Parameters
     ----------
     designs : DataFrame
-        The whole design table (index 0..n-1); ``rows`` its validated rows, same order.
+        The whole design table (index 0..n-1).
+    checked : ValidatedTable
+        Its validated rows (and the invalid ones, stored as failed rows).
     todo : list of int
         Indices of the missing chunks.
     bar : tqdm.tqdm or None
         Progress bar, advanced by one per finished row.
+    timeout : float or None
+        Time limit per row, seconds.
     """
     n = len(designs)
     spans = {k: (k * chunk_size, min(n, (k + 1) * chunk_size)) for k in todo}
-    owner = [(k, i - lo) for k, (lo, hi) in spans.items() for i in range(lo, hi)]
     outs = {k: [None] * (hi - lo) for k, (lo, hi) in spans.items()}
     left = {k: hi - lo for k, (lo, hi) in spans.items()}
-    pending = [rows[i] for lo, hi in spans.values() for i in range(lo, hi)]
-    with closing(iter_results(scenario, pending, address=address)) as results:
+    rows = dict(zip(checked.positions, checked.rows, strict=True))
+    owner, pending = [], []
+    invalid = checked.invalid_outputs(scenario)
+
+    def done(k: int, pos: int, out: dict) -> None:
+        outs[k][pos] = out
+        left[k] -= 1
+        if bar is not None:
+            bar.update(1)
+        if not left[k]:
+            lo, hi = spans[k]
+            # the same table as evaluate_designs(scenario, part) would give
+            write_chunk(results_table(scenario, designs.iloc[lo:hi], outs.pop(k)), chunks, k)
+
+    for k, (lo, hi) in spans.items():
+        for i in range(lo, hi):
+            if i in invalid:
+                done(k, i - lo, invalid[i])
+            else:
+                owner.append((k, i - lo))
+                pending.append(rows[i])
+    if not pending:
+        return
+    with closing(iter_results(scenario, pending, address=address, row_timeout=timeout)) as results:
         for j, out in results:
-            k, pos = owner[j]
-            outs[k][pos] = out
-            left[k] -= 1
-            if bar is not None:
-                bar.update(1)
-            if not left[k]:
-                lo, hi = spans[k]
-                # the same table as evaluate_designs(scenario, part) would give
-                res = results_table(scenario, designs.iloc[lo:hi], outs.pop(k))
-                write_chunk(res, chunks, k)
+            done(*owner[j], out)
 
 
 def generate_database(
@@ -376,12 +408,20 @@ def generate_database(
     progress: bool | None = None,
     scheduler: str | None = None,
     csv: bool = False,
+    on_invalid: str = "fail",
+    row_timeout: float | str | None = None,
 ) -> pd.DataFrame:
     """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
 
     ``seed``, ``method`` and ``ranges`` go to :func:`holofold.design.sampling.sample_designs`
     and are recorded in ``meta.json``; the rest to :func:`build_database`. ``csv`` also
     writes ``database.csv``. Returns the database.
+
+    Sampled designs lie inside the features' ranges, but a scenario's check can still refuse
+    some (an odd arch ``m`` from ``ranges``, a gripper whose ``W`` is not below ``L2/2``):
+    ``on_invalid="fail"`` refuses the database before anything is simulated, ``"skip"``
+    stores them as failed rows with their reason. Designs refused while simulating (a
+    self-overlapping strip) are failed rows either way.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
@@ -392,6 +432,7 @@ def generate_database(
     db = build_database(
         scenario, designs, folder, chunk_size=chunk_size, workers=workers, progress=progress,
         meta={"seed": seed, "method": method, "ranges": recorded}, scheduler=scheduler,
+        on_invalid=on_invalid, row_timeout=row_timeout,
     )  # fmt: skip
     if csv:
         write_table(db, Path(folder) / "database.csv")

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.design.row_limits import check_on_invalid, resolve_row_timeout
 from holofold.design.runner import dask_scheduler, evaluate_designs
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
@@ -181,19 +182,25 @@ def verify_rule(
     workers: int = 1,
     progress: bool | None = None,
     scheduler: str | None = None,
+    on_invalid: str = "fail",
+    row_timeout: float | str | None = None,
 ) -> Verification:
     """Simulate ``n`` fresh designs inside a rule and count those meeting ``target``.
 
-    ``workers``, ``progress`` and ``scheduler`` (a Dask scheduler address or ``"local"``) are
-    passed to :func:`holofold.design.runner.evaluate_designs`.
+    ``workers``, ``progress``, ``scheduler`` (a Dask scheduler address or ``"local"``),
+    ``on_invalid`` and ``row_timeout`` are passed to
+    :func:`holofold.design.runner.evaluate_designs`: with ``on_invalid="skip"`` fresh designs
+    the scenario's check refuses (a box reaching past a validity limit) are failed rows, as
+    are rows past their time limit; failed rows count in ``n_failed``, not in the precision.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     tgt = parse_target(target, scenario.performance_names)
     designs = sample_designs(scenario, n, seed=seed, ranges=rule_ranges(scenario, bounds))
     res = evaluate_designs(
-        scenario, designs, workers=workers, progress=progress, scheduler=scheduler
-    )
+        scenario, designs, workers=workers, progress=progress, scheduler=scheduler,
+        on_invalid=on_invalid, row_timeout=row_timeout,
+    )  # fmt: skip
     return Verification.of(res, tgt)
 
 
@@ -207,16 +214,20 @@ def verify_rules(
     workers: int = 1,
     progress: bool | None = None,
     scheduler: str | None = None,
+    on_invalid: str = "fail",
+    row_timeout: float | str | None = None,
 ) -> list[Verification]:
     """:func:`verify_rule` for each rule record (``bounds`` as in a rules file), in order.
 
     Every rule is checked against the scenario before anything is simulated; rule ``i``
     (1-based) samples with seed ``seed + i``. A local Dask cluster (``scheduler="local"``) is
-    started once for all rules.
+    started once for all rules. ``on_invalid`` and ``row_timeout`` as in :func:`verify_rule`.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     parse_target(target, scenario.performance_names)
+    check_on_invalid(on_invalid)
+    resolve_row_timeout(scenario.row_timeout, row_timeout)
     if int(n) < 1:
         raise ValueError(f"n = {n} designs per rule must be >= 1")
     for r in rules:
@@ -233,6 +244,8 @@ def verify_rules(
                 workers=1 if address else workers,
                 progress=progress,
                 scheduler=address,
+                on_invalid=on_invalid,
+                row_timeout=row_timeout,
             )  # fmt: skip
             for i, r in enumerate(rules, start=1)
         ]

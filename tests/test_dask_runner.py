@@ -157,9 +157,9 @@ EVALUATED = []  # rows run by _recording_evaluate_one (the in-process workers sh
 _EVALUATE_ONE = runner._evaluate_one
 
 
-def _recording_evaluate_one(scenario, row, limit_threads):
+def _recording_evaluate_one(scenario, row, limit_threads, timeout=None):
     EVALUATED.append(tuple(sorted(row.items())))
-    return _EVALUATE_ONE(scenario, row, limit_threads)
+    return _EVALUATE_ONE(scenario, row, limit_threads, timeout)
 
 
 def _chunk_files(folder):

@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import partial
 
-__all__ = ["Column", "Scenario", "single_thread", "check_row"]
+__all__ = ["Column", "Scenario", "single_thread", "check_row", "ROW_TIMEOUTS"]
 
 
 def single_thread():
@@ -28,6 +28,13 @@ def single_thread():
     from holofold.mechanics.threads import single_thread as limit
 
     return limit()
+
+
+#: default time limit per row (s) by scenario ``kind`` (measured on 20 warm rows of each
+#: built-in scenario: slowest 0.02 s single Miura, 0.19 s arch, 1.3 s canopy, 2.3 s gripper of
+#: 6): over 100x the slowest row and at least 60 s, 4-7x the first row of a process whose numba
+#: kernels are compiled rather than loaded from their cache (9-13 s); docs/scenarios.md §1.3
+ROW_TIMEOUTS = {"": 60.0, "strip": 60.0, "sheet": 300.0, "gripper": 600.0}
 
 
 @dataclass(frozen=True)
@@ -117,6 +124,10 @@ class Scenario:
         for tables of many rows.
     batch_key : callable(row) -> hashable, optional
         Rows with equal keys have models of one size (e.g. the strip's ``m``).
+    row_timeout : float, optional
+        The runner's default time limit per row, seconds (a row past it is recorded as
+        ``failed: timeout ...``; see :mod:`~holofold.design.row_limits`); None: the default of
+        the scenario's ``kind`` (:data:`ROW_TIMEOUTS`).
     """
 
     name: str
@@ -133,8 +144,11 @@ class Scenario:
     write_files: Callable | None = None
     evaluate_batch: Callable[[list], list] | None = None
     batch_key: Callable[[Mapping[str, float]], object] | None = None
+    row_timeout: float | None = None
 
     def __post_init__(self):
+        if self.row_timeout is None:
+            object.__setattr__(self, "row_timeout", ROW_TIMEOUTS.get(self.kind, ROW_TIMEOUTS[""]))
         ev = self.evaluate
         if isinstance(ev, partial) and ev.func is _validated_evaluate:
             ev = ev.args[0]  # another scenario's wrapper: validate with this one's checks

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from holofold.design.scenarios.base import Scenario
+from holofold.design.scenarios.base import ROW_TIMEOUTS, Scenario
 from holofold.design.scenarios.sheet import MIURA as MIURA
 from holofold.design.scenarios.sheet import TMP as TMP
 from holofold.design.scenarios.sheet import (
@@ -97,4 +97,5 @@ SCENARIO = Scenario(
     evaluate_batch=_SHEET.evaluate_batch,
     batch_key=_SHEET.batch_key,
     categorical=("pattern", "m", "n"),
+    row_timeout=ROW_TIMEOUTS["sheet"],  # rows take 0.5-1.3 s warm
 )

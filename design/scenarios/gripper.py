@@ -35,7 +35,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, positive, single_thread
+from holofold.design.scenarios.base import ROW_TIMEOUTS, Column, Scenario, positive, single_thread
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.gripper import DEFAULT_RANGE, GripperPattern, gripper_pattern
 from holofold.mechanics.assembly import Assembler
@@ -822,6 +822,7 @@ SCENARIO = Scenario(
     check=check,
     evaluate=evaluate,
     categorical=("Pattern",),
+    row_timeout=ROW_TIMEOUTS["gripper"],
 )
 CONVERGED_OPTIONS = GripperOptions(converged=True)
 #: the gripper with tightly converged Newton solves: repeatable outputs for new databases

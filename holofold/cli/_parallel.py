@@ -1,4 +1,5 @@
-"""The ``--workers`` / ``--scheduler`` options shared by the commands that simulate designs."""
+"""The options shared by the commands that simulate designs: ``--workers`` / ``--scheduler``
+and the per-row isolation ``--on-invalid`` / ``--row-timeout``."""
 
 from __future__ import annotations
 
@@ -44,3 +45,43 @@ def parallel_settings(args) -> tuple[int, str | None]:
         return check_workers(args.workers), scheduler
     except ValueError:
         raise ValueError(f"--workers {args.workers}: must be >= 1 or -1 (every core)") from None
+
+
+def add_row_arguments(p: argparse.ArgumentParser) -> None:
+    """Add ``--on-invalid fail|skip`` and ``--row-timeout S`` to ``p``."""
+    p.add_argument(
+        "--on-invalid",
+        choices=["fail", "skip"],
+        default="fail",
+        help=(
+            "a design that fails validation: 'fail' refuses the run before anything is "
+            "simulated (default); 'skip' records it as a failed row with its reason and "
+            "simulates the others"
+        ),
+    )
+    p.add_argument(
+        "--row-timeout",
+        metavar="S",
+        default=None,
+        help=(
+            "time limit per design in seconds, past which the row is recorded as "
+            "'failed: timeout ...' and the run goes on; 0 or none = no limit (default: the "
+            "scenario's, 60 s for single-miura and arch, 300 s canopy, 600 s gripper)"
+        ),
+    )
+
+
+def row_settings(args) -> tuple[str, float | None]:
+    """(on_invalid, row_timeout) of parsed arguments: row_timeout None for the scenario's
+    default, 0 for no limit, else seconds."""
+    from holofold.design import resolve_row_timeout
+
+    if args.row_timeout is None:
+        return args.on_invalid, None
+    try:
+        limit = resolve_row_timeout(None, args.row_timeout)
+    except ValueError:
+        raise ValueError(
+            f"--row-timeout {args.row_timeout}: must be seconds > 0, or 0 / none for no limit"
+        ) from None
+    return args.on_invalid, 0 if limit is None else limit

@@ -12,7 +12,12 @@ import argparse
 import sys
 from pathlib import Path
 
-from holofold.cli._parallel import add_parallel_arguments, parallel_settings
+from holofold.cli._parallel import (
+    add_parallel_arguments,
+    add_row_arguments,
+    parallel_settings,
+    row_settings,
+)
 from holofold.design import SCENARIO_NAMES
 
 __all__ = ["register", "run"]
@@ -50,6 +55,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "-o", "--output", type=Path, required=True, help="result table (.csv or .parquet)"
     )
     add_parallel_arguments(p)
+    add_row_arguments(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
     return p
 
@@ -92,12 +98,16 @@ def run(args) -> int:
     scenario = load_scenario(args.scenario)
     check_table_path(args.output)
     workers, scheduler = parallel_settings(args)
+    on_invalid, row_timeout = row_settings(args)
     table = read_table(args.designs)
     if len(table) == 0:
         raise ValueError(f"{args.designs} has no rows")
-    checked = validate_designs(scenario, table)  # raises before anything is simulated
+    # --on-invalid fail: raises before anything is simulated
+    checked = validate_designs(scenario, table, on_invalid)
     for w in checked.warnings:
         print(f"holofold evaluate: warning: {w}", file=sys.stderr)
+    if checked.invalid:
+        print(f"holofold evaluate: warning: {checked.skipped_line()}", file=sys.stderr)
     res = evaluate_designs(
         scenario,
         table,
@@ -105,6 +115,8 @@ def run(args) -> int:
         progress=False if args.no_progress else None,
         log_warnings=False,  # printed above
         scheduler=scheduler,
+        on_invalid=on_invalid,
+        row_timeout=row_timeout,
     )
     write_table(res, args.output)
     ok = int(converged_mask(res["status"]).sum())

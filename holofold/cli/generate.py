@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.cli._parallel import add_parallel_arguments, parallel_settings
+from holofold.cli._parallel import (
+    add_parallel_arguments,
+    add_row_arguments,
+    parallel_settings,
+    row_settings,
+)
 from holofold.design import SCENARIO_NAMES
 
 
@@ -33,6 +38,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="override a feature's range (SI units), or NAME=A,B,C for categorical choices",
     )
     add_parallel_arguments(p)
+    add_row_arguments(p)
     p.add_argument("--chunk-size", type=int, default=100, help="rows per result chunk")
     p.add_argument("--csv", action="store_true", help="also write database.csv")
     return p
@@ -62,10 +68,12 @@ def run(args) -> int:
     from holofold.mechanics import failed_mask
 
     workers, scheduler = parallel_settings(args)
+    on_invalid, row_timeout = row_settings(args)
     db = generate_database(
         args.scenario, args.samples, args.output,
         seed=args.seed, method=args.method, ranges=_parse_ranges(args.range),
         chunk_size=args.chunk_size, workers=workers, scheduler=scheduler, csv=args.csv,
+        on_invalid=on_invalid, row_timeout=row_timeout,
     )  # fmt: skip
     failed = int(failed_mask(db["status"]).sum())
     where = Path(args.output) / "database.parquet"

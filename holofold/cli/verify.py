@@ -5,7 +5,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from holofold.cli._parallel import add_parallel_arguments, parallel_settings
+from holofold.cli._parallel import (
+    add_parallel_arguments,
+    add_row_arguments,
+    parallel_settings,
+    row_settings,
+)
 from holofold.design import SCENARIO_NAMES
 
 
@@ -28,6 +33,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--top", type=int, default=None, help="verify only the first K rules")
     p.add_argument("--seed", type=int, default=0)
     add_parallel_arguments(p)
+    add_row_arguments(p)
     p.add_argument("-o", "--output", help="folder for verify.json and the simulated designs")
     return p
 
@@ -38,6 +44,7 @@ def run(args) -> int:
     from holofold.design import read_rules, verify_rules, write_verification
 
     workers, scheduler = parallel_settings(args)
+    on_invalid, row_timeout = row_settings(args)
     if args.top is not None and args.top < 1:
         raise ValueError(f"--top = {args.top} must be >= 1")
     if args.output is not None and Path(args.output).exists() and not Path(args.output).is_dir():
@@ -46,6 +53,7 @@ def run(args) -> int:
     results = verify_rules(
         args.scenario, rules, args.target, args.samples,
         seed=args.seed, workers=workers, scheduler=scheduler,
+        on_invalid=on_invalid, row_timeout=row_timeout,
     )  # fmt: skip
     for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
         print(f"rule {i}: {r['rule']}\n  {v.describe()}")
