@@ -88,6 +88,7 @@ class Capture:
         self.calls: dict = defaultdict(int)
         self.K: dict = defaultdict(list)
         self.red: dict = {}
+        self.inside_step = False
 
     def _record(self, asm, U, spring_rest):
         key = (id(asm.reduction), asm.reduction.n_free)
@@ -113,18 +114,35 @@ class Capture:
 
             def spy_batch(b, U, active, spring_rest=None):
                 U = np.asarray(U, float).reshape(b.n, -1, 3)
-                for s in np.flatnonzero(active):
-                    rest = None if spring_rest is None else spring_rest[s]
-                    cap._record(b.assemblers[s], U[s], rest)
+                if not cap.inside_step:
+                    for s in np.flatnonzero(active):
+                        rest = None if spring_rest is None else spring_rest[s]
+                        cap._record(b.assemblers[s], U[s], rest)
                 return cap.orig_batch(b, U, active, spring_rest)
 
             batch.factorized = spy_batch
+            self.orig_step = getattr(batch, "newton_step", None)
+            if self.orig_step is not None:  # the compiled Newton step (banded samples)
+
+                def spy_step(b, U, rhs_force, active):
+                    U3 = np.asarray(U, float).reshape(b.n, -1, 3)
+                    for s in np.flatnonzero(active):
+                        cap._record(b.assemblers[s], U3[s], None)
+                    cap.inside_step = True  # its factorized() fallback is counted here
+                    try:
+                        return cap.orig_step(b, U, rhs_force, active)
+                    finally:
+                        cap.inside_step = False
+
+                batch.newton_step = spy_step
         return self
 
     def __exit__(self, *exc):
         assembly.Assembler.evaluate_factorized = self.orig
         if getattr(assembly, "BatchAssembler", None) is not None:
             assembly.BatchAssembler.factorized = self.orig_batch
+            if self.orig_step is not None:
+                assembly.BatchAssembler.newton_step = self.orig_step
 
 
 clock = time.thread_time

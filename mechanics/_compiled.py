@@ -23,9 +23,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.extending import intrinsic
 
-__all__ = ["bar_elements", "spring_elements", "gather"]
+__all__ = [
+    "bar_elements",
+    "spring_elements",
+    "gather",
+    "assemble_batch",
+    "band_newton_step",
+    "lapack_addresses",
+]
 
 _TWO_PI = 2.0 * math.pi
 _OPTS = dict(cache=True, nogil=True, error_model="numpy", boundscheck=False)
@@ -99,17 +108,85 @@ def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, energy, force, K):
                     K[i, j, 1, 1, e] = k3 * 1.0
 
 
-@njit(**_OPTS)
-def _dot(a, b):
+@njit(inline="always", **_OPTS)
+def _dot3(a, b):
     s = a[0] * b[0] + a[1] * b[1]
     return s + a[2] * b[2]
 
 
-@njit(**_OPTS)
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
+@njit(inline="always", **_OPTS)
+def _cross3(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(inline="always", **_OPTS)
+def _lin3(a, x, b, y):
+    """``a x + b y`` for 3-vectors ``x``, ``y``."""
+    return (a * x[0] + b * y[0], a * x[1] + b * y[1], a * x[2] + b * y[2])
+
+
+@njit(inline="always", **_OPTS)
+def _comb3(c0, c1, c2, A, B, inv, x, y, z):
+    """``c x + c' y + c'' z`` with the coefficients ``((c + c1 A) + c2 B) inv`` of one row of
+    the derivatives of A and B (the numpy path's ``_TD`` tables, 0 terms kept)."""
+    k0 = ((c0[0] + c1[0] * A) + c2[0] * B) * inv
+    k1 = ((c0[1] + c1[1] * A) + c2[1] * B) * inv
+    k2 = ((c0[2] + c1[2] * A) + c2[2] * B) * inv
+    return (
+        (k0 * x[0] + k1 * y[0]) + k2 * z[0],
+        (k0 * x[1] + k1 * y[1]) + k2 * z[1],
+        (k0 * x[2] + k1 * y[2]) + k2 * z[2],
+    )
+
+
+@njit(inline="always", **_OPTS)
+def _outer(K, t, s, kk, scaled, u, v):
+    """Block ``t`` of spring ``s``: ``u v'`` (``scaled``: the factors carry sqrt(k)) or
+    ``kk (u v')``."""
+    for i in range(3):
+        for j in range(3):
+            K[i, j, t, s] = u[i] * v[j] if scaled else kk * (u[i] * v[j])
+
+
+@njit(inline="always", **_OPTS)
+def _hessian_ij(K, s, i, j, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B):
+    """Entry (i, j) of the Hessian blocks (Liu & Paulino 2017) times M added to blocks 0-5 and
+    7 of spring ``s``; returns the (i, j) entries of the jj and kk blocks before symmetrising."""
+    cm, cml, cn, cnl = c
+    S1 = m[i] * a1[j] + a1[i] * m[j]
+    S2 = m[i] * a2[j] + a2[i] * m[j]
+    S4 = n[i] * b1[j] + b1[i] * n[j]
+    S5 = n[i] * b2[j] + b2[i] * n[j]
+    O4 = m[i] * rkj[j]
+    O9 = n[i] * rkj[j]
+    H_ij = cm * (S1 - S2) - cml * O4
+    H_ik = cm * S2 + cml * O4
+    H_lj = cnl * O9 - cn * S5
+    H_lk = cn * (S5 - S4) - cnl * O9
+    K[i, j, 0, s] -= cm * S1
+    K[i, j, 1, s] += H_ij
+    K[i, j, 2, s] += H_ik
+    K[i, j, 3, s] += cn * S4
+    K[i, j, 4, s] += H_lj
+    K[i, j, 5, s] += H_lk
+    O10 = gs0[i] * dd[0][j]
+    O11 = gs3[i] * dd[2][j]
+    O12 = gs0[i] * dd[1][j]
+    O13 = gs3[i] * dd[3][j]
+    K[i, j, 7, s] += (A - 1.0) * H_ik - B * H_lk + (O12 - O13)
+    hjj = (A - 1.0) * H_ij - B * H_lj + (O10 - O11)
+    hkk = (B - 1.0) * H_lk - A * H_ik + (O13 - O12)
+    return hjj, hkk
+
+
+@njit(inline="always", **_OPTS)
+def _node(X, U, nd):
+    return (X[nd, 0] + U[nd, 0], X[nd, 1] + U[nd, 1], X[nd, 2] + U[nd, 2])
+
+
+@njit(inline="always", **_OPTS)
+def _sub3(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 @njit(**_OPTS)
@@ -119,44 +196,28 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
     ``X``, ``U`` (nn, 3); ``sT`` (4, ns) node quadruples (i, j, k, l); ``k``, ``theta0``
     (ns,); ``k_nonneg``: every k >= 0 (the numpy path's branch). Writes ``energy`` (ns,),
     ``force`` (3, 4, ns), ``theta`` (ns,) and, if ``tangent``, ``K`` (3, 3, 10, ns): the numpy
-    kernel's layouts.
+    kernel's layouts (or any strided views with those indices). Small vectors are tuples and
+    every index a constant after inlining, so they live in registers (not in scratch arrays
+    that the compiler must reload after each store to ``K``).
     """
     ns = sT.shape[1]
-    P = np.empty((4, 3))
-    rij = np.empty(3)
-    rkj = np.empty(3)
-    rkl = np.empty(3)
-    m = np.empty(3)
-    n = np.empty(3)
-    g = np.empty((4, 3))  # [node, component]
-    gk = np.empty((4, 3))
-    a1 = np.empty(3)
-    a2 = np.empty(3)
-    b1 = np.empty(3)
-    b2 = np.empty(3)
-    dd = np.empty((4, 3))  # dA_j, dA_k, dB_j, dB_k
-    gs = np.empty((2, 3))
-    coef = np.empty(3)
-    hjj = np.empty((3, 3))
-    hkk = np.empty((3, 3))
     for s in range(ns):
-        for a in range(4):
-            nd = sT[a, s]
-            for c in range(3):
-                P[a, c] = X[nd, c] + U[nd, c]
-        for c in range(3):
-            rij[c] = P[0, c] - P[1, c]
-            rkj[c] = P[2, c] - P[1, c]
-            rkl[c] = P[2, c] - P[3, c]
-        _cross(rij, rkj, m)
-        _cross(rkj, rkl, n)
-        dl2 = _dot(rkj, rkj)
-        dmm = _dot(m, m)
-        dnn = _dot(n, n)
-        dA = _dot(rij, rkj)
-        dB = _dot(rkl, rkj)
-        dmkl = _dot(m, rkl)
-        dmn = _dot(m, n)
+        P0 = _node(X, U, sT[0, s])
+        P1 = _node(X, U, sT[1, s])
+        P2 = _node(X, U, sT[2, s])
+        P3 = _node(X, U, sT[3, s])
+        rij = _sub3(P0, P1)
+        rkj = _sub3(P2, P1)
+        rkl = _sub3(P2, P3)
+        m = _cross3(rij, rkj)
+        n = _cross3(rkj, rkl)
+        dl2 = _dot3(rkj, rkj)
+        dmm = _dot3(m, m)
+        dnn = _dot3(n, n)
+        dA = _dot3(rij, rkj)
+        dB = _dot3(rkl, rkj)
+        dmkl = _dot3(m, rkl)
+        dmn = _dot3(m, n)
         ell = math.sqrt(dl2)
         th = _mod(math.atan2(ell * dmkl, dmn), _TWO_PI)
         theta[s] = th
@@ -164,104 +225,71 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
         B = dB / dl2
         p = ell / dmm
         q = ell / dnn
-        al0 = p * (1.0 + 0.0 * A)
-        al1 = p * (-1.0 + 1.0 * A)
-        al2 = p * (0.0 + -1.0 * A)
-        al3 = p * (0.0 + 0.0 * A)
-        be0 = q * (0.0 + 0.0 * B)
-        be1 = q * (0.0 + 1.0 * B)
-        be2 = q * (1.0 + -1.0 * B)
-        be3 = q * (-1.0 + 0.0 * B)
-        for c in range(3):
-            g[0, c] = al0 * m[c] + be0 * n[c]
-            g[1, c] = al1 * m[c] + be1 * n[c]
-            g[2, c] = al2 * m[c] + be2 * n[c]
-            g[3, c] = al3 * m[c] + be3 * n[c]
+        g0 = _lin3(p * (1.0 + 0.0 * A), m, q * (0.0 + 0.0 * B), n)
+        g1 = _lin3(p * (-1.0 + 1.0 * A), m, q * (0.0 + 1.0 * B), n)
+        g2 = _lin3(p * (0.0 + -1.0 * A), m, q * (1.0 + -1.0 * B), n)
+        g3 = _lin3(p * (0.0 + 0.0 * A), m, q * (-1.0 + 0.0 * B), n)
         kk = k[s]
         dth = th - theta0[s]
         M = kk * dth
         energy[s] = 0.5 * M * dth
-        for a in range(4):
-            for c in range(3):
-                force[c, a, s] = M * g[a, c]
+        for c in range(3):
+            force[c, 0, s] = M * g0[c]
+            force[c, 1, s] = M * g1[c]
+            force[c, 2, s] = M * g2[c]
+            force[c, 3, s] = M * g3[c]
         if not tangent:
             continue
         # k g g' over the ten distinct blocks (0 ii, 1 ij, 2 ik, 3 ll, 4 lj, 5 lk, 6 jj, 7 jk,
-        # 8 kk, 9 il)
-        if k_nonneg:  # sqrt(k) g_a sqrt(k) g_b' keeps the diagonal blocks exactly symmetric
+        # 8 kk, 9 il); k >= 0: sqrt(k) g_a sqrt(k) g_b' keeps the diagonal blocks symmetric
+        u0, u1, u2, u3 = g0, g1, g2, g3
+        if k_nonneg:
             sk = math.sqrt(kk)
-            for a in range(4):
-                for c in range(3):
-                    gk[a, c] = sk * g[a, c]
-            for t in range(10):
-                ga = _GG_A[t]
-                gb = _GG_B[t]
-                for i in range(3):
-                    for j in range(3):
-                        K[i, j, t, s] = gk[ga, i] * gk[gb, j]
-        else:
-            for t in range(10):
-                ga = _GG_A[t]
-                gb = _GG_B[t]
-                for i in range(3):
-                    for j in range(3):
-                        K[i, j, t, s] = kk * (g[ga, i] * g[gb, j])
+            u0 = (sk * g0[0], sk * g0[1], sk * g0[2])
+            u1 = (sk * g1[0], sk * g1[1], sk * g1[2])
+            u2 = (sk * g2[0], sk * g2[1], sk * g2[2])
+            u3 = (sk * g3[0], sk * g3[1], sk * g3[2])
+        _outer(K, 0, s, kk, k_nonneg, u0, u0)
+        _outer(K, 1, s, kk, k_nonneg, u0, u1)
+        _outer(K, 2, s, kk, k_nonneg, u0, u2)
+        _outer(K, 3, s, kk, k_nonneg, u3, u3)
+        _outer(K, 4, s, kk, k_nonneg, u3, u1)
+        _outer(K, 5, s, kk, k_nonneg, u3, u2)
+        _outer(K, 6, s, kk, k_nonneg, u1, u1)
+        _outer(K, 7, s, kk, k_nonneg, u1, u2)
+        _outer(K, 8, s, kk, k_nonneg, u2, u2)
+        _outer(K, 9, s, kk, k_nonneg, u0, u3)
         # Hessian (Liu & Paulino 2017) times M, in the numpy path's order of operations
         inv = 1.0 / dl2
-        for a in range(4):  # dA_j, dA_k, dB_j, dB_k as combinations of (r_ij, r_kj, r_kl)
-            for r in range(3):
-                coef[r] = (_TD0[a, r] + _TD1[a, r] * A + _TD2[a, r] * B) * inv
-            for c in range(3):
-                v = coef[0] * rij[c] + coef[1] * rkj[c]
-                dd[a, c] = v + coef[2] * rkl[c]
-        _cross(rkj, m, a1)
-        _cross(rij, m, a2)
-        _cross(rkj, n, b1)
-        _cross(rkl, n, b2)
-        for c in range(3):
-            gs[0, c] = g[0, c] * M
-            gs[1, c] = g[3, c] * M
-        cm = M * ell / (dmm * dmm)
-        cml = M / (dmm * ell)
-        cn = M * ell / (dnn * dnn)
-        cnl = M / (dnn * ell)
-        for i in range(3):
-            for j in range(3):
-                S1 = m[i] * a1[j] + a1[i] * m[j]
-                S2 = m[i] * a2[j] + a2[i] * m[j]
-                S4 = n[i] * b1[j] + b1[i] * n[j]
-                S5 = n[i] * b2[j] + b2[i] * n[j]
-                O4 = m[i] * rkj[j]
-                O9 = n[i] * rkj[j]
-                H_ij = cm * (S1 - S2) - cml * O4
-                H_ik = cm * S2 + cml * O4
-                H_lj = cnl * O9 - cn * S5
-                H_lk = cn * (S5 - S4) - cnl * O9
-                K[i, j, 0, s] -= cm * S1
-                K[i, j, 1, s] += H_ij
-                K[i, j, 2, s] += H_ik
-                K[i, j, 3, s] += cn * S4
-                K[i, j, 4, s] += H_lj
-                K[i, j, 5, s] += H_lk
-                O10 = gs[0, i] * dd[0, j]
-                O11 = gs[1, i] * dd[2, j]
-                O12 = gs[0, i] * dd[1, j]
-                O13 = gs[1, i] * dd[3, j]
-                K[i, j, 7, s] += (A - 1.0) * H_ik - B * H_lk + (O12 - O13)
-                hjj[i, j] = (A - 1.0) * H_ij - B * H_lj + (O10 - O11)
-                hkk[i, j] = (B - 1.0) * H_lk - A * H_ik + (O13 - O12)
+        dd = (  # dA_j, dA_k, dB_j, dB_k as combinations of (r_ij, r_kj, r_kl)
+            _comb3((-1.0, -1.0, 0.0), (0.0, 2.0, 0.0), (0.0, 0.0, 0.0), A, B, inv, rij, rkj, rkl),
+            _comb3((1.0, 0.0, 0.0), (0.0, -2.0, 0.0), (0.0, 0.0, 0.0), A, B, inv, rij, rkj, rkl),
+            _comb3((0.0, 0.0, -1.0), (0.0, 0.0, 0.0), (0.0, 2.0, 0.0), A, B, inv, rij, rkj, rkl),
+            _comb3((0.0, 1.0, 1.0), (0.0, 0.0, 0.0), (0.0, -2.0, 0.0), A, B, inv, rij, rkj, rkl),
+        )
+        a1 = _cross3(rkj, m)
+        a2 = _cross3(rij, m)
+        b1 = _cross3(rkj, n)
+        b2 = _cross3(rkl, n)
+        gs0 = (g0[0] * M, g0[1] * M, g0[2] * M)
+        gs3 = (g3[0] * M, g3[1] * M, g3[2] * M)
+        c = (M * ell / (dmm * dmm), M / (dmm * ell), M * ell / (dnn * dnn), M / (dnn * ell))
+        j00, k00 = _hessian_ij(K, s, 0, 0, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j01, k01 = _hessian_ij(K, s, 0, 1, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j02, k02 = _hessian_ij(K, s, 0, 2, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j10, k10 = _hessian_ij(K, s, 1, 0, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j11, k11 = _hessian_ij(K, s, 1, 1, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j12, k12 = _hessian_ij(K, s, 1, 2, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j20, k20 = _hessian_ij(K, s, 2, 0, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j21, k21 = _hessian_ij(K, s, 2, 1, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
+        j22, k22 = _hessian_ij(K, s, 2, 2, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
         # jj and kk blocks, made exactly symmetric as 0.5 (H + H')
+        hj = ((j00, j01, j02), (j10, j11, j12), (j20, j21, j22))
+        hk = ((k00, k01, k02), (k10, k11, k12), (k20, k21, k22))
         for i in range(3):
             for j in range(3):
-                K[i, j, 6, s] += 0.5 * (hjj[i, j] + hjj[j, i])
-                K[i, j, 8, s] += 0.5 * (hkk[i, j] + hkk[j, i])
-
-
-_GG_A = np.array([0, 0, 0, 3, 3, 3, 1, 1, 2, 0])
-_GG_B = np.array([0, 1, 2, 3, 1, 2, 1, 2, 2, 3])
-_TD0 = np.array([[-1.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 1.0]])
-_TD1 = np.array([[0.0, 2.0, 0.0], [0.0, -2.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
-_TD2 = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, -2.0, 0.0]])
+                K[i, j, 6, s] += 0.5 * (hj[i][j] + hj[j][i])
+                K[i, j, 8, s] += 0.5 * (hk[i][j] + hk[j][i])
 
 
 @njit(**_OPTS)
@@ -294,21 +322,108 @@ def gather(ptr_a, src_a, val_a, ptr_b, src_b, val_b, ptr_c, src_c, val_c, dest, 
 @njit(**_OPTS)
 def assemble_batch(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    scratch, f_out, k_out,
+    views, flats, f_out, k_out,
 ):  # fmt: skip
-    """For each sample ``s = idx[j]``: the kernels into ``scratch`` (the seven element arrays
-    of one sample), then ``f_out[j]`` by the ``force_lists`` and ``k_out[j]`` by the
-    ``tangent_lists`` (each the seven arguments of :func:`gather` but the values)."""
-    eb, fb, Kb, es, fs, Ks, th = scratch
+    """For each sample ``s = idx[j]``: the kernels into the element arrays ``views`` (the
+    seven of one sample, in the kernels' layouts), then ``f_out[j]`` by the ``force_lists``
+    and ``k_out[j]`` by the ``tangent_lists`` (each the seven arguments of :func:`gather` but
+    the values), whose sources index the memory of the views, ``flats``."""
+    eb, fb, Kb, es, fs, Ks, th = views
+    _, vfb, vkb, _, vfs, vks, _ = flats
     fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
     ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
     for j in range(idx.shape[0]):
         s = idx[j]
         bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
         spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
-        vfb = fb.reshape(-1)
-        vfs = fs.reshape(-1)
         gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f_out[j])
-        vkb = Kb.reshape(-1)
-        vks = Ks.reshape(-1)
         gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, k_out[j])
+
+
+# ------------------------------------------------------------------------ LAPACK calls
+# scipy's LAPACK routines by address (scipy.linalg.cython_lapack, the library that
+# scipy.linalg.lapack's wrappers call: the same code, the same results bit for bit). The
+# address is an argument, not a constant of the compiled code, so the code stays cacheable.
+
+
+@intrinsic
+def _fcall(typingctx, addr, args):
+    """Call the void C function at ``addr`` (int) with the data pointers of the tuple of
+    arrays ``args`` (Fortran calling convention: every argument by reference)."""
+    sig = types.void(addr, args)
+
+    def codegen(context, builder, signature, llargs):
+        ptrs = []
+        for i, ty in enumerate(signature.args[1].types):
+            ary = context.make_array(ty)(context, builder, builder.extract_value(llargs[1], i))
+            ptrs.append(builder.bitcast(ary.data, ir.IntType(8).as_pointer()))
+        fnty = ir.FunctionType(ir.VoidType(), [ir.IntType(8).as_pointer()] * len(ptrs))
+        builder.call(builder.inttoptr(llargs[0], fnty.as_pointer()), ptrs)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+def lapack_addresses() -> tuple[int, int]:
+    """Addresses of scipy's ``dpbtrf`` and ``dpbtrs``."""
+    from numba.extending import get_cython_function_address
+
+    return tuple(
+        get_cython_function_address("scipy.linalg.cython_lapack", name)
+        for name in ("dpbtrf", "dpbtrs")
+    )
+
+
+@njit(**_OPTS)
+def band_newton_step(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, Fi, free, perm, bw, addrs, Uflat, dU, f_out, info,
+):  # fmt: skip
+    """One Newton update of each sample ``s = idx[j]`` on the banded Cholesky path: the
+    kernels and gathers of :func:`assemble_batch` (force into ``f_out[j]``), ``dpbtrf`` of the
+    band, ``dpbtrs`` of ``(Fi[s] - f)[free]`` in the band's order ``perm``, ``dU[j]`` the
+    solution on the free DOFs and ``Uflat[s, free] += dU[j]``. ``info[j]``: 0 done, 1 not
+    positive definite (nothing solved or updated), 2 a non-finite solution (U not updated).
+    The operations of ``Assembler.evaluate_factorized`` and its band solver, in their order."""
+    eb, fb, Kb, es, fs, Ks, th = views
+    _, vfb, vkb, _, vfs, vks, _ = flats
+    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
+    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
+    nf = free.shape[0]
+    uplo = np.array([ord("U")], np.uint8)
+    n_ = np.array([nf], np.int32)
+    kd_ = np.array([bw], np.int32)
+    ld_ = np.array([bw + 1], np.int32)
+    one = np.array([1], np.int32)
+    inf_ = np.zeros(1, np.int32)
+    ab = np.empty((bw + 1) * nf)
+    y = np.empty(nf)
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
+        spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
+        f = f_out[j]
+        f[:] = 0.0
+        gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f)
+        ab[:] = 0.0
+        gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, ab)
+        _fcall(addrs[0], (uplo, n_, kd_, ab, ld_, inf_))
+        if inf_[0] != 0:
+            info[j] = 1
+            continue
+        for q in range(nf):
+            d = free[perm[q]]
+            y[q] = Fi[s, d] - f[d]
+        _fcall(addrs[1], (uplo, n_, kd_, one, ab, ld_, y, n_, inf_))
+        ok = True
+        x = dU[j]
+        for q in range(nf):
+            x[perm[q]] = y[q]
+            if not np.isfinite(y[q]):
+                ok = False
+        if not ok:
+            info[j] = 2
+            continue
+        info[j] = 0
+        for q in range(nf):
+            Uflat[s, free[q]] += x[q]

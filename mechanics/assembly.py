@@ -110,6 +110,40 @@ def _gather_lists(families, n: int, dest=None):
     return (*out, np.ascontiguousarray(where, dtype=np.intp))
 
 
+#: element-major memory of the batch path's element arrays, as the axes that turn it into the
+#: kernels' layouts: bar force (nb, 2, 3) -> (3, 2, nb), bar tangent (nb, 2, 2, 3, 3) ->
+#: (3, 3, 2, 2, nb), spring force (ns, 4, 3) -> (3, 4, ns), spring tangent (ns, 10, 3, 3) ->
+#: (3, 3, 10, ns). One element's entries are contiguous: its kernel writes one cache line
+#: after the other and a gather target's sources (elements sharing its DOFs) lie close.
+_ELEMENT_MAJOR = {
+    "bar_force": ((2, 3), (2, 1, 0)),
+    "bar_tangent": ((2, 2, 3, 3), (3, 4, 1, 2, 0)),
+    "spring_force": ((4, 3), (2, 1, 0)),
+    "spring_tangent": ((10, 3, 3), (2, 3, 1, 0)),
+}
+
+
+def _element_major_view(flat: np.ndarray, n: int, kind: str) -> np.ndarray:
+    """``flat`` (element-major memory of ``n`` elements) viewed in the kernel layout."""
+    shape, axes = _ELEMENT_MAJOR[kind]
+    return flat.reshape(n, *shape).transpose(axes)
+
+
+def _element_major_lists(lists, nb: int, ns: int, tangent: bool):
+    """Gather ``lists`` (bars, springs, spring mirrors; sources as flat indices of the kernel
+    layouts) with their sources moved to the element-major memory: the same targets and the
+    same order of summation, so the same sums bit for bit."""
+    a, sa, b, sb, c, sc, dest = lists
+    kinds = ("bar_tangent", "spring_tangent") if tangent else ("bar_force", "spring_force")
+    maps = []
+    for kind, n in zip(kinds, (nb, ns), strict=True):
+        shape, axes = _ELEMENT_MAJOR[kind]
+        maps.append(np.arange(n * int(np.prod(shape))).reshape(n, *shape).transpose(axes).ravel())
+    mb, ms = maps
+    i4 = lambda x: np.ascontiguousarray(x, np.int32)  # noqa: E731 - half the index traffic
+    return tuple(map(i4, (a, mb[sa], b, ms[sb], c, ms[sc], dest)))
+
+
 class SingularSystemError(RuntimeError):
     """The reduced tangent stiffness could not be factorised or solved."""
 
@@ -253,6 +287,22 @@ class ReducedPattern:
         bar_ab, spring_ab, size = self.banded_slots
         return _gather_lists((bar_ab, spring_ab), size)
 
+    def batch_gather(self, path: str):
+        """(lists, size) of a solver path's tangent target for the batch path's element-major
+        element arrays (:func:`_element_major_lists`): the dense block, the band or the CSR
+        data (cached)."""
+        cache = self.__dict__.setdefault("_batch_gather", {})
+        if path not in cache:
+            pat = self._pattern
+            lists, n = (
+                (self.dense_gather, self.n_free**2) if path == "dense"
+                else (self.band_gather, _band_size(self)) if path == "banded"
+                else (pat.data_gather, pat.nnz)
+            )  # fmt: skip
+            nb, ns = pat.bar_dofs.shape[0], pat.spring_dofs.shape[0]
+            cache[path] = (_element_major_lists(lists, nb, ns, True), n)
+        return cache[path]
+
     @cached_property
     def ordering(self):
         nf = self.free.size
@@ -358,6 +408,12 @@ class AssemblyPattern:
         """Gather lists (bars, springs, none) of the internal force (targets: the DOFs)."""
         n = self.n_dof
         return _gather_lists((self.bar_force_dofs, self.spring_force_dofs), n)
+
+    @cached_property
+    def force_gather_element_major(self):
+        """:attr:`force_gather` for the batch path's element-major arrays."""
+        nb, ns = self.bar_dofs.shape[0], self.spring_dofs.shape[0]
+        return _element_major_lists(self.force_gather, nb, ns, False)
 
     @cached_property
     def data_gather(self):
@@ -716,9 +772,31 @@ def _element_buffers(nb: int, ns: int):
     )  # fmt: skip
 
 
+def _element_major_buffers(nb: int, ns: int):
+    """(views, flats): the element arrays of :func:`_element_buffers` in element-major memory
+    (``flats``, see :data:`_ELEMENT_MAJOR`) and viewed in the kernels' layouts (``views``)."""
+    flats = (
+        np.empty(nb), np.empty(6 * nb), np.empty(36 * nb),
+        np.empty(ns), np.empty(12 * ns), np.empty(90 * ns), np.empty(ns),
+    )  # fmt: skip
+    views = (
+        flats[0],
+        _element_major_view(flats[1], nb, "bar_force"),
+        _element_major_view(flats[2], nb, "bar_tangent"),
+        flats[3],
+        _element_major_view(flats[4], ns, "spring_force"),
+        _element_major_view(flats[5], ns, "spring_tangent"),
+        flats[6],
+    )
+    return views, flats
+
+
+_NON_FINITE = "non-finite solution of the linear system (singular stiffness)"
+
+
 def _finite(x):
     if not np.all(np.isfinite(x)):
-        raise SingularSystemError("non-finite solution of the linear system (singular stiffness)")
+        raise SingularSystemError(_NON_FINITE)
     return x
 
 
@@ -771,7 +849,8 @@ class BatchAssembler:
         self._theta0 = np.stack([np.asarray(a.theta0, float) for a in asms])
         self._k_nonneg = np.array([a._k_nonneg for a in asms])
         self._arccos = [a._arccos for a in asms]
-        self._scratch = _element_buffers(len(a0.bars), len(a0.springs))
+        self._scratch = _element_major_buffers(len(a0.bars), len(a0.springs))
+        self._addrs = None  # LAPACK addresses of the compiled Newton step, on first use
 
     @property
     def free_dofs(self) -> np.ndarray:
@@ -822,23 +901,89 @@ class BatchAssembler:
                 for s in idx:
                     solves[s] = lambda rhs: np.zeros_like(rhs, dtype=float)
                 continue
-            nf = red.n_free
-            lists, n = (
-                (red.dense_gather, nf * nf) if path == "dense"
-                else (red.band_gather, _band_size(red)) if path == "banded"
-                else (pat.data_gather, pat.nnz)
-            )  # fmt: skip
+            lists, n = red.batch_gather(path)
             fj = np.zeros((idx.size, self.n_dof))
             kj = np.zeros((idx.size, n))
+            views, flats = self._scratch
             ck.assemble_batch(
                 self._X, U, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
-                self._k, theta0, self._k_nonneg, idx, pat.force_gather, lists, self._scratch,
-                fj, kj,
+                self._k, theta0, self._k_nonneg, idx, pat.force_gather_element_major, lists,
+                views, flats, fj, kj,
             )  # fmt: skip
             f[idx] = fj
             for j, s in enumerate(idx):
                 solves[s] = self._solver(s, path, red, kj[j], U[s], rest[s])
         return f, solves
+
+    def newton_step(self, U, rhs_force, active):
+        """One Newton update of the ``active`` samples: ``U[s, free] += dU`` with
+        ``dU = K_ff^-1 (rhs_force[s] - f_int[s])[free]``, bit for bit
+        ``solve = factorized(U, active)[1][s]; dU = solve((rhs_force[s] - f[s])[free])``.
+
+        Samples on the banded path are evaluated, factorised and solved in one compiled call
+        per connectivity (scipy's LAPACK by address, ``_compiled.band_newton_step``); the
+        others, and banded tangents that are not positive definite, by :meth:`factorized`.
+
+        Parameters
+        ----------
+        U : (S, ndof) float, C-contiguous
+            Displacements, updated in place, m.
+        rhs_force : (S, ndof) float
+            External force of each sample, N.
+        active : (S,) bool
+
+        Returns
+        -------
+        dict
+            Sample -> its increment ``dU`` (nf,) on :attr:`free_dofs`, or the
+            :class:`SingularSystemError` that stopped it (its U is left alone).
+        """
+        ck = _ck()
+        if U.dtype != float or not U.flags.c_contiguous or U.shape != (self.n, self.n_dof):
+            raise ValueError(f"U must be a C-contiguous float ({self.n}, {self.n_dof}) array")
+        active = np.ascontiguousarray(active, dtype=bool)
+        U3 = U.reshape(self.n, -1, 3)
+        Fi = np.ascontiguousarray(rhs_force, dtype=float)
+        out: dict = {}
+        rest = active.copy()
+        if not any(self._arccos):
+            for pat, red, members in self.groups:
+                idx = np.ascontiguousarray(members[active[members]], dtype=np.intp)
+                if idx.size == 0 or solver_path(red, self.dense_max) != "banded":
+                    continue
+                if self._addrs is None:
+                    self._addrs = np.array(ck.lapack_addresses(), np.int64)
+                perm, bw, _, _ = red.banded
+                lists, _ = red.batch_gather("banded")
+                views, flats = self._scratch
+                nf = red.n_free
+                dU = np.empty((idx.size, nf))
+                fj = np.empty((idx.size, self.n_dof))
+                info = np.zeros(idx.size, np.int8)
+                ck.band_newton_step(
+                    self._X, U3, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
+                    self._k, self._theta0, self._k_nonneg, idx, pat.force_gather_element_major,
+                    lists, views, flats, Fi, red.free, perm, bw, self._addrs, U, dU, fj, info,
+                )  # fmt: skip
+                for j, s in enumerate(idx):
+                    if info[j] == 1:
+                        continue  # not positive definite: LU by factorized below
+                    rest[s] = False
+                    out[s] = dU[j] if info[j] == 0 else SingularSystemError(_NON_FINITE)
+        if rest.any():
+            f, solves = self.factorized(U3, rest)
+            free = self.free_dofs
+            for s in np.flatnonzero(rest):
+                try:
+                    if isinstance(solves[s], SingularSystemError):
+                        raise solves[s]
+                    dU_s = solves[s]((Fi[s] - f[s])[free])
+                except SingularSystemError as exc:
+                    out[s] = exc
+                    continue
+                U[s, free] += dU_s
+                out[s] = dU_s
+        return out
 
     def _solver(self, s, path, red, values, U, rest):
         """The solver of sample ``s`` from its dense block, band or CSR data ``values``

@@ -150,7 +150,6 @@ def solve_newton_batch(
     P = np.stack([nodal_array("load", ld, nn).ravel() for ld in loads])
     F0v = np.stack([nodal_array("F0", None if F0 is None else F0[s], nn).ravel() for s in range(S)])
     U = np.stack([nodal_array("U0", None if U0 is None else U0[s], nn).ravel() for s in range(S)])
-    free = B.free_dofs
     hists = [History(increments, nn) for _ in range(S)]
     alive = np.ones(S, bool)
     last = np.zeros(S, np.int64)
@@ -163,18 +162,14 @@ def solve_newton_batch(
             it = alive & (step < max_iter) & (R > tol)
             if not it.any():
                 break
-            f, solves = B.factorized(U.reshape(S, nn, 3), it)
+            steps = B.newton_step(U, Fi, it)  # U[s, free] += dU for every solved sample
             for s in np.flatnonzero(it):
-                try:
-                    if isinstance(solves[s], SingularSystemError):
-                        raise solves[s]
-                    dU = solves[s]((Fi[s] - f[s])[free])
-                except SingularSystemError as exc:
-                    hists[s].failure = f"increment {i}, iteration {step[s]}: {exc}"
+                dU = steps[s]
+                if isinstance(dU, SingularSystemError):
+                    hists[s].failure = f"increment {i}, iteration {step[s]}: {dU}"
                     hists[s].record(U[s], i, False, step[s] - 1, R[s])
                     alive[s] = False
                     continue
-                U[s, free] += dU
                 R[s] = float(np.sqrt(dU @ dU))
                 step[s] += 1
         for s in np.flatnonzero(alive):
