@@ -9,7 +9,8 @@ published column sets, unless given), leaves out failed simulations, and fits a
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import os
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -27,7 +28,30 @@ from holofold.design.tables import ColumnRoles
 from holofold.design.targets import Target, parse_target
 from holofold.mechanics.status import failed_mask
 
-__all__ = ["MinedRules", "mine_rules", "select_features"]
+__all__ = [
+    "MinedRules",
+    "mine_rules",
+    "select_features",
+    "mining_estimate",
+    "check_mining_size",
+    "MAX_MINING_BYTES",
+    "MAX_MINING_SECONDS",
+    "MAX_TREE_DEPTH",
+]
+
+#: cost of growing and mining one tree, measured with ``mine_rules`` on tables of 500, 3000 and
+#: 20,000 rows (6 features, 100-400 trees, one thread; docs/limits.md): peak memory per row a
+#: tree is grown on (270-490 B, rounded up) and time per tree and per such row
+BYTES_PER_TREE_ROW = 500
+SECONDS_PER_TREE = 5e-3
+SECONDS_PER_TREE_ROW = 15e-6
+#: the largest work ``mine_rules`` starts without ``force=True`` (``holofold mine --force``):
+#: estimated peak memory of the forest and estimated time on one thread
+MAX_MINING_BYTES = 4 * 2**30
+MAX_MINING_SECONDS = 3600.0
+#: a tree of depth d has a leaf at depth d below d splits of >= 2 rows each: deeper limits
+#: change nothing for the tables mined here (and 1e20 overflowed scikit-learn's C integer)
+MAX_TREE_DEPTH = 1000
 
 
 @dataclass(frozen=True)
@@ -138,6 +162,62 @@ def select_features(
     return tuple(features), tuple(categorical)
 
 
+def mining_estimate(n_train: int, n_estimators: int, max_samples=0.5) -> tuple[float, float]:
+    """(peak bytes, seconds on one thread) of a forest of ``n_estimators`` trees, each grown on
+    ``max_samples`` (a fraction or a count) of ``n_train`` rows: the constants above."""
+    if isinstance(max_samples, float):
+        rows = max(1, int(max_samples * n_train))
+    else:
+        rows = min(int(max_samples), n_train)
+    trees = float(n_estimators)
+    return (
+        trees * rows * BYTES_PER_TREE_ROW,
+        trees * (SECONDS_PER_TREE + rows * SECONDS_PER_TREE_ROW),
+    )
+
+
+def _size(nbytes: float) -> str:
+    return f"{nbytes / 2**30:.3g} GiB" if nbytes >= 2**30 else f"{nbytes / 2**20:.3g} MiB"
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds / 3600:.3g} h" if seconds >= 3600 else f"{seconds:.3g} s"
+
+
+def check_mining_size(n_train: int, params: dict, *, force: bool = False) -> tuple[float, float]:
+    """Refuse a forest whose estimated memory or time is over the limits (unless ``force``),
+    a ``max_depth`` over :data:`MAX_TREE_DEPTH` and more threads than 4 per core; returns the
+    estimate (bytes, seconds). Messages name the parameter and its ``holofold mine`` option."""
+    depth = params.get("max_depth", 20)
+    if depth is not None and not isinstance(depth, bool) and isinstance(depth, int | np.integer):
+        if depth > MAX_TREE_DEPTH:
+            raise ValueError(
+                f"max_depth (--depth) = {depth} is over the limit of {MAX_TREE_DEPTH}: a deeper "
+                "limit grows the same trees"
+            )
+    jobs = params.get("n_jobs")
+    cores = os.cpu_count() or 1
+    if isinstance(jobs, int | np.integer) and not isinstance(jobs, bool) and jobs > 4 * cores:
+        raise ValueError(
+            f"n_jobs (--jobs) = {jobs} threads is over the limit of {4 * cores} (4 per core of "
+            f"the {cores} here); more threads than cores only wait for each other"
+        )
+    trees = params.get("n_estimators", 100)
+    nbytes, seconds = mining_estimate(n_train, trees, params.get("max_samples", 0.5))
+    over = []
+    if nbytes > MAX_MINING_BYTES:
+        over.append(f"{_size(nbytes)} of memory (limit {_size(MAX_MINING_BYTES)})")
+    if seconds > MAX_MINING_SECONDS:
+        over.append(f"{_duration(seconds)} on one thread (limit {_duration(MAX_MINING_SECONDS)})")
+    if over and not force:
+        raise ValueError(
+            f"n_estimators (--trees) = {trees} trees on {n_train} training rows would take an "
+            f"estimated {' and '.join(over)}; use fewer trees, or force it (force=True, "
+            "holofold mine --force)"
+        )
+    return nbytes, seconds
+
+
 def mine_rules(
     table: pd.DataFrame,
     target: str | Target,
@@ -148,6 +228,8 @@ def mine_rules(
     test_size: float = 0.4,
     seed: int = 0,
     source: str = "the table",
+    force: bool = False,
+    progress: Callable[[str], None] | None = None,
     **params,
 ) -> MinedRules:
     """Mine rules for ``target`` on a training split of ``table``, scored on the test split.
@@ -167,9 +249,16 @@ def mine_rules(
         Test fraction of ``train_test_split(rows, test_size, random_state=seed)``.
     seed : int
         Seed of the split and of the forest.
+    force : bool
+        Train a forest whose estimated memory or time is over :data:`MAX_MINING_BYTES` or
+        :data:`MAX_MINING_SECONDS` (:func:`check_mining_size`), which is refused otherwise.
+    progress : callable(str), optional
+        Called with one line (the estimate) before training that is estimated to take over
+        10 s.
     **params
         :class:`~holofold.design.rules.ForestRuleMiner` parameters (``n_estimators``,
-        ``max_depth``, ``n_rules``, ``scoring``, ...); checked by the estimator.
+        ``max_depth``, ``n_rules``, ``scoring``, ...); checked by the estimator, and sizes by
+        :func:`check_mining_size`.
 
     Raises
     ------
@@ -198,5 +287,11 @@ def mine_rules(
     train, _ = split_indices(len(table), test_size=test_size, random_state=seed)
     if y[train].all() or not y[train].any():
         raise ValueError("the training split holds only one class; change --seed or --test-size")
+    nbytes, seconds = check_mining_size(len(train), miner.get_params(), force=force)
+    if progress is not None and seconds > 10:
+        progress(
+            f"training {miner.n_estimators} trees on {len(train)} rows: about "
+            f"{_duration(seconds)} on one thread and {_size(nbytes)} (estimated)"
+        )
     res = holdout(miner, table[list(feats)], y, test_size=test_size, random_state=seed)
     return MinedRules(res, tgt, feats, cats, table, n_failed)

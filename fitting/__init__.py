@@ -41,7 +41,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "read_svg_curve",
         ],
         "error": ["ClosestPointError", "closest_point_error", "index_matched_error", "paper_error"],
-        "strip": ["SAMPLINGS", "StripGeometry", "strip_geometry"],
+        "strip": ["SAMPLINGS", "MAX_M", "StripGeometry", "strip_geometry"],
         "strip_files": ["export_strip_files"],
         "strip_fit": ["StripFit", "fit_strip"],
     },

@@ -60,11 +60,15 @@ __all__ = [
     "quad_warp",
     "sector_angle_development",
     "SAMPLINGS",
+    "MAX_M",
     "check_m",
     "check_sampling",
 ]
 
 SAMPLINGS = ("paper", "arclength")
+#: the largest m that ``holofold fit`` fits and the strip scenarios simulate (a strip of 4m
+#: panels; fitting m = 2000 takes 4 s); the Python functions take any m
+MAX_M = 2000
 _MIN_SIN_PHI = 1e-6  # below this the tangential shift W_s/sin(phi) is considered unbounded
 
 

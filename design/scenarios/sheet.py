@@ -54,7 +54,7 @@ from holofold.design.scenarios.config import (
     read_material,
     read_solver,
 )
-from holofold.geometry import export_pattern_files
+from holofold.geometry import MAX_PANELS, export_pattern_files
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.miura import miura_faces, miura_nodes, miura_sheet, rigid_fold_pattern
 from holofold.geometry.pattern import CreasePattern
@@ -341,6 +341,12 @@ def check_sheet(setting: SheetSetting, row) -> list[str]:
         errs.append(f"pattern = {p!r} must be 1 (Miura) or 2 (TMP)")
     ok_m, ok_n = not integer(d, "m", 1), not integer(d, "n", 1)
     errs += integer(d, "m", 1) + integer(d, "n", 1)
+    if ok_m and ok_n and d["m"] * d["n"] > MAX_PANELS:
+        errs.append(
+            f"m = {int(d['m'])} x n = {int(d['n'])} = {int(d['m']) * int(d['n'])} panels is "
+            f"over the limit of {MAX_PANELS} (docs/limits.md)"
+        )
+        ok_m = ok_n = False  # no geometry checks on a sheet too large to build
     if p == TMP and ok_m and d["m"] % 2:
         errs.append(f"m = {d['m']:g} must be even for a TMP sheet")
     if p == TMP and ok_n and d["n"] % 3:
@@ -600,6 +606,12 @@ def _check_features(doc: Section, sheet: dict, features: tuple[Column, ...]) -> 
         where[k] = f"[sheet] {k}" if sheet[k] is not None else f"[features] {k}"
         if not all(v >= 1 and v == int(v) for v in counts[k]):
             raise doc.error(f"{where[k]} must be integers >= 1, got {counts[k]}")
+    largest = int(max(counts["m"])) * int(max(counts["n"]))
+    if largest > MAX_PANELS:
+        raise doc.error(
+            f"{where['m']} = {counts['m']} x {where['n']} = {counts['n']}: the largest sheet has "
+            f"{largest} panels; at most {MAX_PANELS} (docs/limits.md)"
+        )
     if TMP in pats:
         if any(int(v) % 2 for v in counts["m"]):
             raise doc.error(f"{where['m']} = {counts['m']}: TMP sheets (pattern 2) need even m")

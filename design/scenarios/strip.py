@@ -56,6 +56,7 @@ from holofold.design.scenarios.config import (
 )
 from holofold.fitting import (
     BUILTIN_CURVES,
+    MAX_M,
     PlanarCurve,
     builtin_curve,
     closest_point_error,
@@ -239,6 +240,8 @@ def loaded_node(setting: StripSetting, m: int, at: float, t: np.ndarray | None =
 def check_strip(setting: StripSetting, row) -> list[str]:
     """Physical validity of one design (empty if valid)."""
     errs = integer(row, "m", 2)
+    if not errs and row["m"] > MAX_M:
+        errs.append(f"m = {int(row['m'])} is over the limit of {MAX_M} (4m panels; docs/limits.md)")
     errs += positive(row, ("tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"))
     return errs
 

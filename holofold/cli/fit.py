@@ -32,7 +32,7 @@ import argparse
 import math
 from pathlib import Path
 
-from holofold.fitting import DEFAULT_M_RANGE, PUBLISHED_MAX_WARP, SAMPLINGS
+from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
 
 
@@ -115,8 +115,7 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 # ---------------------------------------------------------------------- validation
-#: the largest m the command fits (a strip of 4m panels; m = 2000 takes 4 s)
-MAX_M = 2000
+# the largest m the command fits: fitting.MAX_M (a strip of 4m panels; m = 2000 takes 4 s)
 
 
 def _m_range(text: str | None) -> list[int]:

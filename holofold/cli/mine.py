@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
 import warnings
 
 __all__ = ["register", "run"]
@@ -70,8 +71,21 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--rules", type=int, default=3, metavar="K", help="rules to keep (default 3)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="split and forest seed")
     p.add_argument("--test-size", type=float, default=0.4, help="test fraction (default 0.4)")
-    p.add_argument("--trees", type=int, default=100, help="number of trees (default 100)")
-    p.add_argument("--depth", type=int, default=20, help="maximum tree depth (default 20)")
+    p.add_argument(
+        "--trees",
+        type=int,
+        default=100,
+        help="number of trees (default 100); a forest estimated to need over 4 GiB or 1 h is "
+        "refused without --force (docs/limits.md)",
+    )
+    p.add_argument(
+        "--depth", type=int, default=20, help="maximum tree depth (default 20, at most 1000)"
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="train a forest over the memory and time limits all the same",
+    )
     p.add_argument("--precision-min", type=float, default=0.9, help="default 0.9")
     p.add_argument("--min-support", type=int, default=10, help="default 10")
     p.add_argument("--beta", type=float, default=0.2, help="F-beta for ranking (default 0.2)")
@@ -157,6 +171,8 @@ def run(args) -> int:
                 test_size=args.test_size,
                 seed=args.seed,
                 source=args.database,
+                force=args.force,
+                progress=lambda line: print(f"holofold mine: {line}", file=sys.stderr),
                 **{
                     param: getattr(args, arg)
                     for param, arg in _MINER_ARGS.items()
