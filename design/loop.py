@@ -203,7 +203,10 @@ def _base_batches(db: Path, n: int, covered: int = 0) -> list[tuple[int, int]]:
 
 
 def _simulate(scenario, designs, folder, workers, progress) -> pd.DataFrame:
-    return build_database(scenario, designs, folder, workers=workers, progress=progress)
+    # sampled designs the scenario's check refuses are failed rows, not a refused run
+    return build_database(
+        scenario, designs, folder, workers=workers, progress=progress, on_invalid="skip"
+    )
 
 
 def _verify(scenario, records, target, n, folder, seed, workers, progress):

@@ -408,7 +408,7 @@ def generate_database(
     progress: bool | None = None,
     scheduler: str | None = None,
     csv: bool = False,
-    on_invalid: str = "fail",
+    on_invalid: str = "skip",
     row_timeout: float | str | None = None,
 ) -> pd.DataFrame:
     """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
@@ -418,10 +418,10 @@ def generate_database(
     writes ``database.csv``. Returns the database.
 
     Sampled designs lie inside the features' ranges, but a scenario's check can still refuse
-    some (an odd arch ``m`` from ``ranges``, a gripper whose ``W`` is not below ``L2/2``):
-    ``on_invalid="fail"`` refuses the database before anything is simulated, ``"skip"``
-    stores them as failed rows with their reason. Designs refused while simulating (a
-    self-overlapping strip) are failed rows either way.
+    some (an odd arch ``m`` from ``ranges``, a gripper whose ``W`` is not below ``L2/2``: 49
+    of 2000 in the paper's ranges): ``"skip"`` (default) stores them as failed rows with
+    their reason, ``on_invalid="fail"`` refuses the database before anything is simulated.
+    Designs refused while simulating (a self-overlapping strip) are failed rows either way.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)

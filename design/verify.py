@@ -182,7 +182,7 @@ def verify_rule(
     workers: int = 1,
     progress: bool | None = None,
     scheduler: str | None = None,
-    on_invalid: str = "fail",
+    on_invalid: str = "skip",
     row_timeout: float | str | None = None,
 ) -> Verification:
     """Simulate ``n`` fresh designs inside a rule and count those meeting ``target``.
@@ -214,7 +214,7 @@ def verify_rules(
     workers: int = 1,
     progress: bool | None = None,
     scheduler: str | None = None,
-    on_invalid: str = "fail",
+    on_invalid: str = "skip",
     row_timeout: float | str | None = None,
 ) -> list[Verification]:
     """:func:`verify_rule` for each rule record (``bounds`` as in a rules file), in order.

@@ -111,9 +111,9 @@ def test_fail_keeps_refusing_the_table():
 def test_verify_rule_skips_refused_fresh_designs():
     bounds = {"a": {"gt": 4.0, "le": None}}  # half of (4, 10] is refused (a > 8)
     with pytest.raises(DesignTableError):
-        verify_rule(TOY, bounds, "double > 12", 20, seed=1, row_timeout=0)
-    with pytest.warns(UserWarning, match="invalid"):
-        v = verify_rule(TOY, bounds, "double > 12", 20, seed=1, on_invalid="skip", row_timeout=0)
+        verify_rule(TOY, bounds, "double > 12", 20, seed=1, on_invalid="fail", row_timeout=0)
+    with pytest.warns(UserWarning, match="invalid"):  # skip: the default for sampled designs
+        v = verify_rule(TOY, bounds, "double > 12", 20, seed=1, row_timeout=0)
     refused = (v.designs["a"] > 8).to_numpy()
     assert refused.any() and v.n_failed == refused.sum() and v.n_ok == 20 - refused.sum()
     assert v.designs["status"][refused].str.startswith("failed: invalid design: a = ").all()
@@ -210,9 +210,9 @@ def test_generate_skips_designs_the_check_refuses(tmp_path, capsys):
     out = tmp_path / "db"
     argv = ["generate", "arch", "-n", "4", "--range", "m=4,5", "--seed", "2", "-o", str(out),
             "--chunk-size", "2"]  # fmt: skip
-    assert main(argv) == 2
+    assert main([*argv, "--on-invalid", "fail"]) == 2
     assert "must be even" in capsys.readouterr().err
-    assert main([*argv, "--on-invalid", "skip"]) == 0
+    assert main(argv) == 0  # skip: the default of a command that samples its own designs
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "row(s) invalid, recorded as failed" in err
     db = pd.read_parquet(out / "database.parquet")

@@ -47,16 +47,18 @@ def parallel_settings(args) -> tuple[int, str | None]:
         raise ValueError(f"--workers {args.workers}: must be >= 1 or -1 (every core)") from None
 
 
-def add_row_arguments(p: argparse.ArgumentParser) -> None:
-    """Add ``--on-invalid fail|skip`` and ``--row-timeout S`` to ``p``."""
+def add_row_arguments(p: argparse.ArgumentParser, on_invalid: str = "fail") -> None:
+    """Add ``--on-invalid fail|skip`` (default ``on_invalid``) and ``--row-timeout S`` to
+    ``p``: ``skip`` for commands that sample their own designs, whose refusals are rows of the
+    database rather than a mistake in the user's input."""
     p.add_argument(
         "--on-invalid",
         choices=["fail", "skip"],
-        default="fail",
+        default=on_invalid,
         help=(
             "a design that fails validation: 'fail' refuses the run before anything is "
-            "simulated (default); 'skip' records it as a failed row with its reason and "
-            "simulates the others"
+            "simulated; 'skip' records it as a failed row with its reason and simulates the "
+            f"others (default: {on_invalid})"
         ),
     )
     p.add_argument(

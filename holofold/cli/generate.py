@@ -38,7 +38,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="override a feature's range (SI units), or NAME=A,B,C for categorical choices",
     )
     add_parallel_arguments(p)
-    add_row_arguments(p)
+    add_row_arguments(p, on_invalid="skip")
     p.add_argument("--chunk-size", type=int, default=100, help="rows per result chunk")
     p.add_argument("--csv", action="store_true", help="also write database.csv")
     return p

@@ -33,7 +33,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--top", type=int, default=None, help="verify only the first K rules")
     p.add_argument("--seed", type=int, default=0)
     add_parallel_arguments(p)
-    add_row_arguments(p)
+    add_row_arguments(p, on_invalid="skip")
     p.add_argument("-o", "--output", help="folder for verify.json and the simulated designs")
     return p
 
