@@ -97,3 +97,20 @@ def test_an_interval_over_a_categorical_feature_gives_its_levels():
     arch = get_scenario("arch")
     got = rule_ranges(arch, {"m": {"gt": 10, "le": None}, "offset": {"gt": None, "le": 0.2}})
     assert got == {"m": [12.0, 16.0, 24.0], "offset": (0.10, 0.2)}
+
+
+def test_verify_shows_what_mining_said_beside_the_verified_precision(tmp_path, capsys):
+    soft = {"tcrease": {"gt": None, "le": 0.6e-3}, "tpanel": {"gt": None, "le": 1.2e-3}}
+    rules = tmp_path / "rules.json"
+    mined = {"rule": "soft", "bounds": soft, "test": {"precision": 0.9, "support": 30},
+             "estimate": {"precision": 0.875, "interval": [0.78, 0.94], "rows": 55}}  # fmt: skip
+    bare = {"rule": "bare", "bounds": soft, "estimate": {"precision": None}}
+    rules.write_text(json.dumps([mined, bare]))
+    argv = ["verify", "single-miura", "--rules", str(rules), "--target", "axialstiff60 < 6000",
+            "-n", "3"]  # fmt: skip
+    assert main(argv) == 0
+    out = capsys.readouterr().out.splitlines()
+    shown = [line.strip() for line in out if line.strip().startswith("mined with")]
+    assert shown == [
+        "mined with: estimate 0.875 (95 % interval 0.780-0.940), held-out precision 0.900"
+    ]  # the second rule carries no usable estimate: nothing is made up

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from holofold.cli._parallel import (
@@ -57,8 +58,32 @@ def run(args) -> int:
     )  # fmt: skip
     for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
         print(f"rule {i}: {r['rule']}\n  {v.describe()}")
+        shown = _shown(r)
+        if shown:
+            print(f"  {shown}")
     if args.output is not None:
         write_verification(args.output, rules, results)
     print(json.dumps([{"rank": i, **{k: v.summary()[k] for k in ("precision", "simulated")}}
                       for i, v in enumerate(results, start=1)]))  # fmt: skip
     return 0
+
+
+def _number(x) -> bool:
+    return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def _shown(rec: dict) -> str:
+    """What `holofold mine` said of the rule (its estimate and held-out precision), if the
+    rules file carries it: '' otherwise."""
+    parts = []
+    est = rec.get("estimate")
+    if isinstance(est, dict) and _number(est.get("precision")):
+        text = f"estimate {est['precision']:.3f}"
+        ci = est.get("interval")
+        if isinstance(ci, list) and len(ci) == 2 and all(_number(c) for c in ci):
+            text += f" (95 % interval {ci[0]:.3f}-{ci[1]:.3f})"
+        parts.append(text)
+    test = rec.get("test")
+    if isinstance(test, dict) and _number(test.get("precision")):
+        parts.append(f"held-out precision {test['precision']:.3f}")
+    return "mined with: " + ", ".join(parts) if parts else ""
