@@ -60,14 +60,13 @@ from holofold.fitting import (
     PlanarCurve,
     builtin_curve,
     closest_point_error,
-    export_strip_files,
     fit_strip,
     index_matched_error,
     read_points_csv,
     read_svg_curve,
     strip_geometry,
 )
-from holofold.geometry import LENGTH_UNITS, non_simple_faces, printability
+from holofold.geometry import LENGTH_UNITS, non_simple_faces
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
@@ -285,6 +284,14 @@ def strip_model(setting: StripSetting, row, *, profile=PAPER):
     return s, g, index_matched_error(setting.curve, g.centre_line, g.t)
 
 
+def _printability(pattern, tpanel: float, W: float):
+    """:func:`holofold.geometry.printability`, imported on first use (it brings trimesh and
+    scipy.spatial, a second of start-up for a worker that never needs them)."""
+    from holofold.geometry import printability
+
+    return printability(pattern, tpanel, W)
+
+
 def _mass(setting: StripSetting, g, row) -> float:
     X, F = g.nodes, g.faces
     area = 0.5 * np.linalg.norm(np.cross(X[F[:, 2]] - X[F[:, 0]], X[F[:, 3]] - X[F[:, 1]]), axis=1)
@@ -300,6 +307,20 @@ def evaluate_strip(setting: StripSetting, columns: Sequence[str], row) -> dict:
     return evaluate_strip_batch(setting, columns, [row])[0]
 
 
+def _non_simple(geometries) -> list[np.ndarray]:
+    """:func:`~holofold.geometry.non_simple_faces` of each strip, in one call for all (the
+    check is per face: the same faces of each strip as alone)."""
+    offsets = np.cumsum([0] + [len(g.nodes) for g in geometries])
+    counts = np.cumsum([0] + [len(g.faces) for g in geometries])
+    bad = non_simple_faces(
+        np.concatenate([g.nodes for g in geometries]),
+        np.concatenate(
+            [np.asarray(g.faces) + o for g, o in zip(geometries, offsets, strict=False)]
+        ),
+    )
+    return [bad[(bad >= a) & (bad < b)] - a for a, b in zip(counts[:-1], counts[1:], strict=True)]
+
+
 def strip_batch_key(row) -> int:
     """Designs with the same key (their ``m``) have models of one size: one batch."""
     return int(row["m"])
@@ -313,9 +334,11 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
     outs: list = [None] * len(rows)
     models = []
     printable = {}
+    built = [strip_model(setting, row) for row in rows]
+    overlaps = _non_simple([g for _, g, _ in built]) if setting.refuse_overlap else None
     for i, row in enumerate(rows):
-        s, g, err = strip_model(setting, row)
-        bad = non_simple_faces(g.nodes, g.faces) if setting.refuse_overlap else ()
+        s, g, err = built[i]
+        bad = overlaps[i] if overlaps is not None else ()
         if len(bad):
             outs[i] = {
                 **dict.fromkeys(columns, float("nan")),
@@ -327,7 +350,7 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
             continue
         if "overlap" in columns:
             pattern = CreasePattern.from_faces(g.nodes, list(g.faces))
-            printable[i] = printability(pattern, float(row["tpanel"]), float(row["W"]))
+            printable[i] = _printability(pattern, float(row["tpanel"]), float(row["W"]))
         models.append((i, s, g, err))
     if not models:
         return outs
@@ -397,6 +420,8 @@ def write_strip_files(setting: StripSetting, row, folder, units: str = "mm") -> 
 
     Returns label -> path (the labels name the formats and units).
     """
+    from holofold.fitting import export_strip_files  # trimesh: only for files
+
     paths = export_strip_files(
         _fit(setting, row),
         folder,
