@@ -40,6 +40,31 @@ def _unit_samples(method: str, n: int, d: int, seed: int, start: int) -> np.ndar
     return u[start : start + n]
 
 
+def _range_of(c, r, categorical: bool):
+    """``r`` checked against the kind of feature ``c``: a (low, high) tuple of a categorical
+    feature becomes its choices in [low, high]; a list of a continuous feature is refused."""
+    if r is None:
+        return None
+    if categorical and isinstance(r, tuple):
+        if len(r) != 2:
+            raise ValueError(f"range of {c.name!r}: expected (low, high), got {r!r}")
+        lo, hi = (float(v) for v in r)
+        inside = [v for v in c.choices or () if lo <= v <= hi]
+        if not inside:
+            have = ", ".join(f"{v:g}" for v in c.choices or ()) or "none"
+            raise ValueError(
+                f"range of {c.name!r}: no choice of this categorical feature lies in "
+                f"[{lo:g}, {hi:g}] (its choices: {have}); give the choices as a list"
+            )
+        return inside
+    if not categorical and isinstance(r, list):
+        raise ValueError(
+            f"range of {c.name!r}: {c.name} is continuous; give (low, high), not a list of "
+            f"values {r!r} (on the command line NAME=LOW:HIGH)"
+        )
+    return r
+
+
 def sample_designs(
     scenario: Scenario,
     n: int,
@@ -62,8 +87,9 @@ def sample_designs(
         Seed; the same seed gives the same rows.
     method : {"random", "lhs", "sobol"}
     ranges : mapping, optional
-        ``name -> (low, high)`` for continuous or ``name -> [choices...]`` for categorical
-        features, replacing the paper's ranges.
+        ``name -> (low, high)`` (a tuple) for continuous features, ``name -> [choices...]``
+        (a list) for categorical ones, replacing the paper's ranges. A tuple for a categorical
+        feature keeps its choices in [low, high]; a list for a continuous one is refused.
     fixed : mapping, optional
         ``name -> value`` for features held constant.
     start : int
@@ -100,7 +126,7 @@ def sample_designs(
     u = _unit_samples(method, n, max(len(free), 1), int(seed), int(start))
     out: dict[str, np.ndarray] = {}
     for j, c in enumerate(free):
-        r = ranges.get(c.name)
+        r = _range_of(c, ranges.get(c.name), c.name in scenario.categorical or bool(c.choices))
         if c.name in scenario.categorical or c.choices:
             choices = np.asarray(r if r is not None else c.choices, float)
             if choices.size == 0:

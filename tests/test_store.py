@@ -43,6 +43,23 @@ def test_ranges_override_and_errors(scen):
         sample_designs(scen, 5, method="grid")
 
 
+def test_a_range_must_match_the_kind_of_feature(capsys, tmp_path):
+    arch = get_scenario("arch")  # m: categorical, choices 8, 12, 16, 24
+    d = sample_designs(arch, 200, seed=0, ranges={"m": (10, 20)})  # the choices in [10, 20]
+    assert set(d["m"]) == {12.0, 16.0}
+    assert set(sample_designs(arch, 50, seed=0, ranges={"m": [8, 24]})["m"]) == {8.0, 24.0}
+    with pytest.raises(ValueError, match=r"no choice .* lies in \[30, 40\]"):
+        sample_designs(arch, 5, ranges={"m": (30, 40)})
+    with pytest.raises(ValueError, match="offset is continuous; give \\(low, high\\)"):
+        sample_designs(arch, 5, ranges={"offset": [0.1, 0.2]})  # used to be taken as a range
+    out = tmp_path / "db"
+    argv = ["generate", "arch", "-n", "2", "-o", str(out), "--range"]
+    assert main([*argv, "offset=0.1,0.2"]) == 2
+    assert "NAME=LOW:HIGH" in capsys.readouterr().err and not out.exists()
+    assert main([*argv, "m=10:20"]) == 0  # 8:24 used to sample only 8 and 24
+    assert set(pd.read_parquet(out / "database.parquet")["m"]) <= {12.0, 16.0}
+
+
 def test_interrupted_build_resumes_without_duplicates(scen, tmp_path, monkeypatch):
     designs = sample_designs(scen, 7, seed=1)
     calls = []

@@ -35,7 +35,8 @@ def register(subparsers) -> argparse.ArgumentParser:
         action="append",
         default=[],
         metavar="NAME=LOW:HIGH",
-        help="override a feature's range (SI units), or NAME=A,B,C for categorical choices",
+        help="override a feature's range (SI units), or NAME=A,B,C for categorical choices "
+        "(NAME=LOW:HIGH on a categorical feature keeps its choices in [LOW, HIGH])",
     )
     add_parallel_arguments(p)
     add_row_arguments(p, on_invalid="skip")
