@@ -16,7 +16,10 @@ best of 5 timings each. A structure's floor per iteration is the cheapest path's
 over its captured tangents (one size and sparsity: a busy machine only adds to a timing), so
 a sample's floor is sum(iterations x that cost). ``solver``
 names the path the assembler takes; the gripper row also gives the floor with the solver it
-uses. The database row runs ``evaluate_designs`` on the 3000 published arch rows (data3) on 2
+uses. ``batch ms`` is the time per design of a batch of 16 copies of the design (4 for the
+canopy) through ``scenario.evaluate_batch``, the path the runner takes for databases, and
+``batch/floor`` its ratio, the one the targets are read against where it exists. The
+database row runs ``evaluate_designs`` on the 3000 published arch rows (data3) on 2
 worker processes (wall clock, and the CPU time of the workers / 2, which other jobs on the
 machine disturb less) and prints the floor beside it (per-row floors of 60 rows spread over
 the file, scaled to 3000 rows and divided by the 2 cores).
@@ -64,18 +67,38 @@ def _published(stem: str, i: int, names) -> dict:
     return dict(zip(names, map(float, arr[i, : len(names)]), strict=True))
 
 
-def workloads():
-    out = {
-        "arch m=24": lambda: arch.evaluate(dict(ARCH, m=24)),
-        "arch m=8": lambda: arch.evaluate(dict(ARCH, m=8)),
-        "single Miura": lambda: single_miura.evaluate(dict(MID, gama=1.1)),
-        "canopy Miura 36x12": lambda: canopy.evaluate(
-            dict(MID, pattern=1, m=36, n=12, creaseE=2e9, panelE=2e9)
+#: designs per batch for the batched time (the runner sends up to 16 rows of one key per task)
+BATCH = {"canopy Miura 36x12": 4}
+
+
+def _rows():
+    rows = {
+        "arch m=24": (arch.SCENARIO, dict(ARCH, m=24)),
+        "arch m=8": (arch.SCENARIO, dict(ARCH, m=8)),
+        "single Miura": (single_miura.SCENARIO, dict(MID, gama=1.1)),
+        "canopy Miura 36x12": (
+            canopy.SCENARIO,
+            dict(MID, pattern=1, m=36, n=12, creaseE=2e9, panelE=2e9),
         ),
     }
     if (REF / "data2_TwoPanel_sample.txt").exists():
-        row = _published("data2_TwoPanel_sample", 1, GRIP)
-        out["gripper two-panel"] = lambda: gripper.evaluate(row)
+        rows["gripper two-panel"] = (gripper.SCENARIO, _published("data2_TwoPanel_sample", 1, GRIP))
+    return rows
+
+
+def workloads():
+    """name -> one evaluation of the workload's design (``scenario.evaluate``)."""
+    return {name: (lambda sc=sc, row=row: sc.evaluate(row)) for name, (sc, row) in _rows().items()}
+
+
+def batched_workloads():
+    """name -> (designs, one ``evaluate_batch`` of that many copies of the design), for the
+    scenarios that evaluate batches (the path the runner takes for databases)."""
+    out = {}
+    for name, (sc, row) in _rows().items():
+        if sc.evaluate_batch is not None:
+            n = BATCH.get(name, 16)
+            out[name] = (n, lambda sc=sc, rows=[row] * n: sc.evaluate_batch(rows))
     return out
 
 
@@ -316,24 +339,35 @@ def main(argv=None) -> int:
     print(f"per sample, BLAS 1 thread, CPU time min / median of {args.repeat} runs (and wall")
     print("median); floor = iterations x (cheapest factorisation + solve of the actual tangents),")
     print("CPU time, measured in this run")
+    print("min ms: one design alone (scenario.evaluate); batch ms: per design of a batch of 16")
+    print("copies (4 for the canopy) through scenario.evaluate_batch, the path the runner takes")
+    print("for databases. The ratio to the target is batch/floor where there is a batch time")
+    print("(min/floor otherwise)")
     head = (
         f"{'workload':<20} {'iters':>6} {'min ms':>9} {'median ms':>10} {'wall ms':>9} "
-        f"{'floor ms':>9} {'min/floor':>10} {'target':>7}  solver (floor with it)"
+        f"{'batch ms':>9} {'floor ms':>9} {'min/floor':>10} {'batch/floor':>12} {'target':>7}  "
+        "solver (floor with it)"
     )
     print(head)
     print("-" * len(head))
+    batched = batched_workloads()
     with threadpool_limits(1):
         for name, fn in workloads().items():
             if args.only not in name:
                 continue
             tmin, tmed, wall = timed(fn, args.repeat)
             iters, floor, used_floor, used = floor_of(fn)
+            bms, bratio = "-", "-"
+            if name in batched:
+                n, bfn = batched[name]
+                tb = timed(bfn, max(3, args.repeat // 2))[0] / n
+                bms, bratio = f"{1e3 * tb:.2f}", f"{tb / floor:.1f}"
             paths = ", ".join(sorted(used))
             extra = f" ({1e3 * used_floor:.2f} ms)" if "gripper" in name else ""
             print(
                 f"{name:<20} {iters:>6d} {1e3 * tmin:>9.2f} {1e3 * tmed:>10.2f} {1e3 * wall:>9.2f} "
-                f"{1e3 * floor:>9.2f} {tmin / floor:>10.1f} {TARGET.get(name, ''):>7}  "
-                f"{paths}{extra}",
+                f"{bms:>9} {1e3 * floor:>9.2f} {tmin / floor:>10.1f} {bratio:>12} "
+                f"{TARGET.get(name, ''):>7}  {paths}{extra}",
                 flush=True,
             )
     limit = getattr(threads, "single_thread", None)

@@ -33,6 +33,7 @@ __all__ = [
     "gather",
     "assemble_batch",
     "band_newton_step",
+    "dense_newton_step",
     "lapack_addresses",
 ]
 
@@ -320,6 +321,23 @@ def gather(ptr_a, src_a, val_a, ptr_b, src_b, val_b, ptr_c, src_c, val_c, dest, 
 
 
 @njit(**_OPTS)
+def _assemble_sample(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+    views, flats, f, K,
+):  # fmt: skip
+    """Sample ``s``'s kernels into ``views`` (memory ``flats``), its internal force into ``f``
+    and its tangent into ``K`` by the gather lists (``f`` and ``K`` start as zeros)."""
+    eb, fb, Kb, es, fs, Ks, th = views
+    _, vfb, vkb, _, vfs, vks, _ = flats
+    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
+    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
+    bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
+    spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
+    gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f)
+    gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, K)
+
+
+@njit(**_OPTS)
 def assemble_batch(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
     views, flats, f_out, k_out,
@@ -328,16 +346,11 @@ def assemble_batch(
     seven of one sample, in the kernels' layouts), then ``f_out[j]`` by the ``force_lists``
     and ``k_out[j]`` by the ``tangent_lists`` (each the seven arguments of :func:`gather` but
     the values), whose sources index the memory of the views, ``flats``."""
-    eb, fb, Kb, es, fs, Ks, th = views
-    _, vfb, vkb, _, vfs, vks, _ = flats
-    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
-    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
     for j in range(idx.shape[0]):
-        s = idx[j]
-        bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
-        spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
-        gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f_out[j])
-        gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, k_out[j])
+        _assemble_sample(
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
+            tangent_lists, views, flats, f_out[j], k_out[j],
+        )  # fmt: skip
 
 
 # ------------------------------------------------------------------------ LAPACK calls
@@ -364,13 +377,12 @@ def _fcall(typingctx, addr, args):
     return sig, codegen
 
 
-def lapack_addresses() -> tuple[int, int]:
-    """Addresses of scipy's ``dpbtrf`` and ``dpbtrs``."""
+def lapack_addresses(*names: str) -> np.ndarray:
+    """Addresses of scipy's LAPACK routines ``names`` (e.g. ``"dpbtrf", "dpbtrs"``)."""
     from numba.extending import get_cython_function_address
 
-    return tuple(
-        get_cython_function_address("scipy.linalg.cython_lapack", name)
-        for name in ("dpbtrf", "dpbtrs")
+    return np.array(
+        [get_cython_function_address("scipy.linalg.cython_lapack", n) for n in names], np.int64
     )
 
 
@@ -385,10 +397,6 @@ def band_newton_step(
     solution on the free DOFs and ``Uflat[s, free] += dU[j]``. ``info[j]``: 0 done, 1 not
     positive definite (nothing solved or updated), 2 a non-finite solution (U not updated).
     The operations of ``Assembler.evaluate_factorized`` and its band solver, in their order."""
-    eb, fb, Kb, es, fs, Ks, th = views
-    _, vfb, vkb, _, vfs, vks, _ = flats
-    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
-    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
     nf = free.shape[0]
     uplo = np.array([ord("U")], np.uint8)
     n_ = np.array([nf], np.int32)
@@ -400,13 +408,13 @@ def band_newton_step(
     y = np.empty(nf)
     for j in range(idx.shape[0]):
         s = idx[j]
-        bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
-        spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
         f = f_out[j]
         f[:] = 0.0
-        gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f)
         ab[:] = 0.0
-        gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, ab)
+        _assemble_sample(
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+            views, flats, f, ab,
+        )  # fmt: skip
         _fcall(addrs[0], (uplo, n_, kd_, ab, ld_, inf_))
         if inf_[0] != 0:
             info[j] = 1
@@ -420,6 +428,52 @@ def band_newton_step(
         for q in range(nf):
             x[perm[q]] = y[q]
             if not np.isfinite(y[q]):
+                ok = False
+        if not ok:
+            info[j] = 2
+            continue
+        info[j] = 0
+        for q in range(nf):
+            Uflat[s, free[q]] += x[q]
+
+
+@njit(**_OPTS)
+def dense_newton_step(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, Fi, free, addrs, Uflat, dU, info,
+):  # fmt: skip
+    """:func:`band_newton_step` on the dense LU path: the free-free block gathered column-major
+    (the Fortran copy ``scipy.linalg.lapack.dgetrf`` makes of the row-major block), ``dgetrf``,
+    ``dgetrs`` of ``(Fi[s] - f)[free]``. ``info[j]``: 0 done, 1 singular (``dgetrf`` info > 0),
+    2 a non-finite solution; U is updated only for 0."""
+    nf = free.shape[0]
+    trans = np.array([ord("N")], np.uint8)
+    n_ = np.array([nf], np.int32)
+    one = np.array([1], np.int32)
+    inf_ = np.zeros(1, np.int32)
+    piv = np.empty(nf, np.int32)
+    a = np.empty(nf * nf)
+    f = np.empty(Uflat.shape[1])
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        f[:] = 0.0
+        a[:] = 0.0
+        _assemble_sample(
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+            views, flats, f, a,
+        )  # fmt: skip
+        _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
+        if inf_[0] > 0:
+            info[j] = 1
+            continue
+        x = dU[j]
+        for q in range(nf):
+            d = free[q]
+            x[q] = Fi[s, d] - f[d]
+        _fcall(addrs[1], (trans, n_, one, a, n_, piv, x, n_, inf_))
+        ok = True
+        for q in range(nf):
+            if not np.isfinite(x[q]):
                 ok = False
         if not ok:
             info[j] = 2

@@ -294,11 +294,14 @@ class ReducedPattern:
         cache = self.__dict__.setdefault("_batch_gather", {})
         if path not in cache:
             pat = self._pattern
+            nf = self.n_free
             lists, n = (
-                (self.dense_gather, self.n_free**2) if path == "dense"
+                (self.dense_gather, nf**2) if path in ("dense", "dense_cm")
                 else (self.band_gather, _band_size(self)) if path == "banded"
                 else (pat.data_gather, pat.nnz)
             )  # fmt: skip
+            if path == "dense_cm":  # column-major: the Fortran copy LAPACK factorises
+                lists = (*lists[:6], (lists[6] % nf) * nf + lists[6] // nf)
             nb, ns = pat.bar_dofs.shape[0], pat.spring_dofs.shape[0]
             cache[path] = (_element_major_lists(lists, nb, ns, True), n)
         return cache[path]
@@ -698,7 +701,7 @@ def _dense_solver(K: np.ndarray):
         if lu is None:
             lu = dgetrf(K)
         if lu[2] > 0:
-            raise SingularSystemError("singular stiffness matrix (Singular matrix)")
+            raise SingularSystemError(_SINGULAR)
         x, _ = dgetrs(lu[0], lu[1], rhs)
         return _finite(x)
 
@@ -792,6 +795,7 @@ def _element_major_buffers(nb: int, ns: int):
 
 
 _NON_FINITE = "non-finite solution of the linear system (singular stiffness)"
+_SINGULAR = "singular stiffness matrix (Singular matrix)"
 
 
 def _finite(x):
@@ -920,9 +924,10 @@ class BatchAssembler:
         ``dU = K_ff^-1 (rhs_force[s] - f_int[s])[free]``, bit for bit
         ``solve = factorized(U, active)[1][s]; dU = solve((rhs_force[s] - f[s])[free])``.
 
-        Samples on the banded path are evaluated, factorised and solved in one compiled call
-        per connectivity (scipy's LAPACK by address, ``_compiled.band_newton_step``); the
-        others, and banded tangents that are not positive definite, by :meth:`factorized`.
+        Samples on the banded and the dense path are evaluated, factorised and solved in one
+        compiled call per connectivity (scipy's LAPACK by address, ``_compiled``'s
+        ``band_newton_step`` and ``dense_newton_step``); the others, and banded tangents that
+        are not positive definite, by :meth:`factorized`.
 
         Parameters
         ----------
@@ -949,27 +954,45 @@ class BatchAssembler:
         if not any(self._arccos):
             for pat, red, members in self.groups:
                 idx = np.ascontiguousarray(members[active[members]], dtype=np.intp)
-                if idx.size == 0 or solver_path(red, self.dense_max) != "banded":
+                path = solver_path(red, self.dense_max)
+                if idx.size == 0 or path not in ("banded", "dense"):
                     continue
                 if self._addrs is None:
-                    self._addrs = np.array(ck.lapack_addresses(), np.int64)
-                perm, bw, _, _ = red.banded
-                lists, _ = red.batch_gather("banded")
+                    self._addrs = {
+                        "banded": ck.lapack_addresses("dpbtrf", "dpbtrs"),
+                        "dense": ck.lapack_addresses("dgetrf", "dgetrs"),
+                    }
                 views, flats = self._scratch
-                nf = red.n_free
-                dU = np.empty((idx.size, nf))
-                fj = np.empty((idx.size, self.n_dof))
-                info = np.zeros(idx.size, np.int8)
-                ck.band_newton_step(
+                common = (
                     self._X, U3, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
                     self._k, self._theta0, self._k_nonneg, idx, pat.force_gather_element_major,
-                    lists, views, flats, Fi, red.free, perm, bw, self._addrs, U, dU, fj, info,
                 )  # fmt: skip
+                dU = np.empty((idx.size, red.n_free))
+                info = np.zeros(idx.size, np.int8)
+                if path == "banded":
+                    perm, bw, _, _ = red.banded
+                    lists, _ = red.batch_gather("banded")
+                    fj = np.empty((idx.size, self.n_dof))
+                    ck.band_newton_step(
+                        *common, lists, views, flats, Fi, red.free, perm, bw,
+                        self._addrs["banded"], U, dU, fj, info,
+                    )  # fmt: skip
+                    lu_below = True  # not positive definite: LU by factorized below
+                else:
+                    lists, _ = red.batch_gather("dense_cm")
+                    ck.dense_newton_step(
+                        *common, lists, views, flats, Fi, red.free, self._addrs["dense"], U,
+                        dU, info,
+                    )  # fmt: skip
+                    lu_below = False  # singular
                 for j, s in enumerate(idx):
-                    if info[j] == 1:
-                        continue  # not positive definite: LU by factorized below
+                    if info[j] == 1 and lu_below:
+                        continue
                     rest[s] = False
-                    out[s] = dU[j] if info[j] == 0 else SingularSystemError(_NON_FINITE)
+                    out[s] = (
+                        dU[j] if info[j] == 0
+                        else SingularSystemError(_SINGULAR if info[j] == 1 else _NON_FINITE)
+                    )  # fmt: skip
         if rest.any():
             f, solves = self.factorized(U3, rest)
             free = self.free_dofs

@@ -39,6 +39,7 @@ from holofold.mechanics.structure import (
 
 __all__ = [
     "build_concentrated",
+    "build_concentrated_batch",
     "build_compliant",
     "crease_rest_targets",
     "orient_springs",
@@ -252,42 +253,117 @@ def build_concentrated(
     nu_panel = _scalar(nu_panel, "nu_panel", -1.0, 0.5, low_open=True, high_open=True)
     _scalar(nu_crease, "nu_crease", -1.0, 0.5, low_open=True, high_open=True)
     nv, ne, nf = pattern.n_vertices, pattern.n_edges, pattern.n_faces
-    t = _topology(pattern)
-    sizes, verts, face, nxt, prv = t["sizes"], t["verts"], t["face"], t["nxt"], t["prv"]
-    side_edge, first, last, interior = t["side"], t["first"], t["last"], t["interior"]
+    interior = _topology(pattern)["interior"]
     W = _per_item(crease_width, ne, "crease_width", interior)
     tc = _per_item(crease_thickness, ne, "crease_thickness", interior)
     tp = _per_item(panel_thickness, nf, "panel_thickness")
-
     if coords is None:
         X = pattern.coords
     else:
         X = np.asarray(coords, float)
         if X.shape != (nv, 3) or not np.isfinite(X).all():
             raise ParameterError(f"coords must be a finite ({nv}, 3) array, got shape {X.shape}")
-    centres = _group_mean(X[verts], face, sizes)
-    nodes = np.vstack([X, centres])
+    w = None if panel_width is None else _per_item(panel_width, nf, "panel_width")[None]
+    (s,) = _concentrated(
+        pattern, X[None], W[None], tc[None], tp[None], np.array([E_panel]), np.array([E_crease]),
+        nu_panel, w, profile, [supports],
+    )  # fmt: skip
+    return s
+
+
+def build_concentrated_batch(
+    pattern: CreasePattern,
+    coords,
+    *,
+    crease_width,
+    crease_thickness,
+    panel_thickness,
+    E_panel=2e9,
+    E_crease=2e9,
+    nu_panel: float = 0.3,
+    nu_crease: float = 0.3,
+    profile: Profile = PAPER,
+    supports=None,
+) -> list[Structure]:
+    """:func:`build_concentrated` of S designs of one pattern, its arrays computed for all at
+    once; each structure is bit for bit the one :func:`build_concentrated` gives the design.
+
+    ``coords`` (S, nv, 3); ``crease_width``, ``crease_thickness``, ``panel_thickness``,
+    ``E_panel``, ``E_crease``: a scalar or one per design (S,); ``supports``: None or one
+    (nv + nf, 3) mask (or None) per design. A design whose values :func:`build_concentrated`
+    refuses raises its error.
+    """
+    X = np.asarray(coords, float)
+    S = X.shape[0]
+    nv, ne, nf = pattern.n_vertices, pattern.n_edges, pattern.n_faces
+    per = lambda v: np.broadcast_to(np.asarray(v, float), (S,))  # noqa: E731
+    W, tc, tp, Ep, Ec = map(
+        per, (crease_width, crease_thickness, panel_thickness, E_panel, E_crease)
+    )
+    ok = X.shape == (S, nv, 3) and np.isfinite(X).all()
+    ok = ok and all(np.all(np.isfinite(v) & (v > 0)) for v in (W, tc, tp, Ep, Ec))
+    if not ok or not -1.0 < nu_panel < 0.5 or not -1.0 < nu_crease < 0.5:
+        return [  # one by one: the error of the first design it refuses
+            build_concentrated(
+                pattern, coords=X[i], crease_width=float(W[i]), crease_thickness=float(tc[i]),
+                panel_thickness=float(tp[i]), E_panel=float(Ep[i]), E_crease=float(Ec[i]),
+                nu_panel=nu_panel, nu_crease=nu_crease, profile=profile,
+                supports=None if supports is None else supports[i],
+            )
+            for i in range(S)
+        ]  # fmt: skip
+    nu_panel = float(nu_panel)
+    full = lambda v, n: np.repeat(v[:, None], n, axis=1)  # noqa: E731 - np.full per design
+    return _concentrated(
+        pattern, X, full(W, ne), full(tc, ne), full(tp, nf), Ep, Ec, nu_panel, None, profile,
+        [None] * S if supports is None else list(supports),
+    )  # fmt: skip
+
+
+def _bincount(group: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
+    """``np.bincount(group, weights[s], minlength=n)`` of every design s, (S, n): one call, the
+    same sums (each design's weights added in their order, from 0)."""
+    S = weights.shape[0]
+    ids = (np.arange(S)[:, None] * n + group[None, :]).ravel()
+    return np.bincount(ids, weights=weights.ravel(), minlength=S * n).reshape(S, n)
+
+
+def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_width, profile, sups):
+    """The structures of :func:`build_concentrated` for S designs: ``X`` (S, nv, 3), ``W``,
+    ``tc`` (S, ne), ``tp`` (S, nf), ``E_panel``, ``E_crease`` (S,), ``panel_width`` None or
+    (S, nf), ``sups`` S supports (or None); values checked by the callers."""
+    S = X.shape[0]
+    nv, ne, nf = pattern.n_vertices, pattern.n_edges, pattern.n_faces
+    t = _topology(pattern)
+    sizes, verts, face, nxt, prv = t["sizes"], t["verts"], t["face"], t["nxt"], t["prv"]
+    side_edge, first, last, interior = t["side"], t["first"], t["last"], t["interior"]
+
+    Xv = X[:, verts]
+    centres = np.empty((S, nf, 3))
+    for c in range(3):  # _group_mean per design
+        centres[:, :, c] = _bincount(face, Xv[:, :, c], nf)
+    centres = centres / sizes[:, None]
+    nodes = np.concatenate([X, centres], axis=1)
     cnode = nv + face  # centre node of each corner's panel
 
     # bars: edges, then spokes
     spokes = np.column_stack([verts, cnode])
     bars = np.vstack([pattern.edges.astype(np.intp), spokes])
-    L = np.linalg.norm(nodes[bars[:, 1]] - nodes[bars[:, 0]], axis=1)
-    edge_len, spoke_len = L[:ne], L[ne:]
+    L = np.linalg.norm(nodes[:, bars[:, 1]] - nodes[:, bars[:, 0]], axis=-1)
+    edge_len, spoke_len = L[:, :ne], L[:, ne:]
 
     # panel areas: fan triangles (centre, C_q, C_q+1)
-    tri_area = 0.5 * np.linalg.norm(
-        _cross(X[verts] - centres[face], X[verts[nxt]] - centres[face]), axis=1
-    )
-    area = np.bincount(face, weights=tri_area, minlength=nf)
-    perim = np.bincount(face, weights=edge_len[side_edge] + spoke_len, minlength=nf)
+    cf = centres[:, face]
+    tri_area = 0.5 * np.linalg.norm(_cross(Xv - cf, X[:, verts[nxt]] - cf), axis=-1)
+    area = _bincount(face, tri_area, nf)
+    perim = _bincount(face, edge_len[:, side_edge] + spoke_len, nf)
     A_p = 2.0 * tp * area / ((1.0 - nu_panel) * perim)
-    bar_area = np.empty(len(bars))
-    bar_area[ne:] = A_p[face]
+    bar_area = np.empty((S, len(bars)))
+    bar_area[:, ne:] = A_p[:, face]
     if profile.edge_bar_area_last_panel:
-        bar_area[:ne] = 2.0 * A_p[last]
+        bar_area[:, :ne] = 2.0 * A_p[:, last]
     else:
-        bar_area[:ne] = np.bincount(side_edge, weights=A_p[face], minlength=ne)
+        bar_area[:, :ne] = _bincount(side_edge, A_p[:, face], ne)
     bar_type = np.concatenate(
         [np.full(ne, BarType.PANEL_EDGE, np.int8), np.full(len(spokes), BarType.PANEL_SPOKE)]
     )
@@ -297,13 +373,9 @@ def build_concentrated(
     e = pattern.edges[cid]
     hinge = np.column_stack([nv + first[cid], e[:, 0], e[:, 1], nv + last[cid]])
     panel = np.column_stack([verts[nxt], verts, cnode, verts[prv]])
-    springs = orient_springs(
-        nodes, np.vstack([hinge, panel]).astype(np.intp), z_only=profile.polarity_z_only
-    )
-    k_hinge = E_crease * tc[cid] ** 3 * edge_len[cid] / (12.0 * W[cid])
-    w = _panel_width(profile, panel_width, W, interior, nf, spoke_len, face)
-    k_panel = E_panel * tp[face] ** 3 * spoke_len / (12.0 * w)
-    spring_k = np.concatenate([k_hinge, k_panel])
+    quads = np.vstack([hinge, panel]).astype(np.intp)
+    k_hinge = E_crease[:, None] * tc[:, cid] ** 3 * edge_len[:, cid] / (12.0 * W[:, cid])
+    k_panel = E_panel[:, None] * tp[:, face] ** 3 * spoke_len
     role = np.concatenate(
         [np.full(len(cid), SpringRole.HINGE, np.int8), np.full(len(panel), SpringRole.PANEL)]
     )
@@ -311,30 +383,38 @@ def build_concentrated(
 
     # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1)
     triangles = np.column_stack([cnode, verts, verts[prv]])
-    return Structure(
-        nodes=nodes,
-        bars=bars,
-        bar_area=bar_area,
-        bar_E=np.full(len(bars), E_panel),
-        bar_length=L,
-        bar_type=bar_type,
-        springs=springs,
-        spring_k=spring_k,
-        spring_rest=dihedral_angle(nodes, springs),
-        spring_role=role,
-        spring_crease=crease_of,
-        triangles=triangles,
-        tri_thickness=tp[face],
-        tri_crease=np.full(len(triangles), -1),
-        tri_panel=face,
-        supports=supports,
-        creases=CreaseModel(
-            kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=e
-        ),
-        panel_centres=nv + np.arange(nf),
-        node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]),
-        profile=profile,
-    )
+    out = []
+    for i in range(S):
+        springs = orient_springs(nodes[i], quads, z_only=profile.polarity_z_only)
+        pw = None if panel_width is None else panel_width[i]
+        w = _panel_width(profile, pw, W[i], interior, nf, spoke_len[i], face)
+        out.append(
+            Structure(
+                nodes=nodes[i],
+                bars=bars,
+                bar_area=bar_area[i],
+                bar_E=np.full(len(bars), E_panel[i]),
+                bar_length=L[i],
+                bar_type=bar_type,
+                springs=springs,
+                spring_k=np.concatenate([k_hinge[i], k_panel[i] / (12.0 * w)]),
+                spring_rest=dihedral_angle(nodes[i], springs),
+                spring_role=role,
+                spring_crease=crease_of,
+                triangles=triangles,
+                tri_thickness=tp[i, face],
+                tri_crease=np.full(len(triangles), -1),
+                tri_panel=face,
+                supports=sups[i],
+                creases=CreaseModel(
+                    kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=e
+                ),
+                panel_centres=nv + np.arange(nf),
+                node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]),
+                profile=profile,
+            )
+        )
+    return out
 
 
 # --------------------------------------------------------------------------- compliant

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -15,12 +16,13 @@ from holofold.mechanics.compat import PAPER, PHYSICAL
 from holofold.mechanics.hinges import (
     build_compliant,
     build_concentrated,
+    build_concentrated_batch,
     crease_rest_targets,
     orient_springs,
 )
 from holofold.mechanics.solvers import solve_newton
 from holofold.mechanics.springs import dihedral_angle
-from holofold.mechanics.structure import SpringRole
+from holofold.mechanics.structure import SpringRole, support_mask
 
 MAT = dict(E_panel=2e9, E_crease=2e9, nu_panel=0.3, nu_crease=0.3)
 
@@ -359,3 +361,43 @@ def test_with_supports_changes_only_the_supports():
     np.testing.assert_array_equal(f.bar_dofs, s.bar_dofs)
     with pytest.raises(ValueError, match="supports must have shape"):
         s.with_supports(np.zeros((2, 3), bool))
+
+
+def _same_structure(a, b) -> bool:
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        if isinstance(x, np.ndarray):
+            if x.shape != y.shape or not np.array_equal(x, y, equal_nan=True):
+                return False
+        elif dataclasses.is_dataclass(x):
+            if not _same_structure(x, y):
+                return False
+        elif x != y:
+            return False
+    return True
+
+
+@pytest.mark.parametrize("profile", [PAPER, PHYSICAL])
+def test_batch_build_is_each_designs_own(profile):
+    """build_concentrated_batch: every structure bit for bit build_concentrated's."""
+    pat = miura_sheet_paper(3, 2, 0.04, 1.1, 0.7)
+    rng = np.random.default_rng(3)
+    S = 5
+    X = pat.coords[None] + 1e-3 * rng.standard_normal((S, pat.n_vertices, 3))
+    W, tc, tp = rng.uniform(1e-3, 4e-3, S), rng.uniform(5e-4, 1e-3, S), rng.uniform(1e-3, 6e-3, S)
+    E = rng.uniform(1e9, 3e9, S)
+    sups = [support_mask(pat.n_vertices + pat.n_faces, [0, i + 1]) for i in range(S)]
+    batch = build_concentrated_batch(
+        pat, X, crease_width=W, crease_thickness=tc, panel_thickness=tp, E_panel=E,
+        E_crease=2e9, profile=profile, supports=sups,
+    )  # fmt: skip
+    for i in range(S):
+        one = build_concentrated(
+            pat, coords=X[i], crease_width=W[i], crease_thickness=tc[i], panel_thickness=tp[i],
+            E_panel=E[i], E_crease=2e9, profile=profile, supports=sups[i],
+        )  # fmt: skip
+        assert _same_structure(one, batch[i])
+    with pytest.raises(ParameterError, match="crease_width"):
+        build_concentrated_batch(
+            pat, X, crease_width=np.r_[W[:-1], -1.0], crease_thickness=tc, panel_thickness=tp
+        )

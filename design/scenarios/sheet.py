@@ -62,8 +62,9 @@ from holofold.geometry.tmp import tmp_faces, tmp_nodes
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
 from holofold.mechanics.compat import PAPER
-from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.hinges import build_concentrated_batch
 from holofold.mechanics.status import Outcome, Status
+from holofold.mechanics.structure import support_mask
 from holofold.mechanics.threads import single_threaded
 
 __all__ = [
@@ -78,6 +79,7 @@ __all__ = [
     "sheet_columns",
     "sheet_nodes",
     "sheet_models",
+    "sheet_models_batch",
     "sheet_mass",
     "check_sheet",
     "evaluate_sheet",
@@ -284,28 +286,48 @@ def sheet_models(setting: SheetSetting, row, *, profile=PAPER, extensions=None):
     list of (Structure, tuple of LoadGroup)
         The load groups in the order of ``setting.loads``.
     """
-    pat, m, n, _ = _design(setting, row)
-    Ec = _modulus(row, "creaseE", setting.E)
-    Ep = _modulus(row, "panelE", setting.E)
-    topo = _topology(pat, m, n)
-    out = []
-    for ext in setting.extensions if extensions is None else extensions:
-        X = sheet_nodes(setting, row, ext)
-        x = X[:, 0]
-        tip = np.flatnonzero(x == x.max())
-        s = build_concentrated(
+    return sheet_models_batch(setting, [row], profile=profile, extensions=extensions)[0]
+
+
+def sheet_models_batch(setting: SheetSetting, rows, *, profile=PAPER, extensions=None):
+    """:func:`sheet_models` of several designs, the models of one pattern, m and n built
+    together (:func:`~holofold.mechanics.hinges.build_concentrated_batch`, bit for bit the
+    same)."""
+    exts = setting.extensions if extensions is None else extensions
+    out: list = [[None] * len(exts) for _ in rows]
+    groups: dict = {}
+    for i, row in enumerate(rows):
+        pat, m, n, _ = _design(setting, row)
+        groups.setdefault((pat, m, n), []).append(i)
+    for (pat, m, n), idx in groups.items():
+        topo = _topology(pat, m, n)
+        items = [(i, e) for i in idx for e in range(len(exts))]
+        X = [sheet_nodes(setting, rows[i], exts[e]) for i, e in items]
+        sups = [  # vertex v is node v; fixed: the nodes at x = min
+            support_mask(
+                len(x) + topo.n_faces,
+                np.flatnonzero(x[:, 0] == x[:, 0].min()),
+                setting.support_dofs,
+            )
+            for x in X
+        ]
+        col = lambda f, items=items: [f(rows[i]) for i, _ in items]  # noqa: E731
+        structures = build_concentrated_batch(
             topo,
-            coords=X,
-            crease_width=row["W"],
-            crease_thickness=row["tcrease"],
-            panel_thickness=row["tpanel"],
-            E_panel=Ep,
-            E_crease=Ec,
+            np.stack(X),
+            crease_width=col(lambda r: r["W"]),
+            crease_thickness=col(lambda r: r["tcrease"]),
+            panel_thickness=col(lambda r: r["tpanel"]),
+            E_panel=col(lambda r: _modulus(r, "panelE", setting.E)),
+            E_crease=col(lambda r: _modulus(r, "creaseE", setting.E)),
             nu_panel=setting.nu,
             nu_crease=setting.nu,
             profile=profile,
-        ).fixed(np.flatnonzero(x == x.min()), setting.support_dofs)  # vertex v is node v
-        out.append((s, tuple(load_along(tip, ld.direction) for ld in setting.loads)))
+            supports=sups,
+        )
+        for (i, e), x, st in zip(items, X, structures, strict=True):
+            tip = np.flatnonzero(x[:, 0] == x[:, 0].max())
+            out[i][e] = (st, tuple(load_along(tip, ld.direction) for ld in setting.loads))
     return out
 
 
@@ -387,7 +409,7 @@ def evaluate_sheet_batch(setting: SheetSetting, columns: Sequence[str], rows) ->
     """:func:`evaluate_sheet` of several designs of one pattern, m and n, their Newton solves
     run in lockstep per extension and load (:func:`secant_stiffness_batch`); each output is
     bit for bit the design's own."""
-    models = [sheet_models(setting, row) for row in rows]
+    models = sheet_models_batch(setting, rows)
     outs: list = [{} for _ in rows]
     cases: list = [{} for _ in rows]
     for e, ext in enumerate(setting.extensions):

@@ -71,8 +71,9 @@ from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
 from holofold.mechanics.compat import PAPER
-from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.hinges import build_concentrated_batch
 from holofold.mechanics.status import Outcome, Status
+from holofold.mechanics.structure import support_mask
 from holofold.mechanics.threads import single_threaded
 
 __all__ = [
@@ -82,6 +83,7 @@ __all__ = [
     "SUPPORTS",
     "strip_scenario",
     "strip_model",
+    "strip_models",
     "strip_columns",
     "evaluate_strip",
     "evaluate_strip_batch",
@@ -255,33 +257,55 @@ def strip_model(setting: StripSetting, row, *, profile=PAPER):
     error : float
         Index-matched fitting error, m.
     """
-    m = int(row["m"])
-    g = strip_geometry(
-        setting.curve,
-        m,
-        float(row["offset"]),
-        float(row["stripeWidth"]),
-        float(row["extrude"]),
-        setting.curve_sampling,
-    )
-    fixed = {
-        "ends": g.ends,
-        "centre-ends": g.centre[[0, -1]],
-        "side-ends": np.concatenate([g.side_a[[0, -1]], g.side_b[[0, -1]]]),
-    }[setting.supports]
-    s = build_concentrated(
-        _topology(m),
-        coords=g.nodes,
-        crease_width=row["W"],
-        crease_thickness=row["tcrease"],
-        panel_thickness=row["tpanel"],
-        E_panel=setting.E,
-        E_crease=setting.E,
-        nu_panel=setting.nu,
-        nu_crease=setting.nu,
-        profile=profile,
-    ).fixed(fixed, setting.support_dofs)
-    return s, g, index_matched_error(setting.curve, g.centre_line, g.t)
+    return strip_models(setting, [row], profile=profile)[0]
+
+
+def strip_models(setting: StripSetting, rows, *, profile=PAPER) -> list[tuple]:
+    """:func:`strip_model` of several designs, the models of each ``m`` built together
+    (:func:`~holofold.mechanics.hinges.build_concentrated_batch`, bit for bit the same)."""
+    geoms = []
+    for row in rows:
+        g = strip_geometry(
+            setting.curve,
+            int(row["m"]),
+            float(row["offset"]),
+            float(row["stripeWidth"]),
+            float(row["extrude"]),
+            setting.curve_sampling,
+        )
+        geoms.append(g)
+    out: list = [None] * len(rows)
+    by_m: dict = {}
+    for i, g in enumerate(geoms):
+        by_m.setdefault(g.m, []).append(i)
+    for m, idx in by_m.items():
+        sups = []
+        for i in idx:
+            g = geoms[i]
+            fixed = {
+                "ends": g.ends,
+                "centre-ends": g.centre[[0, -1]],
+                "side-ends": np.concatenate([g.side_a[[0, -1]], g.side_b[[0, -1]]]),
+            }[setting.supports]
+            sups.append(support_mask(len(g.nodes) + len(g.faces), fixed, setting.support_dofs))
+        col = lambda name, idx=idx: [float(rows[i][name]) for i in idx]  # noqa: E731
+        structures = build_concentrated_batch(
+            _topology(m),
+            np.stack([geoms[i].nodes for i in idx]),
+            crease_width=col("W"),
+            crease_thickness=col("tcrease"),
+            panel_thickness=col("tpanel"),
+            E_panel=setting.E,
+            E_crease=setting.E,
+            nu_panel=setting.nu,
+            nu_crease=setting.nu,
+            profile=profile,
+            supports=sups,
+        )
+        for i, s in zip(idx, structures, strict=True):
+            g = geoms[i]
+            out[i] = (s, g, index_matched_error(setting.curve, g.centre_line, g.t))
+    return out
 
 
 def _printability(pattern, tpanel: float, W: float):
@@ -334,7 +358,7 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
     outs: list = [None] * len(rows)
     models = []
     printable = {}
-    built = [strip_model(setting, row) for row in rows]
+    built = strip_models(setting, rows)
     overlaps = _non_simple([g for _, g, _ in built]) if setting.refuse_overlap else None
     for i, row in enumerate(rows):
         s, g, err = built[i]
