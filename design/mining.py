@@ -48,7 +48,7 @@ SECONDS_PER_TREE_ROW = 15e-6
 #: the largest work ``mine_rules`` starts without ``force=True`` (``holofold mine --force``):
 #: estimated peak memory of the forest and estimated time on one thread
 MAX_MINING_BYTES = 4 * 2**30
-MAX_MINING_SECONDS = 3600.0
+MAX_MINING_SECONDS = 300.0
 #: a tree of depth d has a leaf at depth d below d splits of >= 2 rows each: deeper limits
 #: change nothing for the tables mined here (and 1e20 overflowed scikit-learn's C integer)
 MAX_TREE_DEPTH = 1000

@@ -45,7 +45,7 @@ def test_the_estimate_matches_the_measured_constants():
     [
         ({"n_estimators": 1_000_000}, r"n_estimators \(--trees\) = 1000000 trees on 48 training "
          r"rows would take an estimated 11.2 GiB of memory \(limit 4 GiB\) and 1.49 h on one "
-         r"thread \(limit 1 h\); use fewer trees, or force it \(force=True, holofold mine "
+         r"thread \(limit 300 s\); use fewer trees, or force it \(force=True, holofold mine "
          r"--force\)"),
         ({"max_depth": 10**20}, rf"max_depth \(--depth\) = 10{{20}} is over the limit of "
          rf"{MAX_TREE_DEPTH}"),

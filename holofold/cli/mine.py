@@ -75,7 +75,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "--trees",
         type=int,
         default=100,
-        help="number of trees (default 100); a forest estimated to need over 4 GiB or 1 h is "
+        help="number of trees (default 100); a forest estimated to need over 4 GiB or 5 min is "
         "refused without --force (docs/limits.md)",
     )
     p.add_argument(
