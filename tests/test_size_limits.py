@@ -126,3 +126,12 @@ def test_a_sheet_file_whose_largest_sheet_is_over_the_limit_is_refused(tmp_path)
     path.write_text(text)
     with pytest.raises(ScenarioFileError, match="the largest sheet has 43200 panels; at most"):
         read_scenario(path)
+
+
+def test_a_strip_file_whose_m_is_over_the_fit_limit_is_refused(tmp_path):
+    text = shipped_text("arch").replace("m = { choices = [8, 12, 16, 24] }",
+                                        "m = { choices = [8, 5000] }")  # fmt: skip
+    path = tmp_path / "big.toml"
+    path.write_text(text)
+    with pytest.raises(ScenarioFileError, match=rf"\[features\] m = .*: at most {MAX_M}"):
+        read_scenario(path)

@@ -591,8 +591,11 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
     )
     features = read_features(doc.sub("features"), STRIP_FEATURES)
     for c in features:
-        if c.name == "m" and not all(v >= 2 and v == int(v) for v in c.choices or (c.low, c.high)):
-            raise doc.error(
-                f"[features] m must be integers >= 2, got {c.choices or (c.low, c.high)}"
-            )
+        if c.name != "m":
+            continue
+        levels = c.choices or (c.low, c.high)
+        if not all(v >= 2 and v == int(v) for v in levels):
+            raise doc.error(f"[features] m must be integers >= 2, got {levels}")
+        if max(levels) > MAX_M:
+            raise doc.error(f"[features] m = {levels}: at most {MAX_M} (4m panels; docs/limits.md)")
     return strip_scenario(name, description, setting, features)
