@@ -54,7 +54,7 @@ from holofold.design.scenarios.config import (
     read_material,
     read_solver,
 )
-from holofold.geometry import MAX_PANELS, export_pattern_files
+from holofold.geometry import MAX_PANELS
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.miura import miura_faces, miura_nodes, miura_sheet, rigid_fold_pattern
 from holofold.geometry.pattern import CreasePattern
@@ -468,6 +468,8 @@ def write_sheet_files(
 
     Returns label -> path (the labels name the files).
     """
+    from holofold.geometry import export_pattern_files  # trimesh: only for files
+
     shape = sheet_shape(setting, row, ext)
     W = float(row["W"])
     try:
