@@ -78,7 +78,13 @@ def _tokenize(expr: str) -> list[_Token]:
         kind = m.lastgroup
         text = m.group(kind)
         if kind == "number":
-            tokens.append(_Token("number", text, pos, float(text)))
+            value = float(text)
+            if not np.isfinite(value):  # 1e999: inf would render as a column name
+                raise TargetError(
+                    f"number {text!r} at position {pos} in target {expr!r} is not finite "
+                    "(beyond 1.8e308)"
+                )
+            tokens.append(_Token("number", text, pos, value))
         elif kind == "name":
             tokens.append(_Token("name", text, pos, text))
         elif kind == "quoted":
