@@ -440,12 +440,13 @@ def band_newton_step(
 @njit(**_OPTS)
 def dense_newton_step(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, addrs, Uflat, dU, info,
+    views, flats, Fi, free, addrs, Uflat, dU, info, res,
 ):  # fmt: skip
     """:func:`band_newton_step` on the dense LU path: the free-free block gathered column-major
     (the Fortran copy ``scipy.linalg.lapack.dgetrf`` makes of the row-major block), ``dgetrf``,
-    ``dgetrs`` of ``(Fi[s] - f)[free]``. ``info[j]``: 0 done, 1 singular (``dgetrf`` info > 0),
-    2 a non-finite solution; U is updated only for 0."""
+    ``dgetrs`` of ``(Fi[s] - f)[free]``, which is also kept in ``res[j]`` (``res`` may be
+    ``dU``: then only the solution stays). ``info[j]``: 0 done, 1 singular (``dgetrf`` info >
+    0; ``res[j]`` not written), 2 a non-finite solution; U is updated only for 0."""
     nf = free.shape[0]
     trans = np.array([ord("N")], np.uint8)
     n_ = np.array([nf], np.int32)
@@ -467,9 +468,11 @@ def dense_newton_step(
             info[j] = 1
             continue
         x = dU[j]
+        r = res[j]
         for q in range(nf):
             d = free[q]
-            x[q] = Fi[s, d] - f[d]
+            r[q] = Fi[s, d] - f[d]
+            x[q] = r[q]
         _fcall(addrs[1], (trans, n_, one, a, n_, piv, x, n_, inf_))
         ok = True
         for q in range(nf):

@@ -662,6 +662,59 @@ class Assembler:
             # not positive definite: LU below
         return energy, f, _lu_solver(self._scatter(rb), red)
 
+    def dense_newton_update(self, U, F, spring_rest, r):
+        """One compiled Newton update on the dense path, bit for bit
+        ``_, f, solve = evaluate_factorized(U, spring_rest); r = (F - f)[free]; U[free] +=
+        solve(r)`` in one numba call (kernels, gathers, ``dgetrf``/``dgetrs`` by address).
+
+        Parameters
+        ----------
+        U : (ndof,) float, C-contiguous
+            Displacements, updated in place, m.
+        F : (ndof,) float, C-contiguous
+            External force, N.
+        spring_rest : (ns,) float, C-contiguous
+            Rest angles, rad.
+        r : (nf,) float
+            Filled with the residual ``(F - f_int(U))[free]`` before the update, N.
+
+        Returns
+        -------
+        bool
+            False (nothing done) where this assembler does not take the dense path or uses the
+            reference's arccos angle; then call :meth:`evaluate_factorized`. Raises
+            :class:`SingularSystemError` as the dense solver would (U left alone).
+        """
+        step = self._dense_step
+        if step is None:
+            return False
+        fn, X, mid, after, post, dU, info = step
+        fn(
+            X, U.reshape(1, -1, 3), *mid, spring_rest.reshape(1, -1), *after, F.reshape(1, -1),
+            *post, U.reshape(1, -1), dU, info, r.reshape(1, -1),
+        )  # fmt: skip
+        if info[0]:
+            raise SingularSystemError(_SINGULAR if info[0] == 1 else _NON_FINITE)
+        return True
+
+    @cached_property
+    def _dense_step(self):
+        """``_compiled.dense_newton_step`` and its fixed arguments for this one design, as a
+        batch of one (None off the dense path or with the arccos angle)."""
+        red = self.reduction
+        if self._arccos or solver_path(red, self.dense_max) != "dense":
+            return None
+        ck = _ck()
+        one = lambda a: a.reshape((1, *a.shape))  # noqa: E731
+        mid = tuple(map(one, (self._b0, self._b1, self._D0, self._L0, self._EA, self._sT, self._k)))
+        views, flats = _element_major_buffers(len(self.bars), len(self.springs))
+        lists, _ = red.batch_gather("dense_cm")
+        force = self.pattern.force_gather_element_major
+        after = (np.array([self._k_nonneg]), np.zeros(1, np.intp), force, lists, views, flats)
+        post = (red.free, ck.lapack_addresses("dgetrf", "dgetrs"))
+        dU = np.empty((1, red.n_free))
+        return ck.dense_newton_step, one(self._X), mid, after, post, dU, np.zeros(1, np.int8)
+
 
 def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:
     """The linear-solver path of a reduction: ``"none"`` (no free DOF), ``"dense"`` (LAPACK LU
@@ -982,7 +1035,7 @@ class BatchAssembler:
                     lists, _ = red.batch_gather("dense_cm")
                     ck.dense_newton_step(
                         *common, lists, views, flats, Fi, red.free, self._addrs["dense"], U,
-                        dU, info,
+                        dU, info, dU,
                     )  # fmt: skip
                     lu_below = False  # singular
                 for j, s in enumerate(idx):

@@ -29,6 +29,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.linalg.lapack import dpotrf, dpotrs
 
 from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
@@ -138,6 +139,21 @@ class ThermalModel:
         return sp.csr_matrix((ones, (self.triangles.ravel(), cols)), shape=(self.n_nodes, nt))
 
     @cached_property
+    def reference_pieces(self):
+        """The parts of :func:`triangle_edges` (reference form) and of the air links that do
+        not depend on the shape, built once per model: ``pa`` (nt, 2) zeros, ``pb`` (nt, 2),
+        ``Lac`` (nt, 1), ``0.5 Lab Lac`` (nt,), the perimeters (nt,) and the perimeter term of
+        the air-link sections (nt, L), each by the operations the per-step code did."""
+        Lab, Lac, Lbc = self.rest_edges.T
+        nt = len(Lab)
+        pb = np.column_stack([Lab, np.zeros_like(Lab)])
+        perim = Lab + Lac + Lbc
+        return (
+            np.zeros((nt, 2)), pb, Lac[:, None], 0.5 * Lab * Lac, perim,
+            _air_perimeter_term(self, perim),
+        )  # fmt: skip
+
+    @cached_property
     def dense_slots(self) -> np.ndarray:
         """(9 nt,) int: flat position ``p n + q`` in a dense (nn, nn) matrix of every entry of
         the element matrices (nt, 3, 3)."""
@@ -219,14 +235,20 @@ def triangle_edges(model: ThermalModel, x: np.ndarray):
     xa, xb, xc = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
     if model.reference_geometry:
         u, v = xb - xa, xc - xa
-        cross = np.linalg.norm(np.cross(u, v), axis=1)
+        # |u x v| as np.linalg.norm(np.cross(u, v), axis=1) computes it, op for op
+        c = np.empty_like(u)
+        c[:, 0] = u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1]
+        c[:, 1] = u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2]
+        c[:, 2] = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+        cross = np.sqrt(np.add.reduce(c * c, axis=1))
         alpha = np.arctan2(cross, np.einsum("ij,ij->i", u, v))
-        Lab, Lac, Lbc = model.rest_edges.T
-        pa = np.zeros((len(tri), 2))
-        pb = np.column_stack([Lab, np.zeros_like(Lab)])
-        pc = Lac[:, None] * np.column_stack([np.cos(alpha), np.sin(alpha)])
-        area = 0.5 * Lab * Lac * np.sin(alpha)
-        perimeter = Lab + Lac + Lbc
+        pa, pb, Lac, half_ab_ac, perimeter, _ = model.reference_pieces
+        sin = np.sin(alpha)
+        cs = np.empty((len(tri), 2))
+        cs[:, 0] = np.cos(alpha)
+        cs[:, 1] = sin
+        pc = Lac * cs
+        area = half_ab_ac * sin
     else:
         pa, pb, pc = xa, xb, xc
         area = 0.5 * np.linalg.norm(np.cross(pb - pa, pc - pa), axis=1)
@@ -268,13 +290,20 @@ def air_link_conductances(model: ThermalModel, x: np.ndarray) -> np.ndarray:
 
 
 def _air_links(model: ThermalModel, area, perim) -> np.ndarray:
+    if model.reference_geometry and perim is model.reference_pieces[4]:
+        side = model.reference_pieces[5]  # the perimeters do not change with the shape
+    else:
+        side = _air_perimeter_term(model, perim)
+    Ac = (2.0 / 3.0) * area[:, None] + side
+    return model.env_conductivity * Ac * model.env_layers / model.air_thickness[:, None]
+
+
+def _air_perimeter_term(model: ThermalModel, perim) -> np.ndarray:
+    """(nt, L): the perimeter term of the air-link sections."""
     L = model.env_layers
     h = model.air_thickness
     depth = (np.arange(1, L + 1) - 0.5) / L
-    Ac = (2.0 / 3.0) * area[:, None] + (2.0 / 3.0) * (perim * h * np.tan(model.dissipation_angle))[
-        :, None
-    ] * depth[None, :]
-    return model.env_conductivity * Ac * L / h[:, None]
+    return (2.0 / 3.0) * (perim * h * np.tan(model.dissipation_angle))[:, None] * depth[None, :]
 
 
 def _node_link_conductances(model: ThermalModel, x: np.ndarray, geometry=None) -> np.ndarray:
@@ -327,9 +356,18 @@ def steady_temperature(
         G = chain_conductance(model, x, _geometry=geo)
         ke = _element_matrices(model, geo[0], geo[1])
         A = np.bincount(model.dense_slots, weights=ke.ravel(), minlength=n * n).reshape(n, n)
-        A[np.diag_indices(n)] += G
-        c = sla.cho_factor(A, lower=False, check_finite=False)
-        return sla.cho_solve(c, q + G * RT, check_finite=False)
+        A.flat[:: n + 1] += G
+        # sla.cho_factor / cho_solve (check_finite=False) without their wrappers: the same
+        # LAPACK calls on the same arrays
+        c, info = dpotrf(A, lower=0, clean=0)
+        if info > 0:
+            raise np.linalg.LinAlgError(
+                f"{info}-th leading minor of the array is not positive definite"
+            )
+        T, info = dpotrs(c, q + G * RT, lower=0)
+        if info != 0:  # pragma: no cover - only for invalid arguments
+            raise ValueError(f"illegal value in {-info}th argument of internal potrs")
+        return T
     K = conduction_matrix(model, x) if K_cond is None else K_cond
     G = chain_conductance(model, x) if G is None else G
     A = (K + sp.diags(G)).tocsr()

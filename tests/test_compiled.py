@@ -133,3 +133,40 @@ def test_dense_solver_is_numpy_solve_bit_for_bit():
             assert np.array_equal(solve(rhs), np.linalg.solve(K, rhs))
     with pytest.raises(SingularSystemError, match="singular stiffness matrix"):
         _dense_solver(np.zeros((4, 4)))(np.ones(4))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_dense_newton_update_is_the_factorized_step_bit_for_bit(seed):
+    # the one compiled call solve_selffold makes per iteration on the dense path
+    s, U = _structure(seed)
+    asm, ref = Assembler(s), Assembler(s)
+    free = asm.free_dofs
+    rng = np.random.default_rng(seed)
+    F = rng.normal(size=s.n_dof) * 1e-3
+    rest = np.ascontiguousarray(s.spring_rest + 0.05 * rng.normal(size=len(s.springs)))
+    Ua, Ub = 1e-3 * U.ravel(), 1e-3 * U.ravel()
+    r = np.empty(free.size)
+    for _ in range(3):
+        assert asm.dense_newton_update(Ua, F, rest, r)
+        _, f, solve = ref.evaluate_factorized(Ub, rest)
+        rb = (F - f)[free]
+        Ub[free] += solve(rb)
+        assert np.array_equal(r, rb) and np.array_equal(Ua, Ub)
+    # not the dense path: nothing done, the caller takes evaluate_factorized
+    assert not Assembler(s, dense_max=2).dense_newton_update(Ua, F, rest, r)
+    assert np.array_equal(Ua, Ub)
+
+
+def test_dense_newton_update_raises_on_a_singular_tangent():
+    from holofold.mechanics.assembly import SingularSystemError
+
+    s, _ = _structure(3)
+    s0 = Structure(
+        nodes=s.nodes, bars=s.bars, bar_area=1.0, bar_E=0.0, springs=s.springs, spring_k=0.0,
+        spring_rest=s.spring_rest, supports=s.supports,
+    )  # fmt: skip
+    U = np.zeros(s.n_dof)
+    asm = Assembler(s0)
+    with pytest.raises(SingularSystemError, match="singular stiffness matrix"):
+        asm.dense_newton_update(U, np.ones(s.n_dof), s.spring_rest, np.empty(asm.free_dofs.size))
+    assert not U.any()

@@ -82,6 +82,7 @@ def solve_selffold(
     F0v = nodal_array("F0", F0, nn).ravel()
     U = nodal_array("U0", U0, nn).ravel()
     free = asm.free_dofs
+    r = np.empty(free.size)
     hist = History(increments, nn)
     for i in range(1, increments + 1):
         s = i / increments
@@ -90,10 +91,11 @@ def solve_selffold(
         R = np.inf
         try:
             while step < max_iter and R > tol:
-                _, f, solve = asm.evaluate_factorized(U, rest)
-                r = (F0v - f)[free]
-                dU = solve(r)
-                U[free] += dU
+                # the compiled dense step where it applies, else the same operations here
+                if not asm.dense_newton_update(U, F0v, rest, r):
+                    _, f, solve = asm.evaluate_factorized(U, rest)
+                    r = (F0v - f)[free]
+                    U[free] += solve(r)
                 R = float(np.sqrt(r @ r))
                 step += 1
         except SingularSystemError as exc:
