@@ -662,10 +662,10 @@ class Assembler:
             # not positive definite: LU below
         return energy, f, _lu_solver(self._scatter(rb), red)
 
-    def dense_newton_update(self, U, F, spring_rest, r):
+    def dense_newton_update(self, U, F, spring_rest=None, r=None):
         """One compiled Newton update on the dense path, bit for bit
-        ``_, f, solve = evaluate_factorized(U, spring_rest); r = (F - f)[free]; U[free] +=
-        solve(r)`` in one numba call (kernels, gathers, ``dgetrf``/``dgetrs`` by address).
+        ``_, f, solve = evaluate_factorized(U, spring_rest); r = (F - f)[free]; dU = solve(r);
+        U[free] += dU`` in one numba call (kernels, gathers, ``dgetrf``/``dgetrs`` by address).
 
         Parameters
         ----------
@@ -673,29 +673,45 @@ class Assembler:
             Displacements, updated in place, m.
         F : (ndof,) float, C-contiguous
             External force, N.
-        spring_rest : (ns,) float, C-contiguous
-            Rest angles, rad.
-        r : (nf,) float
+        spring_rest : (ns,) float, C-contiguous, optional
+            Rest angles (default ``structure.spring_rest``), rad.
+        r : (nf,) float, optional
             Filled with the residual ``(F - f_int(U))[free]`` before the update, N.
 
         Returns
         -------
-        bool
-            False (nothing done) where this assembler does not take the dense path or uses the
+        (nf,) float or None
+            The increment ``dU`` on :attr:`free_dofs` (a buffer the next call overwrites), or
+            None (nothing done) where this assembler does not take the dense path or uses the
             reference's arccos angle; then call :meth:`evaluate_factorized`. Raises
             :class:`SingularSystemError` as the dense solver would (U left alone).
         """
-        step = self._dense_step
-        if step is None:
-            return False
-        fn, X, mid, after, post, dU, info = step
-        fn(
-            X, U.reshape(1, -1, 3), *mid, spring_rest.reshape(1, -1), *after, F.reshape(1, -1),
-            *post, U.reshape(1, -1), dU, info, r.reshape(1, -1),
+        step = self.dense_stepper(U, F, spring_rest, r)
+        return None if step is None else step()
+
+    def dense_stepper(self, U, F, spring_rest=None, r=None):
+        """``step()``: :meth:`dense_newton_update` with these arguments bound once (a loop of
+        Newton iterations on one increment calls it over and over), or None off the dense
+        path."""
+        st = self._dense_step
+        if st is None:
+            return None
+        fn, X, mid, after, post, dU, info, theta0 = st
+        rest = theta0 if spring_rest is None else spring_rest.reshape(1, -1)
+        res = dU if r is None else r.reshape(1, -1)
+        args = (
+            X, U.reshape(1, -1, 3), *mid, rest, *after, F.reshape(1, -1), *post,
+            U.reshape(1, -1), dU, info, res,
         )  # fmt: skip
-        if info[0]:
-            raise SingularSystemError(_SINGULAR if info[0] == 1 else _NON_FINITE)
-        return True
+        out = dU[0]
+
+        def step():
+            fn(*args)
+            if info[0]:
+                raise SingularSystemError(_SINGULAR if info[0] == 1 else _NON_FINITE)
+            return out
+
+        return step
 
     @cached_property
     def _dense_step(self):
@@ -713,7 +729,17 @@ class Assembler:
         after = (np.array([self._k_nonneg]), np.zeros(1, np.intp), force, lists, views, flats)
         post = (red.free, ck.lapack_addresses("dgetrf", "dgetrs"))
         dU = np.empty((1, red.n_free))
-        return ck.dense_newton_step, one(self._X), mid, after, post, dU, np.zeros(1, np.int8)
+        theta0 = np.ascontiguousarray(self.theta0, dtype=float).reshape(1, -1)
+        return (
+            ck.dense_newton_step,
+            one(self._X),
+            mid,
+            after,
+            post,
+            dU,
+            np.zeros(1, np.int8),
+            theta0,
+        )
 
 
 def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:

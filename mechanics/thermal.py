@@ -30,6 +30,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dpotrf, dpotrs
+from scipy.sparse import _sparsetools
 
 from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
@@ -309,7 +310,7 @@ def _air_perimeter_term(model: ThermalModel, perim) -> np.ndarray:
 def _node_link_conductances(model: ThermalModel, x: np.ndarray, geometry=None) -> np.ndarray:
     """G_{v,q} = sum over triangles at v of g_e(q), (nn, L)."""
     _, area, perim = triangle_edges(model, x) if geometry is None else geometry
-    return model.node_incidence @ _air_links(model, area, perim)
+    return _csr_times(model.node_incidence, _air_links(model, area, perim))
 
 
 def chain_conductance(model: ThermalModel, x: np.ndarray, *, _geometry=None) -> np.ndarray:
@@ -321,6 +322,28 @@ def chain_conductance(model: ThermalModel, x: np.ndarray, *, _geometry=None) -> 
     with np.errstate(divide="ignore"):
         inv = np.where(Gq > 0, 1.0 / np.where(Gq > 0, Gq, 1.0), np.inf).sum(axis=1)
     return np.where(np.isfinite(inv), 1.0 / inv, 0.0)
+
+
+def _csr_times(M, x: np.ndarray) -> np.ndarray:
+    """``M @ x``; for a float csr matrix and a float (n,) or C-contiguous (n, k) ``x``, the
+    sparsetools loop scipy's ``@`` runs (the same numbers) without its dispatch, which costs
+    more than the loop at these sizes."""
+    if not (
+        isinstance(M, sp.csr_matrix) and M.dtype == np.float64 and isinstance(x, np.ndarray)
+        and x.dtype == np.float64 and x.flags.c_contiguous and x.ndim in (1, 2)
+        and x.shape[0] == M.shape[1]
+    ):  # fmt: skip
+        return M @ x
+    m, n = M.shape
+    if x.ndim == 1:
+        out = np.zeros(m)
+        _sparsetools.csr_matvec(m, n, M.indptr, M.indices, M.data, x, out)
+    else:
+        out = np.zeros((m, x.shape[1]))
+        _sparsetools.csr_matvecs(
+            m, n, x.shape[1], M.indptr, M.indices, M.data, x.ravel(), out.ravel()
+        )
+    return out
 
 
 def _solve_spd(A: sp.spmatrix, b: np.ndarray) -> np.ndarray:
@@ -467,6 +490,13 @@ def timoshenko_curvature(dT, d_alpha, t1, t2, E1=1.0, E2=1.0):
     ``m = t1/t2``, ``n = E1/E2``, ``h = t1 + t2``; ``d_alpha`` (1/K) is the expansion mismatch.
     All arguments broadcast.
     """
+    a, c, d = _timoshenko_factors(d_alpha, t1, t2, E1, E2)
+    return a * np.asarray(dT, float) * c / d
+
+
+def _timoshenko_factors(d_alpha, t1, t2, E1, E2):
+    """``(6 d_alpha, (1+m)^2, h [...])``: :func:`timoshenko_curvature` is
+    ``6 d_alpha * dT * (1+m)^2 / (h [...])``, evaluated left to right."""
     t1, t2, E1, E2 = (np.asarray(v, float) for v in (t1, t2, E1, E2))
     if (t1 <= 0).any() or (t2 <= 0).any() or (E1 <= 0).any() or (E2 <= 0).any():
         raise ValueError("bimorph layer thicknesses and moduli must be > 0")
@@ -474,11 +504,9 @@ def timoshenko_curvature(dT, d_alpha, t1, t2, E1=1.0, E2=1.0):
     n = E1 / E2
     h = t1 + t2
     return (
-        6.0
-        * np.asarray(d_alpha, float)
-        * np.asarray(dT, float)
-        * (1 + m) ** 2
-        / (h * (3 * (1 + m) ** 2 + (1 + m * n) * (m**2 + 1 / (m * n))))
+        6.0 * np.asarray(d_alpha, float),
+        (1 + m) ** 2,
+        h * (3 * (1 + m) ** 2 + (1 + m * n) * (m**2 + 1 / (m * n))),
     )
 
 
@@ -509,8 +537,12 @@ class Bimorph:
 
     def fold_increment(self, dT_crease: np.ndarray) -> np.ndarray:
         """Rest-angle change (nci,), rad, for crease temperature rises ``dT_crease`` (nci,), K."""
-        k = timoshenko_curvature(dT_crease, self.d_alpha, self.t1, self.t2, self.E1, self.E2)
-        return self.width * k
+        a, c, d = self._factors  # timoshenko_curvature's, built once
+        return self.width * (a * np.asarray(dT_crease, float) * c / d)
+
+    @cached_property
+    def _factors(self):
+        return _timoshenko_factors(self.d_alpha, self.t1, self.t2, self.E1, self.E2)
 
 
 @dataclass(frozen=True, eq=False)
@@ -618,7 +650,7 @@ def electrothermal_stage(
     cn = structure.creases.nodes
     H = heat_input_matrix(cn, nn) if heat_matrix is None else heat_matrix
     A = crease_temperature_matrix(cn, nn) if temp_matrix is None else temp_matrix
-    q_stage = H @ Q
+    q_stage = _csr_times(H, Q)
     U = state.U.copy()
     T = state.T
     theta = state.crease_angle
@@ -628,7 +660,7 @@ def electrothermal_stage(
     for s in range(1, steps + 1):
         q = state.q + (s / steps) * q_stage
         T = steady_temperature(model, structure.nodes + U, q)
-        dTc = A @ (T - state.T)
+        dTc = _csr_times(A, T - state.T)
         theta = state.crease_angle + bimorph.fold_increment(dTc)
         full[cid] = theta
         target = crease_rest_targets(structure, full, profile=profile)

@@ -147,13 +147,19 @@ def test_dense_newton_update_is_the_factorized_step_bit_for_bit(seed):
     Ua, Ub = 1e-3 * U.ravel(), 1e-3 * U.ravel()
     r = np.empty(free.size)
     for _ in range(3):
-        assert asm.dense_newton_update(Ua, F, rest, r)
+        dUa = asm.dense_newton_update(Ua, F, rest, r)
         _, f, solve = ref.evaluate_factorized(Ub, rest)
         rb = (F - f)[free]
-        Ub[free] += solve(rb)
-        assert np.array_equal(r, rb) and np.array_equal(Ua, Ub)
+        dUb = solve(rb)
+        Ub[free] += dUb
+        assert np.array_equal(r, rb) and np.array_equal(Ua, Ub) and np.array_equal(dUa, dUb)
+    # the structure's own rest angles by default, no residual asked for
+    _, f, solve = ref.evaluate_factorized(Ub)
+    dUb = solve((F - f)[free])
+    Ub[free] += dUb
+    assert np.array_equal(asm.dense_newton_update(Ua, F), dUb) and np.array_equal(Ua, Ub)
     # not the dense path: nothing done, the caller takes evaluate_factorized
-    assert not Assembler(s, dense_max=2).dense_newton_update(Ua, F, rest, r)
+    assert Assembler(s, dense_max=2).dense_newton_update(Ua, F, rest, r) is None
     assert np.array_equal(Ua, Ub)
 
 

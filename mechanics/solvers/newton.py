@@ -88,11 +88,16 @@ def solve_newton(
         Fi = F0v + i * P
         step = 1
         R = np.inf
+        # the compiled dense step where it applies, else the same operations here
+        dense = asm.dense_stepper(U, Fi)
         try:
             while step < max_iter and R > tol:
-                _, f, solve = asm.evaluate_factorized(U)
-                dU = solve((Fi - f)[free])
-                U[free] += dU
+                if dense is not None:
+                    dU = dense()
+                else:
+                    _, f, solve = asm.evaluate_factorized(U)
+                    dU = solve((Fi - f)[free])
+                    U[free] += dU
                 R = float(np.sqrt(dU @ dU))
                 step += 1
         except SingularSystemError as exc:

@@ -14,6 +14,8 @@ update is applied even on the iteration that meets the tolerance. Snap-through c
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from holofold.mechanics.assembly import Assembler, SingularSystemError
@@ -89,14 +91,17 @@ def solve_selffold(
         rest = (1.0 - s) * start + s * target
         step = 1
         R = np.inf
+        # the compiled dense step where it applies, else the same operations here
+        dense = asm.dense_stepper(U, F0v, rest, r)
         try:
             while step < max_iter and R > tol:
-                # the compiled dense step where it applies, else the same operations here
-                if not asm.dense_newton_update(U, F0v, rest, r):
+                if dense is not None:
+                    dense()
+                else:
                     _, f, solve = asm.evaluate_factorized(U, rest)
                     r = (F0v - f)[free]
                     U[free] += solve(r)
-                R = float(np.sqrt(r @ r))
+                R = math.sqrt(r @ r)  # = float(np.sqrt(r @ r)): both correctly rounded
                 step += 1
         except SingularSystemError as exc:
             hist.failure = f"increment {i}, iteration {step}: {exc}"
