@@ -8,6 +8,7 @@ same CPU time:
     floor = sum over the Newton iterations of (cheapest factorisation + solve of the tangent)
 
 The tangents are the actual ones: every ``Assembler.evaluate_factorized`` call of one sample
+(and every compiled Newton step, ``Assembler.dense_stepper`` and ``BatchAssembler.newton_step``)
 is counted and every ``--every``-th free-free tangent captured; each captured tangent is
 factorised and solved (one right-hand side) by every applicable LAPACK/SuperLU path called
 directly (dense Cholesky dpotrf/dpotrs, dense LU dgetrf/dgetrs, banded Cholesky dpbtrf/dpbtrs
@@ -131,6 +132,21 @@ class Capture:
             return cap.orig(asm, U, spring_rest)
 
         assembly.Assembler.evaluate_factorized = spy
+        self.orig_stepper = getattr(assembly.Assembler, "dense_stepper", None)
+        if self.orig_stepper is not None:  # the compiled dense step of one design
+
+            def spy_stepper(asm, U, F, spring_rest=None, r=None):
+                step = cap.orig_stepper(asm, U, F, spring_rest, r)
+                if step is None:
+                    return None
+
+                def counted():
+                    cap._record(asm, U, spring_rest)
+                    return step()
+
+                return counted
+
+            assembly.Assembler.dense_stepper = spy_stepper
         batch = getattr(assembly, "BatchAssembler", None)  # the batched path (issue 14)
         if batch is not None:
             self.orig_batch = batch.factorized
@@ -162,6 +178,8 @@ class Capture:
 
     def __exit__(self, *exc):
         assembly.Assembler.evaluate_factorized = self.orig
+        if self.orig_stepper is not None:
+            assembly.Assembler.dense_stepper = self.orig_stepper
         if getattr(assembly, "BatchAssembler", None) is not None:
             assembly.BatchAssembler.factorized = self.orig_batch
             if self.orig_step is not None:

@@ -35,6 +35,8 @@ __all__ = [
     "band_newton_step",
     "dense_newton_step",
     "lapack_addresses",
+    "thermal_sides",
+    "thermal_system",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -484,3 +486,73 @@ def dense_newton_step(
         info[j] = 0
         for q in range(nf):
             Uflat[s, free[q]] += x[q]
+
+
+# ------------------------------------------------------------------------ thermal
+# The small-model steady temperature of :mod:`holofold.mechanics.thermal` (reference
+# geometry) without its forty array operations per heating step: the same IEEE operations in
+# numpy's order (products and differences one by one, a length-3 sum left to right, the
+# element matrices summed into the dense matrix in ``np.bincount`` order, the incidence sum in
+# scipy's ``csr_matvecs`` order). numpy keeps the angle (einsum, arctan2, cos, sin) and the
+# series sum over the air layers.
+
+
+@njit(**_OPTS)
+def thermal_sides(x, tri, u, v, cross):
+    """``u = xb - xa``, ``v = xc - xa`` (nt, 3) and ``cross = |u x v|`` (nt,) as
+    ``np.linalg.norm(np.cross(u, v), axis=1)``."""
+    for t in range(tri.shape[0]):
+        a, b, c = tri[t, 0], tri[t, 1], tri[t, 2]
+        for d in range(3):
+            u[t, d] = x[b, d] - x[a, d]
+            v[t, d] = x[c, d] - x[a, d]
+        c0 = u[t, 1] * v[t, 2] - u[t, 2] * v[t, 1]
+        c1 = u[t, 2] * v[t, 0] - u[t, 0] * v[t, 2]
+        c2 = u[t, 0] * v[t, 1] - u[t, 1] * v[t, 0]
+        cross[t] = math.sqrt((c0 * c0 + c1 * c1) + c2 * c2)
+
+
+@njit(**_OPTS)
+def thermal_system(
+    cos, sin, Lab, Lac, half_ab_ac, k_th, slots, side, k_env, layers, h, ptr, idx, data,
+    area, A, Gq,
+):  # fmt: skip
+    """From the angle's ``cos``, ``sin`` (nt,): ``area`` (nt,), the conduction matrix ``A``
+    (flat nn^2, zeros on entry) and the node-layer conductances ``Gq`` (nn, L), as
+    ``triangle_edges``, ``_element_matrices`` + ``np.bincount`` and ``_air_links`` + the
+    incidence product compute them. Returns False (nothing assembled) if an area is <= 0."""
+    nt = cos.shape[0]
+    e = np.empty((3, 2))
+    for t in range(nt):
+        area[t] = half_ab_ac[t] * sin[t]
+    for t in range(nt):
+        if area[t] <= 0.0:
+            return False
+    for t in range(nt):
+        pc0 = Lac[t] * cos[t]
+        pc1 = Lac[t] * sin[t]
+        # pa = (0, 0), pb = (Lab, 0): e = [pc - pb, pa - pc, pb - pa]
+        e[0, 0] = pc0 - Lab[t]
+        e[0, 1] = pc1 - 0.0
+        e[1, 0] = 0.0 - pc0
+        e[1, 1] = 0.0 - pc1
+        e[2, 0] = Lab[t] - 0.0
+        e[2, 1] = 0.0 - 0.0
+        coef = k_th[t] / (4.0 * area[t])
+        for p in range(3):
+            for q in range(3):
+                s = slots[9 * t + 3 * p + q]
+                A[s] += coef * (e[p, 0] * e[q, 0] + e[p, 1] * e[q, 1])
+    L = side.shape[1]
+    links = np.empty((nt, L))
+    for t in range(nt):
+        for j in range(L):
+            Ac = (2.0 / 3.0) * area[t] + side[t, j]
+            links[t, j] = k_env * Ac * layers / h[t]
+    for i in range(Gq.shape[0]):
+        for j in range(L):
+            Gq[i, j] = 0.0
+        for jj in range(ptr[i], ptr[i + 1]):
+            for j in range(L):
+                Gq[i, j] += data[jj] * links[idx[jj], j]
+    return True

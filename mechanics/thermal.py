@@ -155,6 +155,18 @@ class ThermalModel:
         )  # fmt: skip
 
     @cached_property
+    def compiled_pieces(self) -> tuple:
+        """The fixed arguments of ``_compiled.thermal_system`` (reference geometry)."""
+        _, _, Lac, half_ab_ac, _, side = self.reference_pieces
+        inc = self.node_incidence
+        return (
+            np.ascontiguousarray(self.rest_edges[:, 0]), np.ascontiguousarray(Lac[:, 0]),
+            half_ab_ac, self.conductivity * self.thickness, self.dense_slots,
+            np.ascontiguousarray(side), float(self.env_conductivity), float(self.env_layers),
+            self.air_thickness, inc.indptr, inc.indices, inc.data,
+        )  # fmt: skip
+
+    @cached_property
     def dense_slots(self) -> np.ndarray:
         """(9 nt,) int: flat position ``p n + q`` in a dense (nn, nn) matrix of every entry of
         the element matrices (nt, 3, 3)."""
@@ -318,7 +330,12 @@ def chain_conductance(model: ThermalModel, x: np.ndarray, *, _geometry=None) -> 
 
     Nodes that belong to no triangle get 0.
     """
-    Gq = _node_link_conductances(model, x, _geometry)
+    return _series(_node_link_conductances(model, x, _geometry))
+
+
+def _series(Gq: np.ndarray) -> np.ndarray:
+    """Series conductance (nn,) of the node-layer conductances ``Gq`` (nn, L); 0 where a row
+    has no positive entry."""
     with np.errstate(divide="ignore"):
         inv = np.where(Gq > 0, 1.0 / np.where(Gq > 0, Gq, 1.0), np.inf).sum(axis=1)
     return np.where(np.isfinite(inv), 1.0 / inv, 0.0)
@@ -353,6 +370,25 @@ def _solve_spd(A: sp.spmatrix, b: np.ndarray) -> np.ndarray:
     return spla.splu(sp.csc_matrix(A)).solve(b)
 
 
+def _compiled_system(model: ThermalModel, x: np.ndarray):
+    """The dense conduction matrix (nn, nn) and the chain conductances G (nn,) of the small
+    model fast path in the reference geometry, bit for bit those of :func:`triangle_edges`,
+    :func:`_element_matrices` + ``np.bincount`` and :func:`chain_conductance` (two compiled
+    calls around numpy's einsum, arctan2, cos and sin)."""
+    from holofold.mechanics import _compiled as ck
+
+    tri = model.triangles
+    nt, n = len(tri), model.n_nodes
+    x = np.ascontiguousarray(x, dtype=float)
+    u, v, cross = np.empty((nt, 3)), np.empty((nt, 3)), np.empty(nt)
+    ck.thermal_sides(x, tri, u, v, cross)
+    alpha = np.arctan2(cross, np.einsum("ij,ij->i", u, v))
+    area, A, Gq = np.empty(nt), np.zeros(n * n), np.empty((n, model.env_layers))
+    if not ck.thermal_system(np.cos(alpha), np.sin(alpha), *model.compiled_pieces, area, A, Gq):
+        _element_matrices(model, None, area)  # raises, naming the triangle
+    return A.reshape(n, n), _series(Gq)
+
+
 @single_threaded
 def steady_temperature(
     model: ThermalModel,
@@ -375,10 +411,14 @@ def steady_temperature(
     RT = model.room_temperature
     if K_cond is None and G is None and n <= _DENSE_MAX and not len(model.room_temp_nodes):
         # fast path for small models: one geometry pass, dense assembly, Cholesky
-        geo = triangle_edges(model, x)
-        G = chain_conductance(model, x, _geometry=geo)
-        ke = _element_matrices(model, geo[0], geo[1])
-        A = np.bincount(model.dense_slots, weights=ke.ravel(), minlength=n * n).reshape(n, n)
+        if model.reference_geometry:
+            A, G = _compiled_system(model, x)
+        else:
+            geo = triangle_edges(model, x)
+            G = chain_conductance(model, x, _geometry=geo)
+            ke = _element_matrices(model, geo[0], geo[1])
+            A = np.bincount(model.dense_slots, weights=ke.ravel(), minlength=n * n)
+            A = A.reshape(n, n)
         A.flat[:: n + 1] += G
         # sla.cho_factor / cho_solve (check_finite=False) without their wrappers: the same
         # LAPACK calls on the same arrays

@@ -226,3 +226,26 @@ def test_structure_without_triangles_gives_empty_model():
     m = thermal_model(s, panel_conductivity=1.0, crease_conductivity=1.0, air_thickness=1.0)
     assert m.triangles.shape == (0, 3)
     np.testing.assert_array_equal(chain_conductance(m, s.nodes), 0.0)
+
+
+def test_compiled_system_is_the_numpy_one_bit_for_bit():
+    # steady_temperature's small-model path assembles in compiled code (reference geometry)
+    from holofold.mechanics.thermal import _compiled_system, _element_matrices, triangle_edges
+
+    _, s = _gripper_structure()
+    model = thermal_model(s, panel_conductivity=0.3, crease_conductivity=0.2, air_thickness=4e-3)
+    rng = np.random.default_rng(3)
+    n = s.n_nodes
+    for scale in (0.0, 1e-6, 1e-4):
+        x = s.nodes + rng.normal(0, scale, s.nodes.shape)
+        e, area, _ = triangle_edges(model, x)
+        ke = _element_matrices(model, e, area)
+        A = np.bincount(model.dense_slots, weights=ke.ravel(), minlength=n * n).reshape(n, n)
+        Ac, Gc = _compiled_system(model, x)
+        np.testing.assert_array_equal(Ac, A)
+        np.testing.assert_array_equal(Gc, chain_conductance(model, x))
+    x = s.nodes.copy()
+    a, _, c = model.triangles[5]
+    x[c] = x[a]  # triangle 5 collapsed
+    with pytest.raises(ValueError, match="triangle 5 .* zero area"):
+        steady_temperature(model, x, np.ones(n))
