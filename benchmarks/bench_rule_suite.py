@@ -314,6 +314,16 @@ def comparison_table(runs: pd.DataFrame, methods) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
+def _paired_cells(r, prefix: str = "") -> str:
+    """The win, difference [95 % CI] and lose>.05 cells of a method's row (dashes for the
+    paper's method, the reference of the pairing)."""
+    if r.method == PAPER:
+        return f"{'-':>5s} {'-':>24s} {'-':>8s}"
+    g = {k: r[f"{prefix}{k}"] for k in ("win", "diff", "lo", "hi", "lose")}
+    ci = f"{g['diff']:+.3f} [{g['lo']:+.3f}, {g['hi']:+.3f}]"
+    return f"{g['win']:5.2f} {ci:>24s} {g['lose']:8.2f}"
+
+
 def print_external(table: pd.DataFrame) -> None:
     if "ext" not in table:
         return
@@ -330,11 +340,7 @@ def print_external(table: pd.DataFrame) -> None:
     for _, r in table.iterrows():
         if pd.isna(r.get("ext", np.nan)):
             continue
-        if r.method == PAPER:
-            cmp = f"{'-':>5s} {'-':>24s} {'-':>8s}"
-        else:
-            ci = f"{r['ext_diff']:+.3f} [{r['ext_lo']:+.3f}, {r['ext_hi']:+.3f}]"
-            cmp = f"{r['ext_win']:5.2f} {ci:>24s} {r['ext_lose']:8.2f}"
+        cmp = _paired_cells(r, "ext_")
         print(
             f"{r.method:14s} {r.ext:6.3f} {r.ext_support:7.1f} {r['est-ext']:+8.3f} "
             f"{r['|est-ext|']:9.3f} {r['|all-ext|']:9.3f} {cmp}"
@@ -355,11 +361,7 @@ def print_table(table: pd.DataFrame, n_targets: int, n_splits: int) -> None:
     for _, r in table.iterrows():
         what = METHODS[r.method][2] if r.method in METHODS else "gradient boosting (no rule)"
         est = "" if pd.isna(r.get("est-test", np.nan)) else f"{r['est-test']:+.3f}"
-        if r.method == PAPER:
-            cmp = f"{'-':>5s} {'-':>24s} {'-':>8s}"
-        else:
-            ci = f"{r['diff']:+.3f} [{r['lo']:+.3f}, {r['hi']:+.3f}]"
-            cmp = f"{r['win']:5.2f} {ci:>24s} {r['lose']:8.2f}"
+        cmp = _paired_cells(r)
         print(
             f"{r.method:14s} {r.prec:6.3f} {r.recall:6.3f} {r.support:6.1f} {int(r['no rule']):6d} "
             f"{est:>8s} {cmp}  {what}"
