@@ -425,18 +425,22 @@ def band_newton_step(
             d = free[perm[q]]
             y[q] = Fi[s, d] - f[d]
         _fcall(addrs[1], (uplo, n_, kd_, one, ab, ld_, y, n_, inf_))
-        ok = True
         x = dU[j]
         for q in range(nf):
             x[perm[q]] = y[q]
-            if not np.isfinite(y[q]):
-                ok = False
-        if not ok:
-            info[j] = 2
-            continue
-        info[j] = 0
-        for q in range(nf):
-            Uflat[s, free[q]] += x[q]
+        info[j] = _accept(x, Uflat, s, free)
+
+
+@njit(**_OPTS)
+def _accept(x, Uflat, s, free) -> int:
+    """The status of a Newton solution ``x`` (free DOFs) of sample ``s``: 2 if any entry is not
+    finite, else 0 after adding it to ``Uflat[s, free]``."""
+    for q in range(free.shape[0]):
+        if not np.isfinite(x[q]):
+            return 2
+    for q in range(free.shape[0]):
+        Uflat[s, free[q]] += x[q]
+    return 0
 
 
 @njit(**_OPTS)
@@ -476,16 +480,7 @@ def dense_newton_step(
             r[q] = Fi[s, d] - f[d]
             x[q] = r[q]
         _fcall(addrs[1], (trans, n_, one, a, n_, piv, x, n_, inf_))
-        ok = True
-        for q in range(nf):
-            if not np.isfinite(x[q]):
-                ok = False
-        if not ok:
-            info[j] = 2
-            continue
-        info[j] = 0
-        for q in range(nf):
-            Uflat[s, free[q]] += x[q]
+        info[j] = _accept(x, Uflat, s, free)
 
 
 # ------------------------------------------------------------------------ thermal
