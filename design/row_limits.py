@@ -6,8 +6,11 @@ timer raises :class:`RowTimeout` in that thread when the limit passes (CPython's
 ``PyThreadState_SetAsyncExc``, the mechanism behind ``KeyboardInterrupt`` in threads). The
 exception arrives at the next Python bytecode the thread runs, so it interrupts a solver
 between two iterations or two compiled calls; one compiled call (a numba kernel, a LAPACK
-solve) is not cut short, it runs to its end first. Nothing is checked inside the solvers, so
-a row that finishes within its limit gives bit for bit the results it gives without one.
+solve) is not cut short, it runs to its end first. A row that returns after its deadline
+(the watchdog had no chance to interrupt it: one long compiled call, or the interpreter's
+thread switch interval of 5 ms) is a timeout too, so whether a row times out depends only on
+how long it ran. Nothing is checked inside the solvers, so a row that finishes within its
+limit gives bit for bit the results it gives without one.
 """
 
 from __future__ import annotations
@@ -139,12 +142,17 @@ def call_with_limit(seconds: float | None, fn, *args):
 
     ``seconds`` None: no limit (``fn`` is called as is). The watch ends when ``fn`` returns
     or raises, and a :class:`RowTimeout` raised for it that has not yet arrived is withdrawn,
-    so nothing arrives after this function has returned.
+    so nothing arrives after this function has returned. ``fn`` returning after the
+    deadline raises :class:`RowTimeout` as well.
     """
     if seconds is None:
         return fn(*args)
+    deadline = time.monotonic() + seconds
     token = _WATCHDOG.arm(seconds)
     try:
-        return fn(*args)
+        out = fn(*args)
     finally:
         _WATCHDOG.disarm(token)
+    if time.monotonic() > deadline:
+        raise RowTimeout(f"returned after its limit of {seconds:g} s")
+    return out

@@ -143,6 +143,12 @@ def test_limit_interrupts_python_code_in_any_thread():
         call_with_limit(0.05, _spin, 5.0)
     assert time.perf_counter() - t0 < 1.0
     assert call_with_limit(5.0, sum, [1, 2]) == 3
+    # one C call the watchdog cannot cut short: it runs to its end, and still counts as late
+    t0 = time.perf_counter()
+    with pytest.raises(RowTimeout):
+        call_with_limit(0.02, time.sleep, 0.2)
+    assert time.perf_counter() - t0 >= 0.2
+    _spin(0.05)  # and nothing arrives afterwards
     caught = []
 
     def in_thread():
