@@ -328,8 +328,11 @@ def _assemble_sample(
     views, flats, f, K,
 ):  # fmt: skip
     """Sample ``s``'s kernels into ``views`` (memory ``flats``), its internal force into ``f``
-    and its tangent into ``K`` by the gather lists (``f`` and ``K`` start as zeros)."""
+    and its tangent into ``K`` by the gather lists (both zeroed first: the gathers write only
+    the entries that receive something)."""
     eb, fb, Kb, es, fs, Ks, th = views
+    f[:] = 0.0
+    K[:] = 0.0
     _, vfb, vkb, _, vfs, vks, _ = flats
     fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
     ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
@@ -347,7 +350,8 @@ def assemble_batch(
     """For each sample ``s = idx[j]``: the kernels into the element arrays ``views`` (the
     seven of one sample, in the kernels' layouts), then ``f_out[j]`` by the ``force_lists``
     and ``k_out[j]`` by the ``tangent_lists`` (each the seven arguments of :func:`gather` but
-    the values), whose sources index the memory of the views, ``flats``."""
+    the values), whose sources index the memory of the views, ``flats`` (``f_out`` and
+    ``k_out`` need not start as zeros)."""
     for j in range(idx.shape[0]):
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
@@ -411,8 +415,6 @@ def band_newton_step(
     for j in range(idx.shape[0]):
         s = idx[j]
         f = f_out[j]
-        f[:] = 0.0
-        ab[:] = 0.0
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
             views, flats, f, ab,
@@ -463,8 +465,6 @@ def dense_newton_step(
     f = np.empty(Uflat.shape[1])
     for j in range(idx.shape[0]):
         s = idx[j]
-        f[:] = 0.0
-        a[:] = 0.0
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
             views, flats, f, a,

@@ -985,8 +985,8 @@ class BatchAssembler:
                     solves[s] = lambda rhs: np.zeros_like(rhs, dtype=float)
                 continue
             lists, n = red.batch_gather(path)
-            fj = np.zeros((idx.size, self.n_dof))
-            kj = np.zeros((idx.size, n))
+            fj = np.empty((idx.size, self.n_dof))
+            kj = np.empty((idx.size, n))
             views, flats = self._scratch
             ck.assemble_batch(
                 self._X, U, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
