@@ -56,15 +56,6 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _group_mean(values: np.ndarray, group: np.ndarray, sizes: np.ndarray) -> np.ndarray:
-    """Mean of (n, 3) ``values`` per group id, (len(sizes), 3)."""
-    n = len(sizes)
-    out = np.empty((n, 3))
-    for c in range(3):
-        out[:, c] = np.bincount(group, weights=values[:, c], minlength=n)
-    return out / sizes[:, None]
-
-
 def orient_springs(
     x: np.ndarray, springs: np.ndarray, *, z_only: bool = True, where: np.ndarray | None = None
 ) -> np.ndarray:
@@ -340,7 +331,7 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
 
     Xv = X[:, verts]
     centres = np.empty((S, nf, 3))
-    for c in range(3):  # _group_mean per design
+    for c in range(3):  # the mean of each panel's corners, per design
         centres[:, :, c] = _bincount(face, Xv[:, :, c], nf)
     centres = centres / sizes[:, None]
     nodes = np.concatenate([X, centres], axis=1)

@@ -30,7 +30,11 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dpotrf, dpotrs
-from scipy.sparse import _sparsetools
+
+try:  # scipy's private csr loops (a fast path of _csr_times; scipy's @ where they are gone)
+    from scipy.sparse import _sparsetools
+except ImportError:  # pragma: no cover - depends on the scipy release
+    _sparsetools = None
 
 from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
@@ -345,7 +349,7 @@ def _csr_times(M, x: np.ndarray) -> np.ndarray:
     """``M @ x``; for a float csr matrix and a float (n,) or C-contiguous (n, k) ``x``, the
     sparsetools loop scipy's ``@`` runs (the same numbers) without its dispatch, which costs
     more than the loop at these sizes."""
-    if not (
+    if _sparsetools is None or not (
         isinstance(M, sp.csr_matrix) and M.dtype == np.float64 and isinstance(x, np.ndarray)
         and x.dtype == np.float64 and x.flags.c_contiguous and x.ndim in (1, 2)
         and x.shape[0] == M.shape[1]
