@@ -224,10 +224,7 @@ def _eval(node, frame) -> np.ndarray:
         parts = [_eval(a, frame) for a in node.args]
         func = np.logical_and if node.op == "&" else np.logical_or
         return func.reduce(parts)
-    values = [
-        np.asarray(frame[o.name], dtype=float) if isinstance(o, _Column) else o.value
-        for o in node.operands
-    ]
+    values = [_operand(o, frame) for o in node.operands]
     result = None
     for k, op in enumerate(node.ops):
         part = np.asarray(_OPS[op](values[k], values[k + 1]), dtype=bool)
@@ -251,16 +248,19 @@ def _pairs(node):
 
 
 def _pair_margin(a, op, b, frame) -> np.ndarray:
-    """Signed margin of ``a op b``, normalised by the threshold (>= 0 where it holds)."""
+    """Signed margin of ``a op b`` per row of ``frame``, normalised by the threshold (>= 0
+    where it holds); (len(frame),) even for a pair of two numbers (``1 < 2 < Zstiff``)."""
     va, vb = _operand(a, frame), _operand(b, frame)
     if op in ("==", "!="):
         holds = np.asarray(_OPS[op](va, vb), bool)
-        return np.where(holds, np.inf, -np.inf)
-    ref = vb if isinstance(b, _Number) or not isinstance(a, _Number) else va
-    scale = np.abs(np.asarray(ref, dtype=float))
-    scale = np.where(scale > 0, scale, 1.0)
-    diff = (va - vb) if op in (">", ">=") else (vb - va)
-    return np.asarray(diff / scale, dtype=float)
+        out = np.where(holds, np.inf, -np.inf)
+    else:
+        ref = vb if isinstance(b, _Number) or not isinstance(a, _Number) else va
+        scale = np.abs(np.asarray(ref, dtype=float))
+        scale = np.where(scale > 0, scale, 1.0)
+        diff = (va - vb) if op in (">", ">=") else (vb - va)
+        out = np.asarray(diff / scale, dtype=float)
+    return np.broadcast_to(out, (len(frame),))
 
 
 def _margin(node, frame) -> np.ndarray:

@@ -124,3 +124,14 @@ def test_published_target_fractions(reference_data):
     assert snap.sum() == 144
     np.testing.assert_array_equal(snap, parse_target("Zstiff < 5").evaluate(d3))
     assert parse_target("Zstiff > 300 & Xstiff > 150 & error < 0.06").evaluate(d3).sum() == 161
+
+
+def test_a_chain_with_two_numbers_side_by_side_has_a_margin_per_row():
+    # found by hypothesis: "1 < 1 < Zstiff" compares two numbers, a scalar among the rows
+    frame = pd.DataFrame({"Zstiff": [0.5, 2.0, 7.0]})
+    t = parse_target("0 < 1 < Zstiff", ["Zstiff"])
+    assert t.evaluate(frame).tolist() == [False, True, True]
+    np.testing.assert_allclose(t.margin(frame), [-0.5, 1.0, 1.0])  # min(1 / 1, (Z - 1) / 1)
+    never = parse_target("1 < 1 < Zstiff", ["Zstiff"])
+    assert never.evaluate(frame).tolist() == [False, False, False]
+    assert never.margin(frame).shape == (3,)
