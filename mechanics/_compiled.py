@@ -27,8 +27,12 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
+from holofold.mechanics._jit import OPTS as _OPTS
+from holofold.mechanics._spring_loop import spring_force_loop, spring_tangent_loop
+
 __all__ = [
     "bar_elements",
+    "spring_angles",
     "spring_elements",
     "gather",
     "assemble_batch",
@@ -40,7 +44,6 @@ __all__ = [
 ]
 
 _TWO_PI = 2.0 * math.pi
-_OPTS = dict(cache=True, nogil=True, error_model="numpy", boundscheck=False)
 
 
 @njit(**_OPTS)
@@ -123,66 +126,6 @@ def _cross3(a, b):
 
 
 @njit(inline="always", **_OPTS)
-def _lin3(a, x, b, y):
-    """``a x + b y`` for 3-vectors ``x``, ``y``."""
-    return (a * x[0] + b * y[0], a * x[1] + b * y[1], a * x[2] + b * y[2])
-
-
-@njit(inline="always", **_OPTS)
-def _comb3(c0, c1, c2, A, B, inv, x, y, z):
-    """``c x + c' y + c'' z`` with the coefficients ``((c + c1 A) + c2 B) inv`` of one row of
-    the derivatives of A and B (the numpy path's ``_TD`` tables, 0 terms kept)."""
-    k0 = ((c0[0] + c1[0] * A) + c2[0] * B) * inv
-    k1 = ((c0[1] + c1[1] * A) + c2[1] * B) * inv
-    k2 = ((c0[2] + c1[2] * A) + c2[2] * B) * inv
-    return (
-        (k0 * x[0] + k1 * y[0]) + k2 * z[0],
-        (k0 * x[1] + k1 * y[1]) + k2 * z[1],
-        (k0 * x[2] + k1 * y[2]) + k2 * z[2],
-    )
-
-
-@njit(inline="always", **_OPTS)
-def _outer(K, t, s, kk, scaled, u, v):
-    """Block ``t`` of spring ``s``: ``u v'`` (``scaled``: the factors carry sqrt(k)) or
-    ``kk (u v')``."""
-    for i in range(3):
-        for j in range(3):
-            K[i, j, t, s] = u[i] * v[j] if scaled else kk * (u[i] * v[j])
-
-
-@njit(inline="always", **_OPTS)
-def _hessian_ij(K, s, i, j, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B):
-    """Entry (i, j) of the Hessian blocks (Liu & Paulino 2017) times M added to blocks 0-5 and
-    7 of spring ``s``; returns the (i, j) entries of the jj and kk blocks before symmetrising."""
-    cm, cml, cn, cnl = c
-    S1 = m[i] * a1[j] + a1[i] * m[j]
-    S2 = m[i] * a2[j] + a2[i] * m[j]
-    S4 = n[i] * b1[j] + b1[i] * n[j]
-    S5 = n[i] * b2[j] + b2[i] * n[j]
-    O4 = m[i] * rkj[j]
-    O9 = n[i] * rkj[j]
-    H_ij = cm * (S1 - S2) - cml * O4
-    H_ik = cm * S2 + cml * O4
-    H_lj = cnl * O9 - cn * S5
-    H_lk = cn * (S5 - S4) - cnl * O9
-    K[i, j, 0, s] -= cm * S1
-    K[i, j, 1, s] += H_ij
-    K[i, j, 2, s] += H_ik
-    K[i, j, 3, s] += cn * S4
-    K[i, j, 4, s] += H_lj
-    K[i, j, 5, s] += H_lk
-    O10 = gs0[i] * dd[0][j]
-    O11 = gs3[i] * dd[2][j]
-    O12 = gs0[i] * dd[1][j]
-    O13 = gs3[i] * dd[3][j]
-    K[i, j, 7, s] += (A - 1.0) * H_ik - B * H_lk + (O12 - O13)
-    hjj = (A - 1.0) * H_ij - B * H_lj + (O10 - O11)
-    hkk = (B - 1.0) * H_lk - A * H_ik + (O13 - O12)
-    return hjj, hkk
-
-
-@njit(inline="always", **_OPTS)
 def _node(X, U, nd):
     return (X[nd, 0] + U[nd, 0], X[nd, 1] + U[nd, 1], X[nd, 2] + U[nd, 2])
 
@@ -193,18 +136,10 @@ def _sub3(a, b):
 
 
 @njit(**_OPTS)
-def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, theta):
-    """Springs of :func:`~holofold.mechanics.springs.spring_kernel` from nodal arrays.
-
-    ``X``, ``U`` (nn, 3); ``sT`` (4, ns) node quadruples (i, j, k, l); ``k``, ``theta0``
-    (ns,); ``k_nonneg``: every k >= 0 (the numpy path's branch). Writes ``energy`` (ns,),
-    ``force`` (3, 4, ns), ``theta`` (ns,) and, if ``tangent``, ``K`` (3, 3, 10, ns): the numpy
-    kernel's layouts (or any strided views with those indices). Small vectors are tuples and
-    every index a constant after inlining, so they live in registers (not in scratch arrays
-    that the compiler must reload after each store to ``K``).
-    """
-    ns = sT.shape[1]
-    for s in range(ns):
+def spring_angles(X, U, sT, theta):
+    """``theta`` (ns,): the dihedral angle of every spring, in [0, 2 pi) (scalar code: atan2
+    and the branches of ``np.mod`` do not vectorise)."""
+    for s in range(sT.shape[1]):
         P0 = _node(X, U, sT[0, s])
         P1 = _node(X, U, sT[1, s])
         P2 = _node(X, U, sT[2, s])
@@ -214,85 +149,27 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
         rkl = _sub3(P2, P3)
         m = _cross3(rij, rkj)
         n = _cross3(rkj, rkl)
-        dl2 = _dot3(rkj, rkj)
-        dmm = _dot3(m, m)
-        dnn = _dot3(n, n)
-        dA = _dot3(rij, rkj)
-        dB = _dot3(rkl, rkj)
-        dmkl = _dot3(m, rkl)
-        dmn = _dot3(m, n)
-        ell = math.sqrt(dl2)
-        th = _mod(math.atan2(ell * dmkl, dmn), _TWO_PI)
-        theta[s] = th
-        A = dA / dl2
-        B = dB / dl2
-        p = ell / dmm
-        q = ell / dnn
-        g0 = _lin3(p * (1.0 + 0.0 * A), m, q * (0.0 + 0.0 * B), n)
-        g1 = _lin3(p * (-1.0 + 1.0 * A), m, q * (0.0 + 1.0 * B), n)
-        g2 = _lin3(p * (0.0 + -1.0 * A), m, q * (1.0 + -1.0 * B), n)
-        g3 = _lin3(p * (0.0 + 0.0 * A), m, q * (-1.0 + 0.0 * B), n)
-        kk = k[s]
-        dth = th - theta0[s]
-        M = kk * dth
-        energy[s] = 0.5 * M * dth
-        for c in range(3):
-            force[c, 0, s] = M * g0[c]
-            force[c, 1, s] = M * g1[c]
-            force[c, 2, s] = M * g2[c]
-            force[c, 3, s] = M * g3[c]
-        if not tangent:
-            continue
-        # k g g' over the ten distinct blocks (0 ii, 1 ij, 2 ik, 3 ll, 4 lj, 5 lk, 6 jj, 7 jk,
-        # 8 kk, 9 il); k >= 0: sqrt(k) g_a sqrt(k) g_b' keeps the diagonal blocks symmetric
-        u0, u1, u2, u3 = g0, g1, g2, g3
-        if k_nonneg:
-            sk = math.sqrt(kk)
-            u0 = (sk * g0[0], sk * g0[1], sk * g0[2])
-            u1 = (sk * g1[0], sk * g1[1], sk * g1[2])
-            u2 = (sk * g2[0], sk * g2[1], sk * g2[2])
-            u3 = (sk * g3[0], sk * g3[1], sk * g3[2])
-        _outer(K, 0, s, kk, k_nonneg, u0, u0)
-        _outer(K, 1, s, kk, k_nonneg, u0, u1)
-        _outer(K, 2, s, kk, k_nonneg, u0, u2)
-        _outer(K, 3, s, kk, k_nonneg, u3, u3)
-        _outer(K, 4, s, kk, k_nonneg, u3, u1)
-        _outer(K, 5, s, kk, k_nonneg, u3, u2)
-        _outer(K, 6, s, kk, k_nonneg, u1, u1)
-        _outer(K, 7, s, kk, k_nonneg, u1, u2)
-        _outer(K, 8, s, kk, k_nonneg, u2, u2)
-        _outer(K, 9, s, kk, k_nonneg, u0, u3)
-        # Hessian (Liu & Paulino 2017) times M, in the numpy path's order of operations
-        inv = 1.0 / dl2
-        dd = (  # dA_j, dA_k, dB_j, dB_k as combinations of (r_ij, r_kj, r_kl)
-            _comb3((-1.0, -1.0, 0.0), (0.0, 2.0, 0.0), (0.0, 0.0, 0.0), A, B, inv, rij, rkj, rkl),
-            _comb3((1.0, 0.0, 0.0), (0.0, -2.0, 0.0), (0.0, 0.0, 0.0), A, B, inv, rij, rkj, rkl),
-            _comb3((0.0, 0.0, -1.0), (0.0, 0.0, 0.0), (0.0, 2.0, 0.0), A, B, inv, rij, rkj, rkl),
-            _comb3((0.0, 1.0, 1.0), (0.0, 0.0, 0.0), (0.0, -2.0, 0.0), A, B, inv, rij, rkj, rkl),
-        )
-        a1 = _cross3(rkj, m)
-        a2 = _cross3(rij, m)
-        b1 = _cross3(rkj, n)
-        b2 = _cross3(rkl, n)
-        gs0 = (g0[0] * M, g0[1] * M, g0[2] * M)
-        gs3 = (g3[0] * M, g3[1] * M, g3[2] * M)
-        c = (M * ell / (dmm * dmm), M / (dmm * ell), M * ell / (dnn * dnn), M / (dnn * ell))
-        j00, k00 = _hessian_ij(K, s, 0, 0, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j01, k01 = _hessian_ij(K, s, 0, 1, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j02, k02 = _hessian_ij(K, s, 0, 2, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j10, k10 = _hessian_ij(K, s, 1, 0, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j11, k11 = _hessian_ij(K, s, 1, 1, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j12, k12 = _hessian_ij(K, s, 1, 2, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j20, k20 = _hessian_ij(K, s, 2, 0, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j21, k21 = _hessian_ij(K, s, 2, 1, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        j22, k22 = _hessian_ij(K, s, 2, 2, m, n, rkj, a1, a2, b1, b2, gs0, gs3, dd, c, A, B)
-        # jj and kk blocks, made exactly symmetric as 0.5 (H + H')
-        hj = ((j00, j01, j02), (j10, j11, j12), (j20, j21, j22))
-        hk = ((k00, k01, k02), (k10, k11, k12), (k20, k21, k22))
-        for i in range(3):
-            for j in range(3):
-                K[i, j, 6, s] += 0.5 * (hj[i][j] + hj[j][i])
-                K[i, j, 8, s] += 0.5 * (hk[i][j] + hk[j][i])
+        ell = math.sqrt(_dot3(rkj, rkj))
+        theta[s] = _mod(math.atan2(ell * _dot3(m, rkl), _dot3(m, n)), _TWO_PI)
+
+
+@njit(**_OPTS)
+def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, theta):
+    """Springs of :func:`~holofold.mechanics.springs.spring_kernel` from nodal arrays.
+
+    ``X``, ``U`` (nn, 3); ``sT`` (4, ns) node quadruples (i, j, k, l); ``k``, ``theta0``
+    (ns,); ``k_nonneg``: every k >= 0 (the numpy path's branch). Writes ``energy`` (ns,),
+    ``force`` (3, 4, ns), ``theta`` (ns,) and, if ``tangent``, ``K`` (3, 3, 10, ns): the numpy
+    kernel's layouts (or any strided views with those indices; the outputs must not overlap
+    each other or the inputs). The angles first (:func:`spring_angles`, scalar), then one
+    branch-free loop over the springs (:mod:`~holofold.mechanics._spring_loop`), which runs
+    vectorised across springs where the outputs are the kernels' contiguous layouts.
+    """
+    spring_angles(X, U, sT, theta)
+    if tangent:
+        spring_tangent_loop(X, U, sT, k, theta0, k_nonneg, energy, force, K, theta)
+    else:
+        spring_force_loop(X, U, sT, k, theta0, energy, force, theta)
 
 
 @njit(**_OPTS)

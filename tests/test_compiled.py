@@ -28,18 +28,31 @@ def _random_model(seed, nn=40, ns=70, nb=110, negative_k=False):
     return X, U, np.ascontiguousarray(sT), k, th0, bars, L0, EA
 
 
+@pytest.mark.parametrize("element_major", [False, True])
 @pytest.mark.parametrize("negative_k", [False, True])
 @pytest.mark.parametrize("tangent", [True, False])
-def test_spring_kernel_is_the_numpy_one_bit_for_bit(negative_k, tangent):
+def test_spring_kernel_is_the_numpy_one_bit_for_bit(negative_k, tangent, element_major):
+    # 70 springs: the vectorised loop's remainder runs too; element-major outputs are strided
     X, U, sT, k, th0, *_ = _random_model(1, negative_k=negative_k)
     ref, theta = spring_kernel((X + U).T[:, sT], k, th0, tangent=tangent)
     ns = sT.shape[1]
     e, f, K, t = np.empty(ns), np.empty((3, 4, ns)), np.empty((3, 3, 10, ns)), np.empty(ns)
+    if element_major:
+        f = np.empty((ns, 4, 3)).transpose(2, 1, 0)
+        K = np.empty((ns, 10, 3, 3)).transpose(2, 3, 1, 0)
     _compiled.spring_elements(X, U, sT, k, th0, bool((k >= 0).all()), tangent, e, f, K, t)
     assert np.array_equal(e, ref.energy) and np.array_equal(f, ref.force)
     assert np.array_equal(t, theta)
     if tangent:
         assert np.array_equal(K, ref.tangent)
+
+
+def test_generated_spring_loop_is_current():
+    """mechanics/_spring_loop.py is what its generator writes (regenerate with
+    ``python -m holofold.mechanics._spring_codegen``)."""
+    from holofold.mechanics import _spring_codegen
+
+    assert _spring_codegen.TARGET.read_text() == _spring_codegen.source()
 
 
 def test_bar_kernel_is_the_numpy_one_bit_for_bit():
