@@ -3,27 +3,30 @@
 For each workload the table gives the time per sample (min and median of ``--repeat`` runs,
 BLAS limited to one thread; CPU time of this thread, which a busy machine disturbs far less
 than the wall clock, and the wall-clock median) and its floor measured in the same run, in the
-same CPU time:
+same CPU time, the two interleaved (each round: one run alone, one batch, one timing of every
+factorisation path of every captured tangent), so that a machine whose speed drifts with
+other jobs slows the workload and its floor alike:
 
     floor = sum over the Newton iterations of (cheapest factorisation + solve of the tangent)
 
 The tangents are the actual ones: every ``Assembler.evaluate_factorized`` call of one sample
-(and every compiled Newton step, ``Assembler.dense_stepper`` and ``BatchAssembler.newton_step``)
-is counted and every ``--every``-th free-free tangent captured; each captured tangent is
-factorised and solved (one right-hand side) by every applicable LAPACK/SuperLU path called
-directly (dense Cholesky dpotrf/dpotrs, dense LU dgetrf/dgetrs, banded Cholesky dpbtrf/dpbtrs
-on the reverse Cuthill-McKee ordering, SuperLU with the cached minimum-degree ordering), the
-best of 5 timings each. A structure's floor per iteration is the cheapest path's best timing
-over its captured tangents (one size and sparsity: a busy machine only adds to a timing), so
-a sample's floor is sum(iterations x that cost). ``solver``
-names the path the assembler takes; the gripper row also gives the floor with the solver it
-uses. ``batch ms`` is the time per design of a batch of 16 copies of the design (4 for the
-canopy) through ``scenario.evaluate_batch``, the path the runner takes for databases, and
-``batch/floor`` its ratio, the one the targets are read against where it exists. The
-database row runs ``evaluate_designs`` on the 3000 published arch rows (data3) on 2
-worker processes (wall clock, and the CPU time of the workers / 2, which other jobs on the
-machine disturb less) and prints the floor beside it (per-row floors of 60 rows spread over
-the file, scaled to 3000 rows and divided by the 2 cores).
+(and every compiled Newton step, ``Assembler.dense_stepper`` and
+``BatchAssembler.newton_step``) is counted and every ``--every``-th free-free tangent
+captured; each captured tangent is factorised and solved (one right-hand side) by every
+applicable LAPACK/SuperLU path called directly (dense Cholesky dpotrf/dpotrs, dense LU
+dgetrf/dgetrs, banded Cholesky dpbtrf/dpbtrs on the reverse Cuthill-McKee ordering, SuperLU
+with the cached minimum-degree ordering), the best of the rounds' timings each. A
+structure's floor per iteration is the cheapest path's best timing over its captured
+tangents (one size and sparsity: a busy machine only adds to a timing), so a sample's floor
+is sum(iterations x that cost). ``solver`` names the path the assembler takes; the gripper
+row also gives the floor with the solver it uses. ``batch ms`` is the time per design of a
+batch of 16 copies of the design (4 for the canopy) through ``scenario.evaluate_batch``, the
+path the runner takes for databases, and ``batch/floor`` its ratio, the one the targets are
+read against where it exists. The database row runs ``evaluate_designs`` on the 3000
+published arch rows (data3) on 2 worker processes (wall clock, and the CPU time of the
+workers / 2, which other jobs on the machine disturb less) and prints the floor beside it
+(per-row floors of 120 rows spread over the file, scaled to 3000 rows and divided by the 2
+cores).
 
     python benchmarks/bench_floor.py [--repeat 7] [--no-db] [--only arch]
 """
@@ -211,8 +214,9 @@ def _best(fn, n: int = 5) -> float:
     return min(ts)
 
 
-def path_costs(K: sp.csr_matrix, red) -> dict:
-    """Seconds for factorisation + one solve of ``K`` by every applicable path."""
+def path_costs(K: sp.csr_matrix, red, n: int = 5) -> dict:
+    """Seconds for factorisation + one solve of ``K`` by every applicable path (best of ``n``
+    timings each)."""
     nf = K.shape[0]
     b = np.ones(nf)
     out = {}
@@ -231,10 +235,10 @@ def path_costs(K: sp.csr_matrix, red) -> dict:
 
         try:
             chol()
-            out["dense Cholesky"] = _best(chol)
+            out["dense Cholesky"] = _best(chol, n)
         except np.linalg.LinAlgError:
             pass
-        out["dense LU"] = _best(lu)
+        out["dense LU"] = _best(lu, n)
     perm, bw, _, _ = red.banded
     if nf * (bw + 1) ** 2 <= 2e10:
         Kp = K[perm][:, perm].tocoo()
@@ -250,7 +254,7 @@ def path_costs(K: sp.csr_matrix, red) -> dict:
 
         try:
             band()
-            out["banded Cholesky"] = _best(band)
+            out["banded Cholesky"] = _best(band, n)
         except np.linalg.LinAlgError:
             pass
     order = red.ordering[0]
@@ -261,7 +265,7 @@ def path_costs(K: sp.csr_matrix, red) -> dict:
                         panel_size=10, options={"SymmetricMode": True})  # fmt: skip
         lu_.solve(b)
 
-    out["SuperLU"] = _best(slu)
+    out["SuperLU"] = _best(slu, n)
     return out
 
 
@@ -280,36 +284,49 @@ def _old_path(red) -> str:  # the code before issue 14 had no assembly.solver_pa
     return "banded Cholesky" if nf * (bw + 1) ** 2 <= assembly.BANDED_MAX_WORK else "SuperLU"
 
 
-def floor_of(fn, every: int = 4):
+class Floor:
+    """The floor of one call of ``fn``: its tangents captured once (:class:`Capture`), their
+    factorisations timed in rounds (:meth:`round`, one timing per path and tangent each) that
+    can be interleaved with the workload's own runs, so that both meet the same machine."""
+
+    def __init__(self, fn, every: int = 4):
+        with Capture(every) as cap:
+            fn()
+        self.cases = [  # (iterations, tangents, reduction) per structure
+            (n, cap.K[key], cap.red[key]) for key, n in cap.calls.items()
+        ]
+        self.best: list[list[dict]] = [[{} for _ in Ks] for _, Ks, _ in self.cases]
+
+    def round(self) -> None:
+        """Time every path of every captured tangent once more, keeping the best."""
+        for (_, Ks, red), best in zip(self.cases, self.best, strict=True):
+            for K, b in zip(Ks, best, strict=True):
+                for path, t in path_costs(K, red, n=1).items():
+                    b[path] = min(t, b.get(path, np.inf))
+
+    def totals(self):
+        """(iterations, floor s, floor s with the assembler's own path, paths used)."""
+        iters = total = used_total = 0.0
+        used = set()
+        for (n, _, red), costs in zip(self.cases, self.best, strict=True):
+            # the tangents of one structure have one size and sparsity: the best timing of
+            # any is the least disturbed estimate of the cost of each (a busy machine only adds)
+            best = min(min(c.values()) for c in costs)
+            path = solver_path(red)
+            used.add(path)
+            mine = min(c.get(path, min(c.values())) for c in costs)
+            iters += n
+            total += n * best
+            used_total += n * mine
+        return int(iters), total, used_total, used
+
+
+def floor_of(fn, every: int = 4, rounds: int = 5):
     """(iterations, floor s, floor s with the assembler's own path, paths used) of one call."""
-    with Capture(every) as cap:
-        fn()
-    iters = total = used_total = 0.0
-    used = set()
-    for key, n in cap.calls.items():
-        costs = [path_costs(K, cap.red[key]) for K in cap.K[key]]
-        # the tangents of one structure have one size and sparsity: the best timing of any
-        # is the least disturbed estimate of the cost of each (a busy machine only adds)
-        best = min(min(c.values()) for c in costs)
-        path = solver_path(cap.red[key])
-        used.add(path)
-        mine = min(c.get(path, min(c.values())) for c in costs)
-        iters += n
-        total += n * best
-        used_total += n * mine
-    return int(iters), total, used_total, used
-
-
-def timed(fn, repeat: int) -> tuple[float, float, float]:
-    """(min CPU, median CPU, median wall) seconds of ``repeat`` calls after a warm-up."""
-    fn()  # warm-up: topology, sparse pattern and compiled-kernel caches
-    cpu, wall = [], []
-    for _ in range(repeat):
-        t, w = clock(), time.perf_counter()
-        fn()
-        cpu.append(clock() - t)
-        wall.append(time.perf_counter() - w)
-    return min(cpu), statistics.median(cpu), statistics.median(wall)
+    floor = Floor(fn, every)
+    for _ in range(rounds):
+        floor.round()
+    return floor.totals()
 
 
 def _workers_cpu() -> float:
@@ -381,16 +398,33 @@ def main(argv=None) -> int:
         for name, fn in workloads().items():
             if args.only not in name:
                 continue
-            tmin, tmed, wall = timed(fn, args.repeat)
-            iters, floor, used_floor, used = floor_of(fn)
+            # single runs, batch runs and floor rounds interleaved: a machine whose speed
+            # drifts (other jobs) slows all three alike, and each keeps its best
+            fn()  # warm-up: topology, sparse pattern and compiled-kernel caches
+            floor_run = Floor(fn)
+            bfn = batched[name][1] if name in batched else None
+            if bfn is not None:
+                bfn()
+            cpu, wall, tbs = [], [], []
+            for _ in range(args.repeat):
+                t, w = clock(), time.perf_counter()
+                fn()
+                cpu.append(clock() - t)
+                wall.append(time.perf_counter() - w)
+                if bfn is not None:
+                    t = clock()
+                    bfn()
+                    tbs.append(clock() - t)
+                floor_run.round()
+            tmin, tmed, wall = min(cpu), statistics.median(cpu), statistics.median(wall)
+            iters, floor, used_floor, used = floor_run.totals()
             extra = ""
             if name in OWN_SOLVER_FLOOR:  # the target is against the solver it keeps
                 extra = f" (cheapest path: {1e3 * floor:.2f} ms)"
                 floor = used_floor
             bms, bratio = "-", "-"
-            if name in batched:
-                n, bfn = batched[name]
-                tb = timed(bfn, max(3, args.repeat // 2))[0] / n
+            if bfn is not None:
+                tb = min(tbs) / batched[name][0]
                 bms, bratio = f"{1e3 * tb:.2f}", f"{tb / floor:.1f}"
             paths = ", ".join(sorted(used))
             print(
