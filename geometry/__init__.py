@@ -30,7 +30,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "clearance": ["Printability", "printability", "panel_overlap", "panel_clearance"],
         "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],
-        "miura": ["miura_cell", "miura_sheet", "miura_sheet_paper", "miura_nodes", "miura_faces"],
+        "miura": [
+            "miura_cell",
+            "miura_sheet",
+            "miura_sheet_paper",
+            "miura_nodes",
+            "miura_nodes_batch",
+            "miura_faces",
+        ],
         "outputs": ["check_output_path", "atomic_write", "write_text", "write_json"],
         "pattern": ["CreasePattern", "ASSIGNMENTS", "MAX_PANELS", "non_simple_faces"],
         "printable": [

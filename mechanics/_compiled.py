@@ -21,6 +21,7 @@ numba compiles on first use and caches the machine code next to this file (or un
 from __future__ import annotations
 
 import math
+from functools import cache
 
 import numpy as np
 from llvmlite import ir
@@ -262,6 +263,11 @@ def _fcall(typingctx, addr, args):
 
 def lapack_addresses(*names: str) -> np.ndarray:
     """Addresses of scipy's LAPACK routines ``names`` (e.g. ``"dpbtrf", "dpbtrs"``)."""
+    return _addresses(names).copy()
+
+
+@cache
+def _addresses(names: tuple[str, ...]) -> np.ndarray:
     from numba.extending import get_cython_function_address
 
     return np.array(

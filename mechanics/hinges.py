@@ -35,6 +35,7 @@ from holofold.mechanics.structure import (
     CreaseModel,
     SpringRole,
     Structure,
+    trusted_structure,
 )
 
 __all__ = [
@@ -66,22 +67,31 @@ def orient_springs(
     ``z_only=False`` a spring whose z component vanishes (relative 1e-12) is judged by the y,
     then the x component instead. ``where`` (ns,) bool limits it to some springs.
     """
-    springs = np.array(springs, dtype=np.intp, copy=True)
+    x = np.asarray(x, float)
+    return _orient_batch(x[None], springs, z_only, where)[0]
+
+
+def _orient_batch(x: np.ndarray, springs, z_only: bool, where=None) -> np.ndarray:
+    """:func:`orient_springs` of S designs of one connectivity: ``x`` (S, nn, 3), ``springs``
+    (ns, 4) -> (S, ns, 4), each design's the one :func:`orient_springs` gives it."""
+    springs = np.asarray(springs, dtype=np.intp)
+    S = x.shape[0]
     if len(springs) == 0:
-        return springs
-    v = _cross(x[springs[:, 1]] - x[springs[:, 0]], x[springs[:, 2]] - x[springs[:, 1]])
+        return np.zeros((S, 0, 4), np.intp)
+    v = _cross(x[:, springs[:, 1]] - x[:, springs[:, 0]], x[:, springs[:, 2]] - x[:, springs[:, 1]])
     if z_only:
-        comp = v[:, 2]
+        comp = v[..., 2]
     else:
-        tiny = 1e-12 * np.linalg.norm(v, axis=1)
-        comp = np.where(
-            np.abs(v[:, 2]) > tiny, v[:, 2], np.where(np.abs(v[:, 1]) > tiny, v[:, 1], v[:, 0])
-        )
+        tiny = 1e-12 * np.linalg.norm(v, axis=-1)
+        vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+        comp = np.where(np.abs(vz) > tiny, vz, np.where(np.abs(vy) > tiny, vy, vx))
     swap = comp > 0
     if where is not None:
         swap &= np.asarray(where, bool)
-    springs[swap, 0], springs[swap, 3] = springs[swap, 3], springs[swap, 0].copy()
-    return springs
+    out = np.repeat(springs[None], S, axis=0)
+    out[..., 0] = np.where(swap, springs[:, 3], springs[:, 0])
+    out[..., 3] = np.where(swap, springs[:, 0], springs[:, 3])
+    return out
 
 
 def _per_item(value, n: int, name: str, where: np.ndarray | None = None) -> np.ndarray:
@@ -373,36 +383,52 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
     crease_of = np.concatenate([cid, np.full(len(panel), -1)])
 
     # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1)
-    triangles = np.column_stack([cnode, verts, verts[prv]])
+    triangles = np.column_stack([cnode, verts, verts[prv]]).astype(np.intp)
+
+    # the checks Structure makes that a valid input can still fail (coordinates that overflow,
+    # coincident nodes), once for the batch: the first design refused raises Structure's error
+    bad_x = ~np.isfinite(nodes).all(axis=(1, 2))
+    bad = np.flatnonzero(bad_x | ~(L > 0).all(axis=1))
+    if bad.size:
+        i = bad[0]
+        if bad_x[i]:
+            raise ValueError("nodes contain non-finite coordinates")
+        raise ValueError(f"bar {int(np.argmin(L[i]))} has zero rest length")
+    nn = nodes.shape[1]
+    # per design: spring polarity from its geometry and its rest angles, for all at once
+    springs_all = _orient_batch(nodes, quads, profile.polarity_z_only)
+    rest_all = dihedral_angle(nodes, springs_all)
+    bars = bars.astype(np.intp)
+    crease_of = crease_of.astype(np.intp)
+    creases = CreaseModel(kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=e)
+    shared = dict(
+        bars=bars, bar_type=bar_type.astype(np.int8), spring_role=role.astype(np.int8),
+        spring_crease=crease_of,
+        triangles=triangles, tri_crease=np.full(len(triangles), -1, np.intp),
+        tri_panel=face.astype(np.intp), creases=creases,
+        panel_centres=(nv + np.arange(nf)).astype(np.intp),
+        node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]).astype(np.intp),
+        profile=profile,
+    )  # fmt: skip
     out = []
     for i in range(S):
-        springs = orient_springs(nodes[i], quads, z_only=profile.polarity_z_only)
         pw = None if panel_width is None else panel_width[i]
         w = _panel_width(profile, pw, W[i], interior, nf, spoke_len[i], face)
+        sup = np.zeros((nn, 3), bool) if sups[i] is None else np.asarray(sups[i], bool)
+        if sup.shape != (nn, 3):
+            raise ValueError(f"supports must have shape ({nn}, 3), got {sup.shape}")
         out.append(
-            Structure(
+            trusted_structure(  # the arrays are valid by construction (checked above)
                 nodes=nodes[i],
-                bars=bars,
                 bar_area=bar_area[i],
                 bar_E=np.full(len(bars), E_panel[i]),
                 bar_length=L[i],
-                bar_type=bar_type,
-                springs=springs,
+                springs=springs_all[i],
                 spring_k=np.concatenate([k_hinge[i], k_panel[i] / (12.0 * w)]),
-                spring_rest=dihedral_angle(nodes[i], springs),
-                spring_role=role,
-                spring_crease=crease_of,
-                triangles=triangles,
+                spring_rest=rest_all[i],
                 tri_thickness=tp[i, face],
-                tri_crease=np.full(len(triangles), -1),
-                tri_panel=face,
-                supports=sups[i],
-                creases=CreaseModel(
-                    kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=e
-                ),
-                panel_centres=nv + np.arange(nf),
-                node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]),
-                profile=profile,
+                supports=sup,
+                **shared,
             )
         )
     return out

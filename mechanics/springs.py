@@ -89,9 +89,14 @@ def _cross(a, b):
 
 
 def _gather(x, springs):
-    """(..., nn, 3) coordinates -> (..., 3, 4, ns) node positions [component, node, spring]."""
+    """(..., nn, 3) coordinates -> (..., 3, 4, ns) node positions [component, node, spring];
+    ``springs`` (ns, 4), or (S, ns, 4) for ``x`` (S, nn, 3): one connectivity per design."""
     xT = np.swapaxes(np.asarray(x, float), -1, -2)
-    return xT[..., np.asarray(springs).T]
+    springs = np.asarray(springs)
+    if springs.ndim == 3:
+        idx = np.swapaxes(springs, -1, -2)[:, None]  # (S, 1, 4, ns)
+        return np.take_along_axis(xT[:, :, None, :], idx, axis=-1)
+    return xT[..., springs.T]
 
 
 def _banks(P):
@@ -122,7 +127,8 @@ def dihedral_angle(x, springs, *, form: str = "atan2") -> np.ndarray:
     x : (..., nn, 3) float
         Current nodal coordinates, m.
     springs : (ns, 4) int
-        Node quadruples (i, j, k, l), hinge j-k.
+        Node quadruples (i, j, k, l), hinge j-k; or (S, ns, 4), one set per design of ``x``
+        (S, nn, 3).
     form : {"atan2", "acos"}
         ``"atan2"`` (default, accurate near flat) or the reference's clamped arccos form.
 

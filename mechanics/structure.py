@@ -315,6 +315,19 @@ class Structure:
         return replace(self, **changes)
 
 
+def trusted_structure(**fields) -> Structure:
+    """A :class:`Structure` from arrays already in the form its checks leave them in (every
+    field given: nodes float (nn, 3), index arrays intp, ``bar_type`` and ``spring_role``
+    int8, per-element values float of full length, ``supports`` bool (nn, 3)), built without
+    those checks. For the model builders of :mod:`~holofold.mechanics.hinges`, whose arrays
+    are valid by construction (tests/test_hinges.py checks the two constructions agree);
+    anything else goes through ``Structure(...)``."""
+    st = object.__new__(Structure)
+    for name in Structure.__dataclass_fields__:
+        object.__setattr__(st, name, fields[name])
+    return st
+
+
 _AXIS = {"x": 0, "y": 1, "z": 2}
 
 

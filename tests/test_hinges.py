@@ -22,7 +22,7 @@ from holofold.mechanics.hinges import (
 )
 from holofold.mechanics.solvers import solve_newton
 from holofold.mechanics.springs import dihedral_angle
-from holofold.mechanics.structure import SpringRole, support_mask
+from holofold.mechanics.structure import SpringRole, Structure, support_mask
 
 MAT = dict(E_panel=2e9, E_crease=2e9, nu_panel=0.3, nu_crease=0.3)
 
@@ -384,6 +384,7 @@ def test_batch_build_is_each_designs_own(profile):
     rng = np.random.default_rng(3)
     S = 5
     X = pat.coords[None] + 1e-3 * rng.standard_normal((S, pat.n_vertices, 3))
+    X[1, :, 0] *= -1.0  # mirrored: the polarity rule orients its springs the other way
     W, tc, tp = rng.uniform(1e-3, 4e-3, S), rng.uniform(5e-4, 1e-3, S), rng.uniform(1e-3, 6e-3, S)
     E = rng.uniform(1e9, 3e9, S)
     sups = [support_mask(pat.n_vertices + pat.n_faces, [0, i + 1]) for i in range(S)]
@@ -401,3 +402,29 @@ def test_batch_build_is_each_designs_own(profile):
         build_concentrated_batch(
             pat, X, crease_width=np.r_[W[:-1], -1.0], crease_thickness=tc, panel_thickness=tp
         )
+    # the builders skip Structure's checks (trusted_structure): the same arrays, dtypes and all
+    for s in batch:
+        fields = {f.name: getattr(s, f.name) for f in dataclasses.fields(s)}
+        checked = Structure(**fields)
+        assert _same_structure(checked, s)
+        for f in dataclasses.fields(s):
+            x = getattr(s, f.name)
+            if isinstance(x, np.ndarray):
+                assert x.dtype == getattr(checked, f.name).dtype, f.name
+    assert any((b.springs != batch[0].springs).any() for b in batch)  # polarity per design
+
+
+def test_batch_build_keeps_structures_checks():
+    """What Structure refused (coincident nodes, coordinates whose panel centres overflow) the
+    batch builder refuses with the same message, for the first design that has it."""
+    pat = miura_sheet_paper(2, 2, 0.04, 1.1, 0.7)
+    X = np.repeat(pat.coords[None], 3, axis=0)
+    X[2, 1] = X[2, 0]  # design 2: a zero-length bar
+    X[1] = 1.5e308  # design 1: finite corners, infinite centres
+    kw = dict(crease_width=2e-3, crease_thickness=5e-4, panel_thickness=3e-3)
+    with pytest.raises(ValueError, match="non-finite coordinates"), np.errstate(all="ignore"):
+        build_concentrated_batch(pat, X, **kw)
+    with pytest.raises(ValueError, match="bar 0 has zero rest length"):
+        build_concentrated_batch(pat, X[[0, 2]], **kw)
+    with pytest.raises(ValueError, match="zero rest length"):
+        build_concentrated(pat, coords=X[2], **kw)
