@@ -1024,9 +1024,11 @@ class BatchAssembler:
 
         Returns
         -------
-        dict
-            Sample -> its increment ``dU`` (nf,) on :attr:`free_dofs`, or the
-            :class:`SingularSystemError` that stopped it (its U is left alone).
+        dU : (S, nf) float
+            Row s: the increment of active sample s on :attr:`free_dofs` (rows of inactive
+            or failed samples are undefined).
+        errors : dict
+            Sample -> the :class:`SingularSystemError` that stopped it (its U is left alone).
         """
         ck = _ck()
         if U.dtype != float or not U.flags.c_contiguous or U.shape != (self.n, self.n_dof):
@@ -1034,7 +1036,8 @@ class BatchAssembler:
         active = np.ascontiguousarray(active, dtype=bool)
         U3 = U.reshape(self.n, -1, 3)
         Fi = np.ascontiguousarray(rhs_force, dtype=float)
-        out: dict = {}
+        dU_all = np.empty((self.n, self.free_dofs.size))
+        errors: dict = {}
         rest = active.copy()
         if not any(self._arccos):
             for pat, red, members in self.groups:
@@ -1070,14 +1073,15 @@ class BatchAssembler:
                         dU, info, dU,
                     )  # fmt: skip
                     lu_below = False  # singular
-                for j, s in enumerate(idx):
+                dU_all[idx] = dU
+                rest[idx] = False
+                for j in np.flatnonzero(info):  # the failed samples only
                     if info[j] == 1 and lu_below:
-                        continue
-                    rest[s] = False
-                    out[s] = (
-                        dU[j] if info[j] == 0
-                        else SingularSystemError(_SINGULAR if info[j] == 1 else _NON_FINITE)
-                    )  # fmt: skip
+                        rest[idx[j]] = True
+                    else:
+                        errors[int(idx[j])] = SingularSystemError(
+                            _SINGULAR if info[j] == 1 else _NON_FINITE
+                        )
         if rest.any():
             f, solves = self.factorized(U3, rest)
             free = self.free_dofs
@@ -1087,11 +1091,11 @@ class BatchAssembler:
                         raise solves[s]
                     dU_s = solves[s]((Fi[s] - f[s])[free])
                 except SingularSystemError as exc:
-                    out[s] = exc
+                    errors[int(s)] = exc
                     continue
                 U[s, free] += dU_s
-                out[s] = dU_s
-        return out
+                dU_all[s] = dU_s
+        return dU_all, errors
 
     def _solver(self, s, path, red, values, U, rest):
         """The solver of sample ``s`` from its dense block, band or CSR data ``values``

@@ -59,6 +59,17 @@ def _truss(k_spring, n=5, supported=1):
     )  # fmt: skip
 
 
+def test_vecdot_is_the_dot_solve_newton_takes_bit_for_bit():
+    """solve_newton_batch takes every sample's ||dU|| from one np.vecdot; solve_newton from
+    dU @ dU. Both are numpy's BLAS dot: the same bits, at the sizes the models have."""
+    rng = np.random.default_rng(5)
+    for n in (1, 7, 30, 99, 231, 711, 2700):
+        A = rng.standard_normal((16, n)) * 10.0 ** rng.uniform(-12, 2, (16, 1))
+        rows = A[[0, 3, 4, 9, 15]]  # a selection, as the batch takes its active samples
+        v = np.sqrt(np.vecdot(rows, rows))
+        assert [float(x) for x in v] == [float(np.sqrt(r @ r)) for r in rows]
+
+
 def test_newton_batch_keeps_failures_and_stalls_per_design():
     ok = _truss(1.0, supported=2)
     stiff = _truss(2.0, supported=2)

@@ -167,16 +167,17 @@ def solve_newton_batch(
             it = alive & (step < max_iter) & (R > tol)
             if not it.any():
                 break
-            steps = B.newton_step(U, Fi, it)  # U[s, free] += dU for every solved sample
-            for s in np.flatnonzero(it):
-                dU = steps[s]
-                if isinstance(dU, SingularSystemError):
-                    hists[s].failure = f"increment {i}, iteration {step[s]}: {dU}"
-                    hists[s].record(U[s], i, False, step[s] - 1, R[s])
-                    alive[s] = False
-                    continue
-                R[s] = float(np.sqrt(dU @ dU))
-                step[s] += 1
+            dU, errors = B.newton_step(U, Fi, it)  # U[s, free] += dU[s] where solved
+            for s, exc in errors.items():
+                hists[s].failure = f"increment {i}, iteration {step[s]}: {exc}"
+                hists[s].record(U[s], i, False, step[s] - 1, R[s])
+                alive[s] = False
+                it[s] = False
+            # ||dU|| of each solved sample: vecdot is dU[s] @ dU[s] (numpy's BLAS dot) bit for
+            # bit, as solve_newton computes it (tests/test_batch.py)
+            ok = np.flatnonzero(it)
+            R[ok] = np.sqrt(np.vecdot(dU[ok], dU[ok]))
+            step[ok] += 1
         for s in np.flatnonzero(alive):
             hists[s].record(U[s], i, R[s] <= tol, step[s] - 1, R[s])
     return [
