@@ -111,24 +111,41 @@ def _gather_lists(families, n: int, dest=None):
 
 
 #: memory of the batch path's element arrays, as the shape of one element's entries and the
-#: axes that turn ``(n, *shape)`` into the kernels' layouts. Bars are element-major, bar force
-#: (nb, 2, 3) -> (3, 2, nb) and bar tangent (nb, 2, 2, 3, 3) -> (3, 3, 2, 2, nb): one bar's
-#: entries are contiguous, so a gather target's sources (bars sharing its DOFs) lie close.
-#: Springs keep the kernels' own layouts, force (3, 4, ns) and tangent (3, 3, 10, ns) (axes
-#: None): each entry is a contiguous row over the springs, which lets the compiled spring loop
-#: run vectorised across springs (``_spring_loop``; about 2x faster than element-major memory).
+#: axes that turn ``(n, *shape)`` into the kernels' layouts (None: already that layout). Bars
+#: are element-major, bar force (nb, 2, 3) -> (3, 2, nb) and bar tangent (nb, 2, 2, 3, 3) ->
+#: (3, 3, 2, 2, nb): one bar's entries are contiguous, so a gather target's sources (bars
+#: sharing its DOFs) lie close. Springs, up to :data:`SPRING_ROWS_MAX`, keep the kernels' own
+#: layouts, force (3, 4, ns) and tangent (3, 3, 10, ns): each entry is a contiguous row over
+#: the springs, which lets the compiled spring loop run vectorised (``_spring_loop``). Beyond,
+#: the tangent rows outgrow the cache the gathers read them from, and springs are
+#: element-major too, force (ns, 4, 3) and tangent (ns, 10, 3, 3).
 _SCRATCH_LAYOUT = {
     "bar_force": ((2, 3), (2, 1, 0)),
     "bar_tangent": ((2, 2, 3, 3), (3, 4, 1, 2, 0)),
     "spring_force": ((3, 4), None),
     "spring_tangent": ((3, 3, 10), None),
+    "spring_force_em": ((4, 3), (2, 1, 0)),
+    "spring_tangent_em": ((10, 3, 3), (2, 3, 1, 0)),
 }
+
+#: most springs kept in rows (vectorised kernel) in the batch memory. Measured with the
+#: kernels and the band gather of one step (benchmarks/bench_scratch_layout.py): rows take
+#: 0.79-0.89 of the element-major time from 174 to 1120 springs (arch m = 8 to 24, Miura
+#: sheets 12 x 4 to 24 x 8) and 1.40 of it at 2544 (36 x 12), whose tangent rows fill 1.8 MB
+SPRING_ROWS_MAX = 1500
+
+
+def _layout(kind: str, n: int) -> tuple:
+    """(shape, axes) of ``kind`` for ``n`` elements of that family."""
+    if kind.startswith("spring") and n > SPRING_ROWS_MAX:
+        kind += "_em"
+    return _SCRATCH_LAYOUT[kind]
 
 
 def _scratch_view(flat: np.ndarray, n: int, kind: str) -> np.ndarray:
     """``flat`` (the batch memory of ``n`` elements, :data:`_SCRATCH_LAYOUT`) viewed in the
     kernel layout."""
-    shape, axes = _SCRATCH_LAYOUT[kind]
+    shape, axes = _layout(kind, n)
     if axes is None:
         return flat.reshape(*shape, n)
     return flat.reshape(n, *shape).transpose(axes)
@@ -142,7 +159,7 @@ def _scratch_lists(lists, nb: int, ns: int, tangent: bool):
     kinds = ("bar_tangent", "spring_tangent") if tangent else ("bar_force", "spring_force")
     maps = []
     for kind, n in zip(kinds, (nb, ns), strict=True):
-        shape, axes = _SCRATCH_LAYOUT[kind]
+        shape, axes = _layout(kind, n)
         where = np.arange(n * int(np.prod(shape)))
         maps.append(where if axes is None else where.reshape(n, *shape).transpose(axes).ravel())
     mb, ms = maps
