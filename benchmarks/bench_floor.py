@@ -3,11 +3,19 @@
 For each workload the table gives the time per sample (min and median of ``--repeat`` runs,
 BLAS limited to one thread; CPU time of this thread, which a busy machine disturbs far less
 than the wall clock, and the wall-clock median) and its floor measured in the same run, in the
-same CPU time, the two interleaved (each round: one run alone, one batch, one timing of every
-factorisation path of every captured tangent), so that a machine whose speed drifts with
-other jobs slows the workload and its floor alike:
+same CPU time, the two interleaved (each round: one run alone, one batch, one run of the
+floor's computation), so that a machine whose speed drifts with other jobs slows the workload
+and its floor alike:
 
     floor = sum over the Newton iterations of (cheapest factorisation + solve of the tangent)
+
+``run ms`` times that computation itself as one run per round (as many samples' worth as the
+batch holds, each captured tangent for its share of the iterations), the best round. A run
+as long as the workload's meets the same share of other jobs, where the best of many short
+timings (``floor ms``, the one the ratios use) catches the gaps between them. In the calmest
+runs on this project's shared 2-core machine the two agreed within 10 %; in busy ones the
+run took up to 60 % longer, a measure of how much the workload's own times (and so the
+ratios) are inflated then.
 
 The tangents are the actual ones: every ``Assembler.evaluate_factorized`` call of one sample
 (and every compiled Newton step, ``Assembler.dense_stepper`` and
@@ -217,6 +225,12 @@ def _best(fn, n: int = 5) -> float:
 def path_costs(K: sp.csr_matrix, red, n: int = 5) -> dict:
     """Seconds for factorisation + one solve of ``K`` by every applicable path (best of ``n``
     timings each)."""
+    return {path: _best(fn, n) for path, fn in path_fns(K, red).items()}
+
+
+def path_fns(K: sp.csr_matrix, red) -> dict:
+    """Path -> a call that factorises ``K`` and solves one right-hand side by it, for every
+    path that applies (positive definite for the Cholesky paths)."""
     nf = K.shape[0]
     b = np.ones(nf)
     out = {}
@@ -235,10 +249,10 @@ def path_costs(K: sp.csr_matrix, red, n: int = 5) -> dict:
 
         try:
             chol()
-            out["dense Cholesky"] = _best(chol, n)
+            out["dense Cholesky"] = chol
         except np.linalg.LinAlgError:
             pass
-        out["dense LU"] = _best(lu, n)
+        out["dense LU"] = lu
     perm, bw, _, _ = red.banded
     if nf * (bw + 1) ** 2 <= 2e10:
         Kp = K[perm][:, perm].tocoo()
@@ -254,7 +268,7 @@ def path_costs(K: sp.csr_matrix, red, n: int = 5) -> dict:
 
         try:
             band()
-            out["banded Cholesky"] = _best(band, n)
+            out["banded Cholesky"] = band
         except np.linalg.LinAlgError:
             pass
     order = red.ordering[0]
@@ -265,7 +279,7 @@ def path_costs(K: sp.csr_matrix, red, n: int = 5) -> dict:
                         panel_size=10, options={"SymmetricMode": True})  # fmt: skip
         lu_.solve(b)
 
-    out["SuperLU"] = _best(slu, n)
+    out["SuperLU"] = slu
     return out
 
 
@@ -303,6 +317,27 @@ class Floor:
             for K, b in zip(Ks, best, strict=True):
                 for path, t in path_costs(K, red, n=1).items():
                     b[path] = min(t, b.get(path, np.inf))
+
+    def block(self, reps: int = 1, own: bool = False) -> float:
+        """CPU seconds per sample of the floor's computation itself: ``reps`` samples' worth
+        of factorisations + solves (each structure's iteration count, shared among its
+        captured tangents) by the cheapest path (``own``: the assembler's), timed as one run,
+        as a workload's run is. Needs :meth:`round` first (the path choice)."""
+        if not hasattr(self, "_fns"):
+            self._fns = [[path_fns(K, red) for K in Ks] for _, Ks, red in self.cases]
+        calls = []
+        for (n, Ks, red), costs, fns in zip(self.cases, self.best, self._fns, strict=True):
+            path = solver_path(red)
+            if not own or not all(path in c for c in costs):
+                path = min(costs[0], key=lambda p: min(c.get(p, np.inf) for c in costs))
+            # each tangent for its share of the iterations in a row: its factorisation then
+            # finds its matrix in cache, as the workload's finds the tangent just assembled
+            counts = np.diff(np.linspace(0, n * reps, len(Ks) + 1).round().astype(int))
+            calls += [f[path] for f, c in zip(fns, counts, strict=True) for _ in range(c)]
+        t = clock()
+        for call in calls:
+            call()
+        return (clock() - t) / reps
 
     def totals(self):
         """(iterations, floor s, floor s with the assembler's own path, paths used)."""
@@ -381,14 +416,16 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     print(f"per sample, BLAS 1 thread, CPU time min / median of {args.repeat} runs (and wall")
     print("median); floor = iterations x (cheapest factorisation + solve of the actual tangents),")
-    print("CPU time, measured in this run")
+    print("CPU time, measured in this run (the sum of each factorisation's best timing; run ms:")
+    print("the same computation timed as one run per round, like the workload, the best round)")
     print("min ms: one design alone (scenario.evaluate); batch ms: per design of a batch of 16")
     print("copies (4 for the canopy) through scenario.evaluate_batch, the path the runner takes")
     print("for databases. The ratio to the target is batch/floor where there is a batch time")
     print("(min/floor otherwise)")
     head = (
         f"{'workload':<20} {'iters':>6} {'min ms':>9} {'median ms':>10} {'wall ms':>9} "
-        f"{'batch ms':>9} {'floor ms':>9} {'min/floor':>10} {'batch/floor':>12} {'target':>7}  "
+        f"{'batch ms':>9} {'floor ms':>9} {'run ms':>9} {'min/floor':>10} {'batch/floor':>12} "
+        f"{'target':>7}  "
         "solver (floor with it)"
     )
     print(head)
@@ -398,14 +435,17 @@ def main(argv=None) -> int:
         for name, fn in workloads().items():
             if args.only not in name:
                 continue
-            # single runs, batch runs and floor rounds interleaved: a machine whose speed
-            # drifts (other jobs) slows all three alike, and each keeps its best
+            # single runs, batch runs and floor runs interleaved: a machine whose speed drifts
+            # (other jobs) slows all three alike, and each keeps its best
             fn()  # warm-up: topology, sparse pattern and compiled-kernel caches
             floor_run = Floor(fn)
+            floor_run.round()  # the path choice: every path of every tangent timed
             bfn = batched[name][1] if name in batched else None
+            reps = batched[name][0] if bfn is not None else 1
             if bfn is not None:
                 bfn()
-            cpu, wall, tbs = [], [], []
+            own = name in OWN_SOLVER_FLOOR  # the target is against the solver it keeps
+            cpu, wall, tbs, blocks = [], [], [], []
             for _ in range(args.repeat):
                 t, w = clock(), time.perf_counter()
                 fn()
@@ -415,21 +455,24 @@ def main(argv=None) -> int:
                     t = clock()
                     bfn()
                     tbs.append(clock() - t)
+                blocks.append(floor_run.block(reps, own=own))
                 floor_run.round()
             tmin, tmed, wall = min(cpu), statistics.median(cpu), statistics.median(wall)
             iters, floor, used_floor, used = floor_run.totals()
+            run = min(blocks)
             extra = ""
-            if name in OWN_SOLVER_FLOOR:  # the target is against the solver it keeps
+            if own:
                 extra = f" (cheapest path: {1e3 * floor:.2f} ms)"
                 floor = used_floor
             bms, bratio = "-", "-"
             if bfn is not None:
-                tb = min(tbs) / batched[name][0]
+                tb = min(tbs) / reps
                 bms, bratio = f"{1e3 * tb:.2f}", f"{tb / floor:.1f}"
             paths = ", ".join(sorted(used))
             print(
                 f"{name:<20} {iters:>6d} {1e3 * tmin:>9.2f} {1e3 * tmed:>10.2f} {1e3 * wall:>9.2f} "
-                f"{bms:>9} {1e3 * floor:>9.2f} {tmin / floor:>10.1f} {bratio:>12} "
+                f"{bms:>9} {1e3 * floor:>9.2f} {1e3 * run:>9.2f} {tmin / floor:>10.1f} "
+                f"{bratio:>12} "
                 f"{TARGET.get(name, ''):>7}  {paths}{extra}",
                 flush=True,
             )
