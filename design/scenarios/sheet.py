@@ -309,10 +309,11 @@ def sheet_models_batch(setting: SheetSetting, rows, *, profile=PAPER, extensions
         topo = _topology(pat, m, n)
         items = [(i, e) for i in idx for e in range(len(exts))]
         if pat == MIURA:  # every sheet's nodes at once (bit for bit sheet_nodes)
-            sides = [_miura_sides(setting, m, n, _design(setting, rows[i])[3]) for i, _ in items]
+            gammas = [_design(setting, rows[i])[3] for i, _ in items]
+            sides = [_miura_sides(setting, m, n, g) for g in gammas]
             X = miura_nodes_batch(
-                m, n, [s[0] for s in sides], [s[1] for s in sides],
-                [_design(setting, rows[i])[3] for i, _ in items], [exts[e] for _, e in items],
+                m, n, [a for a, _ in sides], [b for _, b in sides], gammas,
+                [exts[e] for _, e in items],
             )  # fmt: skip
         else:
             X = np.stack([sheet_nodes(setting, rows[i], exts[e]) for i, e in items])
