@@ -129,9 +129,9 @@ _SCRATCH_LAYOUT = {
 }
 
 #: most springs kept in rows (vectorised kernel) in the batch memory. Measured with the
-#: kernels and the band gather of one step (benchmarks/bench_scratch_layout.py, two runs):
-#: rows take 0.6-0.94 of the element-major time from 174 to 1120 springs (arch m = 8 to 24,
-#: Miura sheets 12 x 4 to 24 x 8) and 1.34-1.40 of it at 2544 (36 x 12), whose tangent rows
+#: kernels and the band gather of one step (benchmarks/bench_scratch_layout.py, three runs):
+#: rows take 0.58-0.94 of the element-major time from 174 to 1120 springs (arch m = 8 to 24,
+#: Miura sheets 12 x 4 to 24 x 8) and 0.99-1.40 of it at 2544 (36 x 12), whose tangent rows
 #: fill 1.8 MB
 SPRING_ROWS_MAX = 1500
 
