@@ -310,6 +310,7 @@ class Floor:
             (n, cap.K[key], cap.red[key]) for key, n in cap.calls.items()
         ]
         self.best: list[list[dict]] = [[{} for _ in Ks] for _, Ks, _ in self.cases]
+        self._fns = None  # the path calls of every tangent, for block(): built on first use
 
     def round(self) -> None:
         """Time every path of every captured tangent once more, keeping the best."""
@@ -323,7 +324,7 @@ class Floor:
         of factorisations + solves (each structure's iteration count, shared among its
         captured tangents) by the cheapest path (``own``: the assembler's), timed as one run,
         as a workload's run is. Needs :meth:`round` first (the path choice)."""
-        if not hasattr(self, "_fns"):
+        if self._fns is None:
             self._fns = [[path_fns(K, red) for K in Ks] for _, Ks, red in self.cases]
         calls = []
         for (n, Ks, red), costs, fns in zip(self.cases, self.best, self._fns, strict=True):

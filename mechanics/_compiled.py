@@ -2,8 +2,10 @@
 
 The numpy kernels of :mod:`~holofold.mechanics.bars` and :mod:`~holofold.mechanics.springs`
 make some forty array operations per call: about 95 us of fixed cost whatever the model size,
-and a temporary per operation. Here each element is one pass of scalar code and each scatter
-one loop, with no fixed cost beyond the call.
+and a temporary per operation. Here each bar is one pass of scalar code, the springs one
+branch-free loop that runs vectorised across springs (:mod:`~holofold.mechanics._spring_loop`,
+after a scalar pass for the angles), and each scatter one loop, with no fixed cost beyond the
+call.
 
 The results are bit for bit those of the numpy kernels and ``np.bincount`` scatters
 (tests/test_compiled.py): every element performs the same IEEE operations in the same order

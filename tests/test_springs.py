@@ -144,3 +144,22 @@ def test_sample_axis_matches_single_evaluations():
         np.testing.assert_allclose(H[s], H1, rtol=1e-13, atol=1e-14)
     r = spring_forces(x, SPR, np.array([1.0]), theta + 0.1)
     assert r.tangent.shape == (3, 1, 12, 12)
+
+
+def test_batched_angles_and_orientation_are_each_designs_own():
+    """dihedral_angle with one spring set per design, and the batch form of orient_springs,
+    give every design the bits it gets alone (the batch model builders rely on it)."""
+    from holofold.mechanics.hinges import _orient_batch, orient_springs
+
+    rng = np.random.default_rng(7)
+    S, nn, ns = 6, 12, 15
+    x = rng.normal(size=(S, nn, 3))
+    quads = np.array([rng.choice(nn, 4, replace=False) for _ in range(ns)])
+    for z_only in (True, False):
+        batch = _orient_batch(x, quads, z_only)
+        alone = np.stack([orient_springs(x[s], quads, z_only=z_only) for s in range(S)])
+        assert np.array_equal(batch, alone)
+    assert any((batch[s] != batch[0]).any() for s in range(S))  # orientations differ
+    theta = dihedral_angle(x, batch)
+    for s in range(S):
+        assert np.array_equal(theta[s], dihedral_angle(x[s], batch[s]))
