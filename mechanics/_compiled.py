@@ -10,7 +10,7 @@ call.
 The results are bit for bit those of the numpy kernels and ``np.bincount`` scatters
 (tests/test_compiled.py): every element performs the same IEEE operations in the same order
 (sums over the three components left to right as numpy reduces a length-3 axis, ``np.mod`` as
-numpy's ``npy_divmod``, no fast-math, no fused multiply-add), and :func:`gather` adds the
+numpy's ``npy_divmod``, no fast-math, no fused multiply-add), and :func:`scatter` adds the
 contributions of a target in the order ``np.bincount`` does (the flat order of the kernel
 layout, each family summed on its own, the families added as the numpy path added them). The
 layouts are the numpy kernels' (see :func:`~holofold.mechanics.bars.bar_kernel` and
@@ -37,7 +37,7 @@ __all__ = [
     "bar_elements",
     "spring_angles",
     "spring_elements",
-    "gather",
+    "scatter",
     "assemble_batch",
     "band_newton_step",
     "dense_newton_step",
@@ -176,40 +176,48 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
 
 
 @njit(**_OPTS)
-def gather(ptr_a, src_a, val_a, ptr_b, src_b, val_b, ptr_c, src_c, val_c, dest, out):
+def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest, acc, out):
     """``out[dest[p]] = (A_p + B_p) + C_p`` for every listed target p, where ``A_p`` is the
-    sum of ``val_a[src_a[ptr_a[p]:ptr_a[p + 1]]]`` from 0.0 in that order (likewise B, C).
-    With each family's sources listed in the order ``np.bincount`` meets them, this is
-    ``bincount(a) + bincount(b) + bincount(c)`` bit for bit, without scratch arrays and only
-    for the targets that receive something (``out`` starts as zeros)."""
-    for p in range(dest.shape[0]):
-        sa = 0.0
-        for q in range(ptr_a[p], ptr_a[p + 1]):
-            sa += val_a[src_a[q]]
-        sb = 0.0
-        for q in range(ptr_b[p], ptr_b[p + 1]):
-            sb += val_b[src_b[q]]
-        sc = 0.0
-        for q in range(ptr_c[p], ptr_c[p + 1]):
-            sc += val_c[src_c[q]]
-        out[dest[p]] = (sa + sb) + sc
+    sum from 0.0 of the values ``val_a[src_a[q]]`` with ``pos_a[q] == p``, added for q in
+    order (likewise B, C). With each family's sources in flat order, this is ``bincount(a) +
+    bincount(b) + bincount(c)`` bit for bit, and the values are read in the order they lie in
+    memory (a gather target by target read them scattered: 1.2-1.5x slower with the
+    kernels, benchmarks/bench_scatter.py). ``acc`` holds the sums (3 ``dest.size`` floats);
+    ``out`` must start as zeros where nothing is listed."""
+    n = dest.shape[0]
+    for p in range(3 * n):
+        acc[p] = 0.0
+    for q in range(src_a.shape[0]):
+        acc[pos_a[q]] += val_a[src_a[q]]
+    for q in range(src_b.shape[0]):
+        acc[n + pos_b[q]] += val_b[src_b[q]]
+    for q in range(src_c.shape[0]):
+        acc[2 * n + pos_c[q]] += val_c[src_c[q]]
+    for p in range(n):
+        out[dest[p]] = (acc[p] + acc[n + p]) + acc[2 * n + p]
+
+
+@njit(**_OPTS)
+def _acc_size(force_lists, tangent_lists) -> int:
+    """Length of the ``acc`` memory that :func:`_assemble_sample`'s scatters need."""
+    return 3 * max(force_lists[6].shape[0], tangent_lists[6].shape[0])
 
 
 # ------------------------------------------------------------------------ batches
 # A batch is S designs of one size: the arrays gain a leading sample axis and each listed
 # sample runs the single-design code above on one scratch set of element arrays, which stays
-# in cache between the kernels and the gathers (so each design's numbers are bit for bit those
+# in cache between the kernels and the scatters (so each design's numbers are bit for bit those
 # of its own evaluation).
 
 
 @njit(**_OPTS)
 def _assemble_sample(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-    views, flats, f, K,
+    views, flats, f, K, acc,
 ):  # fmt: skip
     """Sample ``s``'s kernels into ``views`` (memory ``flats``), its internal force into ``f``
-    and its tangent into ``K`` by the gather lists (both zeroed first: the gathers write only
-    the entries that receive something)."""
+    and its tangent into ``K`` by the scatter lists (both zeroed first: the scatters write
+    only the entries that receive something; ``acc``: :func:`_acc_size` floats)."""
     eb, fb, Kb, es, fs, Ks, th = views
     f[:] = 0.0
     K[:] = 0.0
@@ -218,8 +226,8 @@ def _assemble_sample(
     ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
     bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
     spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
-    gather(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, f)
-    gather(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, K)
+    scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, acc, f)
+    scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, acc, K)
 
 
 @njit(**_OPTS)
@@ -229,13 +237,14 @@ def assemble_batch(
 ):  # fmt: skip
     """For each sample ``s = idx[j]``: the kernels into the element arrays ``views`` (the
     seven of one sample, in the kernels' layouts), then ``f_out[j]`` by the ``force_lists``
-    and ``k_out[j]`` by the ``tangent_lists`` (each the seven arguments of :func:`gather` but
-    the values), whose sources index the memory of the views, ``flats`` (``f_out`` and
+    and ``k_out[j]`` by the ``tangent_lists`` (each the seven lists of :func:`scatter`, without
+    the values and ``acc``), whose sources index the memory of the views, ``flats`` (``f_out`` and
     ``k_out`` need not start as zeros)."""
+    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
-            tangent_lists, views, flats, f_out[j], k_out[j],
+            tangent_lists, views, flats, f_out[j], k_out[j], acc,
         )  # fmt: skip
 
 
@@ -283,7 +292,7 @@ def band_newton_step(
     views, flats, Fi, free, perm, bw, addrs, Uflat, dU, f_out, info,
 ):  # fmt: skip
     """One Newton update of each sample ``s = idx[j]`` on the banded Cholesky path: the
-    kernels and gathers of :func:`assemble_batch` (force into ``f_out[j]``), ``dpbtrf`` of the
+    kernels and scatters of :func:`assemble_batch` (force into ``f_out[j]``), ``dpbtrf`` of the
     band, ``dpbtrs`` of ``(Fi[s] - f)[free]`` in the band's order ``perm``, ``dU[j]`` the
     solution on the free DOFs and ``Uflat[s, free] += dU[j]``. ``info[j]``: 0 done, 1 not
     positive definite (nothing solved or updated), 2 a non-finite solution (U not updated).
@@ -297,12 +306,13 @@ def band_newton_step(
     inf_ = np.zeros(1, np.int32)
     ab = np.empty((bw + 1) * nf)
     y = np.empty(nf)
+    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         s = idx[j]
         f = f_out[j]
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, ab,
+            views, flats, f, ab, acc,
         )  # fmt: skip
         _fcall(addrs[0], (uplo, n_, kd_, ab, ld_, inf_))
         if inf_[0] != 0:
@@ -335,7 +345,7 @@ def dense_newton_step(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
     views, flats, Fi, free, addrs, Uflat, dU, info, res,
 ):  # fmt: skip
-    """:func:`band_newton_step` on the dense LU path: the free-free block gathered column-major
+    """:func:`band_newton_step` on the dense LU path: the free-free block summed column-major
     (the Fortran copy ``scipy.linalg.lapack.dgetrf`` makes of the row-major block), ``dgetrf``,
     ``dgetrs`` of ``(Fi[s] - f)[free]``, which is also kept in ``res[j]`` (``res`` may be
     ``dU``: then only the solution stays). ``info[j]``: 0 done, 1 singular (``dgetrf`` info >
@@ -348,11 +358,12 @@ def dense_newton_step(
     piv = np.empty(nf, np.int32)
     a = np.empty(nf * nf)
     f = np.empty(Uflat.shape[1])
+    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         s = idx[j]
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, a,
+            views, flats, f, a, acc,
         )  # fmt: skip
         _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
         if inf_[0] > 0:

@@ -4,10 +4,11 @@ The pattern (CSR ``indptr``/``indices`` and the data slot of every entry the ele
 produce) depends only on the connectivity, so it is computed once per topology and cached (keyed
 on a hash of the bar and spring connectivity: every sample of one Miura m x n or arch m shares
 it); each evaluation runs the compiled element kernels (:mod:`~holofold.mechanics._compiled`)
-and fills the CSR data, the dense free-free block or the band by one gather per target (bars,
-springs and the mirrors of their off-diagonal blocks, summed in ``np.bincount``'s order).
-Supports are handled by elimination: the free-free slots, the reduced CSR pattern, the
-fill-reducing orderings and the gather lists are cached per support mask.
+and fills the CSR data, the dense free-free block or the band by one scatter of the kernels'
+entries in the order they lie in memory (bars, springs and the mirrors of their off-diagonal
+blocks, each family summed in ``np.bincount``'s order, then added). Supports are handled by
+elimination: the free-free slots, the reduced CSR pattern, the fill-reducing orderings and the
+sum lists are cached per support mask.
 
 Linear solves on the free DOFs (:meth:`Assembler.evaluate_factorized`) pick the fastest path:
 dense LAPACK LU up to :data:`DENSE_MAX_DOF` free DOFs, then a banded Cholesky on a cached reverse
@@ -81,91 +82,32 @@ def _ck():
     return _COMPILED
 
 
-def _family(pos: np.ndarray, n: int):
-    """Gather list ``(ptr (n + 1,), src)`` of one element family: ``pos`` gives the target
-    of every entry of the kernel's flat array (outside ``0..n-1``: dropped); each target's
-    sources stay in flat order, the order in which ``np.bincount`` adds them."""
-    keep = np.flatnonzero((pos >= 0) & (pos < n))
-    p = pos[keep]
-    order = np.argsort(p, kind="stable")
-    ptr = np.zeros(n + 1, np.intp)
-    ptr[1:] = np.cumsum(np.bincount(p, minlength=n))
-    return ptr, np.ascontiguousarray(keep[order], dtype=np.intp)
-
-
-def _gather_lists(families, n: int, dest=None):
-    """The arguments of :func:`holofold.mechanics._compiled.gather` for up to three families
-    ``(pos, n)`` -> targets ``0..n-1`` written to ``out[dest[t]]`` (default ``out[t]``): only
-    the targets that receive something are listed (``out`` must start as zeros)."""
-    lists = [_family(pos, n) for pos in families]
-    while len(lists) < 3:
-        lists.append((np.zeros(n + 1, np.intp), np.zeros(0, np.intp)))
-    counts = sum(np.diff(ptr) for ptr, _ in lists)
+def _sum_lists(families, n: int, dest=None):
+    """The lists of :func:`holofold.mechanics._compiled.scatter` for up to three element
+    families (bars, springs, spring mirrors) ``pos`` -> targets ``0..n-1`` written to
+    ``out[dest[t]]`` (default ``out[t]``): per family the flat kernel-layout index of every
+    entry that has a target (``pos`` outside ``0..n-1``: dropped), in flat order, the order in
+    which ``np.bincount`` adds them, and its target's position among the targets that receive
+    something; then those targets (``out`` must start as zeros)."""
+    families = list(families)
+    counts = np.zeros(n, np.intp)
+    kept = []
+    for pos in families:
+        pos = np.asarray(pos).ravel()
+        src = np.flatnonzero((pos >= 0) & (pos < n))
+        kept.append((src, pos[src]))
+        counts += np.bincount(pos[src], minlength=n)
     hit = np.flatnonzero(counts > 0)
-    out = []
-    for ptr, src in lists:
-        c = np.diff(ptr)[hit]
-        out += [np.concatenate([[0], np.cumsum(c)]).astype(np.intp), src]
-    where = hit if dest is None else np.asarray(dest, np.intp)[hit]
-    return (*out, np.ascontiguousarray(where, dtype=np.intp))
-
-
-#: memory of the batch path's element arrays, as the shape of one element's entries and the
-#: axes that turn ``(n, *shape)`` into the kernels' layouts (None: already that layout). Bars
-#: are element-major, bar force (nb, 2, 3) -> (3, 2, nb) and bar tangent (nb, 2, 2, 3, 3) ->
-#: (3, 3, 2, 2, nb): one bar's entries are contiguous, so a gather target's sources (bars
-#: sharing its DOFs) lie close. Springs, up to :data:`SPRING_ROWS_MAX`, keep the kernels' own
-#: layouts, force (3, 4, ns) and tangent (3, 3, 10, ns): each entry is a contiguous row over
-#: the springs, which lets the compiled spring loop run vectorised (``_spring_loop``). Beyond,
-#: the tangent rows outgrow the cache the gathers read them from, and springs are
-#: element-major too, force (ns, 4, 3) and tangent (ns, 10, 3, 3).
-_SCRATCH_LAYOUT = {
-    "bar_force": ((2, 3), (2, 1, 0)),
-    "bar_tangent": ((2, 2, 3, 3), (3, 4, 1, 2, 0)),
-    "spring_force": ((3, 4), None),
-    "spring_tangent": ((3, 3, 10), None),
-    "spring_force_em": ((4, 3), (2, 1, 0)),
-    "spring_tangent_em": ((10, 3, 3), (2, 3, 1, 0)),
-}
-
-#: most springs kept in rows (vectorised kernel) in the batch memory. Measured with the
-#: kernels and the band gather of one step (benchmarks/bench_scratch_layout.py, three runs):
-#: rows take 0.58-0.94 of the element-major time from 174 to 1120 springs (arch m = 8 to 24,
-#: Miura sheets 12 x 4 to 24 x 8) and 0.99-1.40 of it at 2544 (36 x 12), whose tangent rows
-#: fill 1.8 MB
-SPRING_ROWS_MAX = 1500
-
-
-def _layout(kind: str, n: int) -> tuple:
-    """(shape, axes) of ``kind`` for ``n`` elements of that family."""
-    if kind.startswith("spring") and n > SPRING_ROWS_MAX:
-        kind += "_em"
-    return _SCRATCH_LAYOUT[kind]
-
-
-def _scratch_view(flat: np.ndarray, n: int, kind: str) -> np.ndarray:
-    """``flat`` (the batch memory of ``n`` elements, :data:`_SCRATCH_LAYOUT`) viewed in the
-    kernel layout."""
-    shape, axes = _layout(kind, n)
-    if axes is None:
-        return flat.reshape(*shape, n)
-    return flat.reshape(n, *shape).transpose(axes)
-
-
-def _scratch_lists(lists, nb: int, ns: int, tangent: bool):
-    """Gather ``lists`` (bars, springs, spring mirrors; sources as flat indices of the kernel
-    layouts) with their sources moved to the batch memory: the same targets and the same
-    order of summation, so the same sums bit for bit."""
-    a, sa, b, sb, c, sc, dest = lists
-    kinds = ("bar_tangent", "spring_tangent") if tangent else ("bar_force", "spring_force")
-    maps = []
-    for kind, n in zip(kinds, (nb, ns), strict=True):
-        shape, axes = _layout(kind, n)
-        where = np.arange(n * int(np.prod(shape)))
-        maps.append(where if axes is None else where.reshape(n, *shape).transpose(axes).ravel())
-    mb, ms = maps
+    where = np.full(n, -1, np.intp)
+    where[hit] = np.arange(hit.size)
     i4 = lambda x: np.ascontiguousarray(x, np.int32)  # noqa: E731 - half the index traffic
-    return tuple(map(i4, (a, mb[sa], b, ms[sb], c, ms[sc], dest)))
+    out = []
+    for src, tgt in kept:
+        out += [i4(src), i4(where[tgt])]
+    while len(out) < 6:
+        out += [np.zeros(0, np.int32), np.zeros(0, np.int32)]
+    targets = hit if dest is None else np.asarray(dest, np.intp)[hit]
+    return (*out, i4(targets))
 
 
 class SingularSystemError(RuntimeError):
@@ -294,40 +236,37 @@ class ReducedPattern:
         return positions(pat.bar_slot, keep_b), positions(pat.spring_slot, keep_s), size
 
     @cached_property
-    def dense_gather(self):
-        """Gather lists (bars, springs, spring mirrors) of the kept slots, in
-        :func:`holofold.mechanics._compiled.gather`'s form, for the flat dense free-free
-        block (targets ``dense``)."""
+    def dense_sums(self):
+        """Sum lists (bars, springs, spring mirrors; :func:`_sum_lists`) of the kept slots,
+        for the flat dense free-free block (targets ``dense``)."""
         pat = self._pattern
         kidx = np.full(pat.nnz + 1, -1, np.intp)
         kidx[self.keep] = np.arange(self.keep.size)
         fams = (kidx[pat.bar_slot], kidx[pat.spring_slot], kidx[pat.spring_slot_mirror])
-        return _gather_lists(fams, self.keep.size, self.dense)
+        return _sum_lists(fams, self.keep.size, self.dense)
 
     @cached_property
-    def band_gather(self):
-        """Gather lists (bars, springs, none) of the column-major upper band (see
+    def band_sums(self):
+        """Sum lists (bars, springs, none) of the column-major upper band (see
         :attr:`banded_slots`)."""
         bar_ab, spring_ab, size = self.banded_slots
-        return _gather_lists((bar_ab, spring_ab), size)
+        return _sum_lists((bar_ab, spring_ab), size)
 
-    def batch_gather(self, path: str):
-        """(lists, size) of a solver path's tangent target for the batch path's
-        element arrays (:func:`_scratch_lists`): the dense block, the band or the CSR
-        data (cached)."""
-        cache = self.__dict__.setdefault("_batch_gather", {})
+    def tangent_sums(self, path: str):
+        """(lists, size) of :func:`_sum_lists` for a solver path's tangent target: the dense
+        block (``"dense"``; ``"dense_cm"`` column-major), the band or the CSR data (cached)."""
+        cache = self.__dict__.setdefault("_tangent_sums", {})
         if path not in cache:
             pat = self._pattern
             nf = self.n_free
             lists, n = (
-                (self.dense_gather, nf**2) if path in ("dense", "dense_cm")
-                else (self.band_gather, _band_size(self)) if path == "banded"
-                else (pat.data_gather, pat.nnz)
+                (self.dense_sums, nf**2) if path in ("dense", "dense_cm")
+                else (self.band_sums, _band_size(self)) if path == "banded"
+                else (pat.data_sums, pat.nnz)
             )  # fmt: skip
             if path == "dense_cm":  # column-major: the Fortran copy LAPACK factorises
                 lists = (*lists[:6], (lists[6] % nf) * nf + lists[6] // nf)
-            nb, ns = pat.bar_dofs.shape[0], pat.spring_dofs.shape[0]
-            cache[path] = (_scratch_lists(lists, nb, ns, True), n)
+            cache[path] = (lists, n)
         return cache[path]
 
     @cached_property
@@ -431,22 +370,16 @@ class AssemblyPattern:
         self._reduced: dict[bytes, ReducedPattern] = {}
 
     @cached_property
-    def force_gather(self):
-        """Gather lists (bars, springs, none) of the internal force (targets: the DOFs)."""
+    def force_sums(self):
+        """Sum lists (bars, springs, none) of the internal force (targets: the DOFs)."""
         n = self.n_dof
-        return _gather_lists((self.bar_force_dofs, self.spring_force_dofs), n)
+        return _sum_lists((self.bar_force_dofs, self.spring_force_dofs), n)
 
     @cached_property
-    def force_gather_scratch(self):
-        """:attr:`force_gather` for the batch path's element arrays (:func:`_scratch_lists`)."""
-        nb, ns = self.bar_dofs.shape[0], self.spring_dofs.shape[0]
-        return _scratch_lists(self.force_gather, nb, ns, False)
-
-    @cached_property
-    def data_gather(self):
-        """Gather lists (bars, springs, spring mirrors) of the CSR data (targets: the slots)."""
+    def data_sums(self):
+        """Sum lists (bars, springs, spring mirrors) of the CSR data (targets: the slots)."""
         n = self.nnz
-        return _gather_lists((self.bar_slot, self.spring_slot, self.spring_slot_mirror), n)
+        return _sum_lists((self.bar_slot, self.spring_slot, self.spring_slot_mirror), n)
 
     def reduced(self, free_mask: np.ndarray) -> ReducedPattern:
         """The free-DOF reduction for a boolean (ndof,) mask (cached per mask)."""
@@ -605,17 +538,17 @@ class Assembler:
         buffers = self._kernels(U, spring_rest, tangent, self._buffers())
         eb, fb, _, es, fs, _, _ = buffers
         energy = float(eb.sum() + es.sum())
-        f = _gather(self.pattern.force_gather, fb, fs, np.zeros(self.n_dof))
+        f = _sum(self.pattern.force_sums, fb, fs, np.zeros(self.n_dof))
         return energy, f, buffers
 
     def _scatter(self, buffers):
         """CSR data (nnz,) of the full tangent."""
-        return _gather(self.pattern.data_gather, buffers[2], buffers[5], np.zeros(self.pattern.nnz))
+        return _sum(self.pattern.data_sums, buffers[2], buffers[5], np.zeros(self.pattern.nnz))
 
     def _dense(self, buffers, red):
         """The free-free tangent block, dense (nf, nf)."""
         nf = red.n_free
-        return _gather(red.dense_gather, buffers[2], buffers[5], np.zeros(nf * nf)).reshape(nf, nf)
+        return _sum(red.dense_sums, buffers[2], buffers[5], np.zeros(nf * nf)).reshape(nf, nf)
 
     def _data(self, U, spring_rest, tangent=True):
         energy, f, buffers = self._elements(U, spring_rest, tangent)
@@ -680,7 +613,7 @@ class Assembler:
         if path == "dense":
             return energy, f, _dense_solver(self._dense(rb, red))
         if path == "banded":
-            solve = _band_solver(_gather(red.band_gather, rb[2], rb[5], _band_zeros(red)), red)
+            solve = _band_solver(_sum(red.band_sums, rb[2], rb[5], _band_zeros(red)), red)
             if solve is not None:
                 return energy, f, solve
             # not positive definite: LU below
@@ -689,7 +622,7 @@ class Assembler:
     def dense_newton_update(self, U, F, spring_rest=None, r=None):
         """One compiled Newton update on the dense path, bit for bit
         ``_, f, solve = evaluate_factorized(U, spring_rest); r = (F - f)[free]; dU = solve(r);
-        U[free] += dU`` in one numba call (kernels, gathers, ``dgetrf``/``dgetrs`` by address).
+        U[free] += dU`` in one numba call (kernels, scatters, ``dgetrf``/``dgetrs`` by address).
 
         Parameters
         ----------
@@ -748,8 +681,8 @@ class Assembler:
         one = lambda a: a.reshape((1, *a.shape))  # noqa: E731
         mid = tuple(map(one, (self._b0, self._b1, self._D0, self._L0, self._EA, self._sT, self._k)))
         views, flats = _scratch_buffers(len(self.bars), len(self.springs))
-        lists, _ = red.batch_gather("dense_cm")
-        force = self.pattern.force_gather_scratch
+        lists, _ = red.tangent_sums("dense_cm")
+        force = self.pattern.force_sums
         after = (np.array([self._k_nonneg]), np.zeros(1, np.intp), force, lists, views, flats)
         post = (red.free, ck.lapack_addresses("dgetrf", "dgetrs"))
         dU = np.empty((1, red.n_free))
@@ -858,13 +791,13 @@ def _lu_solver(data: np.ndarray, red: ReducedPattern):
     return solve
 
 
-def _gather(lists, bar_values, spring_values, out):
-    """``out`` (zeros) filled by :func:`holofold.mechanics._compiled.gather` with ``lists``
-    (:func:`_gather_lists`: bars, springs, spring mirrors) from the element arrays."""
-    a, sa, b, sb, c, sc, dest = lists
+def _sum(lists, bar_values, spring_values, out):
+    """``out`` (zeros) filled by :func:`holofold.mechanics._compiled.scatter` with ``lists``
+    (:func:`_sum_lists`: bars, springs, spring mirrors) from the element arrays."""
     vb = bar_values.reshape(-1)
     vs = spring_values.reshape(-1)
-    _ck().gather(a, sa, vb, b, sb, vs, c, sc, vs, dest, out)
+    acc = np.empty(3 * lists[6].size)
+    _ck().scatter(*lists[:2], vb, *lists[2:4], vs, *lists[4:6], vs, lists[6], acc, out)
     return out
 
 
@@ -879,22 +812,10 @@ def _element_buffers(nb: int, ns: int):
 
 
 def _scratch_buffers(nb: int, ns: int):
-    """(views, flats): the element arrays of :func:`_element_buffers` in the batch memory
-    (``flats``, see :data:`_SCRATCH_LAYOUT`) and viewed in the kernels' layouts (``views``)."""
-    flats = (
-        np.empty(nb), np.empty(6 * nb), np.empty(36 * nb),
-        np.empty(ns), np.empty(12 * ns), np.empty(90 * ns), np.empty(ns),
-    )  # fmt: skip
-    views = (
-        flats[0],
-        _scratch_view(flats[1], nb, "bar_force"),
-        _scratch_view(flats[2], nb, "bar_tangent"),
-        flats[3],
-        _scratch_view(flats[4], ns, "spring_force"),
-        _scratch_view(flats[5], ns, "spring_tangent"),
-        flats[6],
-    )
-    return views, flats
+    """(views, flats): the element arrays of :func:`_element_buffers` (``views``, the kernels'
+    layouts) and the same memory flat (``flats``, which the sum lists index)."""
+    views = _element_buffers(nb, ns)
+    return views, tuple(v.reshape(-1) for v in views)
 
 
 _NON_FINITE = "non-finite solution of the linear system (singular stiffness)"
@@ -913,7 +834,7 @@ class BatchAssembler:
     Every sample of an arch m or a Miura m x n sheet has the same nodes, bars and springs up to
     the orientation of some springs (the polarity rule follows the geometry), hence one of a
     few connectivities. One call of :meth:`factorized` runs the compiled kernels once for the
-    whole batch and one gather per connectivity (loops over the samples inside compiled code),
+    whole batch and one scatter per connectivity (loops over the samples inside compiled code),
     then factorises each active sample's tangent by the path :class:`Assembler` takes, so every
     sample's numbers are bit for bit those of its own :class:`Assembler`.
 
@@ -1008,13 +929,13 @@ class BatchAssembler:
                 for s in idx:
                     solves[s] = lambda rhs: np.zeros_like(rhs, dtype=float)
                 continue
-            lists, n = red.batch_gather(path)
+            lists, n = red.tangent_sums(path)
             fj = np.empty((idx.size, self.n_dof))
             kj = np.empty((idx.size, n))
             views, flats = self._scratch
             ck.assemble_batch(
                 self._X, U, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
-                self._k, theta0, self._k_nonneg, idx, pat.force_gather_scratch, lists,
+                self._k, theta0, self._k_nonneg, idx, pat.force_sums, lists,
                 views, flats, fj, kj,
             )  # fmt: skip
             f[idx] = fj
@@ -1071,13 +992,13 @@ class BatchAssembler:
                 views, flats = self._scratch
                 common = (
                     self._X, U3, self._b0, self._b1, self._D0, self._L0, self._EA, self._sT,
-                    self._k, self._theta0, self._k_nonneg, idx, pat.force_gather_scratch,
+                    self._k, self._theta0, self._k_nonneg, idx, pat.force_sums,
                 )  # fmt: skip
                 dU = np.empty((idx.size, red.n_free))
                 info = np.zeros(idx.size, np.int8)
                 if path == "banded":
                     perm, bw, _, _ = red.banded
-                    lists, _ = red.batch_gather("banded")
+                    lists, _ = red.tangent_sums("banded")
                     fj = np.empty((idx.size, self.n_dof))
                     ck.band_newton_step(
                         *common, lists, views, flats, Fi, red.free, perm, bw,
@@ -1085,7 +1006,7 @@ class BatchAssembler:
                     )  # fmt: skip
                     lu_below = True  # not positive definite: LU by factorized below
                 else:
-                    lists, _ = red.batch_gather("dense_cm")
+                    lists, _ = red.tangent_sums("dense_cm")
                     ck.dense_newton_step(
                         *common, lists, views, flats, Fi, red.free, self._addrs["dense"], U,
                         dU, info, dU,

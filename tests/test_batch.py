@@ -29,17 +29,8 @@ def _same(a, b):
     assert np.array_equal(a.applied_force, b.applied_force)
 
 
-@pytest.mark.parametrize("rows_max", [None, 0])
 @pytest.mark.parametrize("m", [8, 12])
-def test_secant_stiffness_batch_is_each_design_alone(m, rows_max, monkeypatch):
-    if rows_max is not None:  # the element-major spring memory of large models, on a small one
-        from collections import OrderedDict
-
-        import holofold.mechanics.assembly as assembly
-
-        monkeypatch.setattr(assembly, "SPRING_ROWS_MAX", rows_max)
-        # patterns (and their gather lists for the batch memory) built under this layout only
-        monkeypatch.setattr(assembly, "_PATTERN_CACHE", OrderedDict())
+def test_secant_stiffness_batch_is_each_design_alone(m):
     models = [arch.arch_model(r) for r in _rows(m, 6)]
     ss = [s for s, _, _ in models]
     assert len({s.springs.tobytes() for s in ss}) > 1  # several spring orientations in a batch

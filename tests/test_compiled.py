@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse as sp
 
 from holofold.mechanics import _compiled
-from holofold.mechanics.assembly import Assembler, _gather
+from holofold.mechanics.assembly import Assembler, _sum, _sum_lists
 from holofold.mechanics.bars import bar_kernel
 from holofold.mechanics.springs import dihedral_angle, spring_kernel
 from holofold.mechanics.structure import Structure
@@ -32,7 +32,8 @@ def _random_model(seed, nn=40, ns=70, nb=110, negative_k=False):
 @pytest.mark.parametrize("negative_k", [False, True])
 @pytest.mark.parametrize("tangent", [True, False])
 def test_spring_kernel_is_the_numpy_one_bit_for_bit(negative_k, tangent, element_major):
-    # 70 springs: the vectorised loop's remainder runs too; element-major outputs are strided
+    # 70 springs: the vectorised loop's remainder runs too; strided outputs (element-major
+    # arrays) take the scalar path
     X, U, sT, k, th0, *_ = _random_model(1, negative_k=negative_k)
     ref, theta = spring_kernel((X + U).T[:, sT], k, th0, tangent=tangent)
     ns = sT.shape[1]
@@ -97,6 +98,34 @@ def _numpy_assembly(asm, U):
     return energy, f, data, rb, rs
 
 
+@pytest.mark.parametrize("n_families", [1, 2, 3])
+def test_scatter_is_bincount_per_family_then_added(n_families):
+    # random targets with many repeats and dropped entries (-1, n): each family's sum in
+    # flat order from 0.0, then (A + B) + C, written to out[dest] for the targets hit
+    rng = np.random.default_rng(n_families)
+    n = 50
+    pos = [rng.integers(-1, n + 1, size) for size in (700, 400, 300)[:n_families]]
+    vals = [rng.standard_normal(p.size) * 10.0 ** rng.integers(-8, 8, p.size) for p in pos]
+    dest = rng.permutation(3 * n)[:n]
+    lists = _sum_lists(pos, n, dest)
+    ref = np.zeros(n)
+    for p, v in zip(pos, vals, strict=True):
+        keep = (p >= 0) & (p < n)
+        ref = ref + np.bincount(p[keep], weights=v[keep], minlength=n)
+    while len(vals) < 3:
+        vals.append(np.zeros(0))
+    out = np.zeros(3 * n)
+    acc = np.empty(3 * lists[6].size)
+    _compiled.scatter(*lists[:2], vals[0], *lists[2:4], vals[1], *lists[4:6], vals[2],
+                      lists[6], acc, out)  # fmt: skip
+    expect = np.zeros(3 * n)
+    hit = np.zeros(n, bool)
+    for p in pos:
+        hit[p[(p >= 0) & (p < n)]] = True
+    expect[dest[hit]] = ref[hit]
+    assert np.array_equal(out, expect) and not np.array_equal(out, 0 * out)
+
+
 @pytest.mark.parametrize("seed", [3, 4])
 def test_assembly_is_the_bincount_one_bit_for_bit(seed):
     s, U = _structure(seed)
@@ -118,7 +147,7 @@ def test_assembly_is_the_bincount_one_bit_for_bit(seed):
     ab = np.bincount(bar_ab, weights=rb.tangent.ravel(), minlength=size + 1)
     ab += np.bincount(spring_ab, weights=rs.tangent.ravel(), minlength=size + 1)
     buffers = asm._kernels(U, None, True, asm._buffers())
-    got = _gather(red.band_gather, buffers[2], buffers[5], np.zeros(size))
+    got = _sum(red.band_sums, buffers[2], buffers[5], np.zeros(size))
     assert np.array_equal(got, ab[:size])
 
 

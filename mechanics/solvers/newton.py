@@ -123,7 +123,7 @@ def solve_newton_batch(
     """:func:`solve_newton` for S structures of one topology and support mask, in lockstep.
 
     Every iteration evaluates the samples still iterating together (one kernel call and one
-    gather for the batch, :class:`~holofold.mechanics.assembly.BatchAssembler`); each sample
+    scatter for the batch, :class:`~holofold.mechanics.assembly.BatchAssembler`); each sample
     keeps its own increment loop, convergence, iteration count and failure, and its
     :class:`SolveResult` is bit for bit the one :func:`solve_newton` gives it alone.
 
