@@ -72,8 +72,8 @@ def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, energy, force, K):
     """
     nb = b0.shape[0]
     for e in range(nb):
-        na = b0[e]
-        nbb = b1[e]
+        na = np.uintp(b0[e])  # unsigned: no negative-index wrap-around in the loads
+        nbb = np.uintp(b1[e])
         d0 = U[nbb, 0] - U[na, 0]
         d1 = U[nbb, 1] - U[na, 1]
         d2 = U[nbb, 2] - U[na, 2]
@@ -130,6 +130,7 @@ def _cross3(a, b):
 
 @njit(inline="always", **_OPTS)
 def _node(X, U, nd):
+    nd = np.uintp(nd)  # unsigned: no negative-index wrap-around in the loads
     return (X[nd, 0] + U[nd, 0], X[nd, 1] + U[nd, 1], X[nd, 2] + U[nd, 2])
 
 
@@ -187,14 +188,15 @@ def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest,
     n = dest.shape[0]
     for p in range(3 * n):
         acc[p] = 0.0
+    # unsigned indices: numba then skips its negative-index wrap-around (25 % of the time)
     for q in range(src_a.shape[0]):
-        acc[pos_a[q]] += val_a[src_a[q]]
+        acc[np.uintp(pos_a[q])] += val_a[np.uintp(src_a[q])]
     for q in range(src_b.shape[0]):
-        acc[n + pos_b[q]] += val_b[src_b[q]]
+        acc[np.uintp(n + pos_b[q])] += val_b[np.uintp(src_b[q])]
     for q in range(src_c.shape[0]):
-        acc[2 * n + pos_c[q]] += val_c[src_c[q]]
+        acc[np.uintp(2 * n + pos_c[q])] += val_c[np.uintp(src_c[q])]
     for p in range(n):
-        out[dest[p]] = (acc[p] + acc[n + p]) + acc[2 * n + p]
+        out[np.uintp(dest[p])] = (acc[p] + acc[n + p]) + acc[2 * n + p]
 
 
 @njit(**_OPTS)

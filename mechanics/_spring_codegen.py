@@ -37,6 +37,7 @@ arguments overlap (``noalias``).
 
 import math
 
+import numpy as np
 from numba import njit
 
 from holofold.mechanics._jit import NOALIAS
@@ -47,7 +48,8 @@ __all__ = ["spring_force_loop", "spring_tangent_loop"]
 
 def _lines_common() -> list[str]:
     """The frame, gradient, energy and force of spring ``s`` (shared by both loops)."""
-    L = [f"q{t} = sT[{t}, s]" for t in range(4)]
+    # unsigned node indices: numba skips its negative-index wrap-around in the loads
+    L = [f"q{t} = np.uintp(sT[{t}, s])" for t in range(4)]
     for t in range(4):
         L += [f"P{t}_{c} = X[q{t}, {c}] + U[q{t}, {c}]" for c in C]
     L += [f"rij_{c} = P0_{c} - P1_{c}" for c in C]

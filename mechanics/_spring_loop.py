@@ -9,6 +9,7 @@ arguments overlap (``noalias``).
 
 import math
 
+import numpy as np
 from numba import njit
 
 from holofold.mechanics._jit import NOALIAS
@@ -21,10 +22,10 @@ def spring_tangent_loop(X, U, sT, k, theta0, k_nonneg, energy, force, K, theta):
     """Energy, force and tangent ``K`` (3, 3, 10, ns) of every spring
     (``k_nonneg``: every k >= 0)."""
     for s in range(sT.shape[1]):
-        q0 = sT[0, s]
-        q1 = sT[1, s]
-        q2 = sT[2, s]
-        q3 = sT[3, s]
+        q0 = np.uintp(sT[0, s])
+        q1 = np.uintp(sT[1, s])
+        q2 = np.uintp(sT[2, s])
+        q3 = np.uintp(sT[3, s])
         P0_0 = X[q0, 0] + U[q0, 0]
         P0_1 = X[q0, 1] + U[q0, 1]
         P0_2 = X[q0, 2] + U[q0, 2]
@@ -516,10 +517,10 @@ def spring_tangent_loop(X, U, sT, k, theta0, k_nonneg, energy, force, K, theta):
 def spring_force_loop(X, U, sT, k, theta0, energy, force, theta):
     """Energy and force of every spring."""
     for s in range(sT.shape[1]):
-        q0 = sT[0, s]
-        q1 = sT[1, s]
-        q2 = sT[2, s]
-        q3 = sT[3, s]
+        q0 = np.uintp(sT[0, s])
+        q1 = np.uintp(sT[1, s])
+        q2 = np.uintp(sT[2, s])
+        q3 = np.uintp(sT[3, s])
         P0_0 = X[q0, 0] + U[q0, 0]
         P0_1 = X[q0, 1] + U[q0, 1]
         P0_2 = X[q0, 2] + U[q0, 2]
