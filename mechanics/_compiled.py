@@ -182,8 +182,8 @@ def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest,
     sum from 0.0 of the values ``val_a[src_a[q]]`` with ``pos_a[q] == p``, added for q in
     order (likewise B, C). With each family's sources in flat order, this is ``bincount(a) +
     bincount(b) + bincount(c)`` bit for bit, and the values are read in the order they lie in
-    memory (a gather target by target read them scattered: 1.2-1.5x slower with the
-    kernels, benchmarks/bench_scatter.py). ``acc`` holds the sums (3 ``dest.size`` floats);
+    memory (a gather target by target read them scattered: its sums took 1.2-1.6x as long,
+    benchmarks/bench_scatter.py). ``acc`` holds the sums (3 ``dest.size`` floats);
     ``out`` must start as zeros where nothing is listed."""
     n = dest.shape[0]
     for p in range(3 * n):
