@@ -73,7 +73,8 @@ def gather_lists(lists):
 
 
 def step(st):
-    """(kernels, kernels + gathers, kernels + scatters) of one Newton step of ``st``."""
+    """(solver path, entries summed, (kernels, kernels + gathers, kernels + scatters)) of one
+    Newton step of ``st``."""
     a = assembly.Assembler(st)
     red = a.reduction
     path = assembly.solver_path(red, a.dense_max)
@@ -106,7 +107,8 @@ def step(st):
         ck.scatter(*fl[:2], flats[1], *fl[2:4], flats[4], *fl[4:6], flats[4], fl[6], acc, f)
         return np.concatenate([out, f])
 
-    return path, (kernels, by_gather, by_scatter)
+    n = tl[0].size + tl[2].size + tl[4].size
+    return path, n, (kernels, by_gather, by_scatter)
 
 
 def main(argv=None) -> int:
@@ -125,7 +127,7 @@ def main(argv=None) -> int:
     with threadpool_limits(1):
         for size in args.sizes:
             st = structure(size)
-            path, fns = step(st)
+            path, n, fns = step(st)
             if fns[1]().tobytes() != fns[2]().tobytes():
                 raise SystemExit(f"{size}: the gather and the scatter give different bits")
             best = [np.inf] * 3
@@ -136,9 +138,6 @@ def main(argv=None) -> int:
                     fn()
                     best[i] = min(best[i], time.perf_counter() - t)
             k, g, s = (1e6 * b for b in best)
-            a = assembly.Assembler(st)
-            tl, _ = a.reduction.tangent_sums("dense" if path == "dense" else "banded")
-            n = tl[0].size + tl[2].size + tl[4].size
             print(
                 f"{size:<12} {path:>7} {n:>8d} {k:>8.1f} {g:>8.1f} {s:>9.1f} {g - k:>7.1f} "
                 f"{s - k:>7.1f} {s / g:>9.2f}"

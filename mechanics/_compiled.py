@@ -188,7 +188,7 @@ def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest,
     n = dest.shape[0]
     for p in range(3 * n):
         acc[p] = 0.0
-    # unsigned indices: numba then skips its negative-index wrap-around (25 % of the time)
+    # unsigned indices: numba then skips its negative-index wrap-around (a fifth of the time)
     for q in range(src_a.shape[0]):
         acc[np.uintp(pos_a[q])] += val_a[np.uintp(src_a[q])]
     for q in range(src_b.shape[0]):

@@ -89,7 +89,6 @@ def _sum_lists(families, n: int, dest=None):
     entry that has a target (``pos`` outside ``0..n-1``: dropped), in flat order, the order in
     which ``np.bincount`` adds them, and its target's position among the targets that receive
     something; then those targets (``out`` must start as zeros)."""
-    families = list(families)
     counts = np.zeros(n, np.intp)
     kept = []
     for pos in families:

@@ -1,4 +1,4 @@
-"""The compiled kernels and gathers equal the numpy kernels and bincount scatters bit for bit."""
+"""The compiled kernels and scatters equal the numpy kernels and np.bincount bit for bit."""
 
 import numpy as np
 import pytest
