@@ -88,3 +88,17 @@ def test_pip_install_dot_gives_one_import_name(tmp_path):
     cli = subprocess.run([str(env_dir / "bin" / "holofold"), "--help"], cwd=work,
                          capture_output=True, text=True, env=env)  # fmt: skip
     assert cli.returncode == 0 and "usage: holofold" in cli.stdout, cli.stderr[-2000:]
+
+
+def test_checkout_has_no_symlinks_and_every_face_imports_from_the_tree():
+    """The repository carries no symlinks (checkouts without them must work), and the layer
+    faces resolve through the installed package-dir mapping to the top-level folders."""
+    if (ROOT / ".git").exists():
+        listed = subprocess.run(["git", "ls-files", "-s"], cwd=ROOT, capture_output=True,
+                                text=True, check=True).stdout.splitlines()  # fmt: skip
+        links = [line.split("\t", 1)[1] for line in listed if line.startswith("120000")]
+        assert not links, f"symlinks in the repository: {links[:5]}"
+    for name in FACES[1:]:
+        mod = importlib.import_module(name)
+        folder = name.split(".")[1]
+        assert Path(mod.__file__).resolve().parent == ROOT / folder, mod.__file__
