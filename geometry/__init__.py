@@ -15,6 +15,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "InvalidPatternError",
             "DegenerateGeometryError",
             "FormatError",
+            "EnvironmentFault",
             "check_range",
         ],
         "export": ["export", "export_pattern_files", "EXPORT_TYPES"],

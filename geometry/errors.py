@@ -1,7 +1,8 @@
 """Exceptions raised by holofold when input is wrong.
 
-All subclass :class:`ValueError`, so callers (and the CLI) can catch one type. Messages name
-the offending value, where it is, and what is allowed.
+The input errors subclass :class:`ValueError`, so callers (and the CLI) can catch one type.
+Messages name the offending value, where it is, and what is allowed. :class:`EnvironmentFault`
+is the other kind: the machine, not the input, is wrong; it is never a design's result.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ __all__ = [
     "DegenerateGeometryError",
     "FormatError",
     "ParameterError",
+    "EnvironmentFault",
     "check_range",
 ]
 
@@ -29,6 +31,12 @@ class FormatError(ValueError):
 
 class ParameterError(ValueError):
     """A design or model parameter outside its allowed range."""
+
+
+class EnvironmentFault(RuntimeError):
+    """The environment cannot run the computation: a missing or broken module, a shared library
+    that fails to load, a compile failure, out of memory. It says the cause and the fix in one
+    line; runs stop on it before more work, and it is never stored as a design's outcome."""
 
 
 def check_range(
