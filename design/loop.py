@@ -467,7 +467,9 @@ def run_design(
     write_table(table, out / "designs.parquet")
     if files:
         t0 = time.perf_counter()
-        say("[files] fabrication files, pictures and report.html")
+        what = "fabrication files, " if sc.write_files is not None else "(no fabrication files "
+        what += "" if sc.write_files is not None else f"for scenario {sc.name!r}) "
+        say(f"[files] {what}pictures and report.html")
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             summary["files"], summary["images"] = _write_files(

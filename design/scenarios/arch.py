@@ -92,4 +92,6 @@ SCENARIO = Scenario(
     categorical=("m",),
     evaluate_batch=_STRIP.evaluate_batch,
     batch_key=_STRIP.batch_key,
+    shape=_STRIP.shape,
+    write_files=_STRIP.write_files,  # the same seven files as the shipped arch.toml
 )

@@ -96,6 +96,8 @@ SCENARIO = Scenario(
     evaluate=evaluate,
     evaluate_batch=_SHEET.evaluate_batch,
     batch_key=_SHEET.batch_key,
+    shape=_SHEET.shape,
+    write_files=_SHEET.write_files,
     categorical=("pattern", "m", "n"),
     row_timeout=ROW_TIMEOUTS["sheet"],  # rows take 0.5-1.3 s warm
 )

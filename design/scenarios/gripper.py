@@ -38,6 +38,7 @@ import numpy as np
 from holofold.design.scenarios.base import ROW_TIMEOUTS, Column, Scenario, positive, single_thread
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.gripper import DEFAULT_RANGE, GripperPattern, gripper_pattern
+from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.compat import (
     PAPER,
@@ -90,6 +91,8 @@ __all__ = [
     "published_q",
     "decode_closing_step",
     "STATUS_NO_CLOSURE",
+    "gripper_shape",
+    "write_gripper_files",
 ]
 
 # constants of every gripper script (the defaults of GripperMaterial and GripperOptions)
@@ -810,6 +813,24 @@ def evaluate_converged(row) -> dict:
     return simulate(row, CONVERGED_OPTIONS).as_row()
 
 
+def gripper_shape(row) -> CreasePattern:
+    """The design's stress-free (flat) gripper pattern, m."""
+    return gripper_pattern(int(round(row["Pattern"])), row["L1"], row["L2"], row["rate"]).pattern
+
+
+def write_gripper_files(row, folder, units: str = "mm") -> dict:
+    """FOLD, SVG (cut and score lines), STL/OBJ and the thick solid of the flat gripper
+    (:func:`~holofold.geometry.export_pattern_files`; meshes in ``units``). Returns label ->
+    path."""
+    from holofold.geometry import export_pattern_files  # trimesh: only for files
+
+    paths = export_pattern_files(
+        gripper_shape(row), folder, thickness=float(row["tpanel"]), crease_width=float(row["W"]),
+        units=units,
+    )  # fmt: skip
+    return {p.name: p for p in paths}
+
+
 SCENARIO = Scenario(
     name="gripper",
     description=(
@@ -823,6 +844,8 @@ SCENARIO = Scenario(
     evaluate=evaluate,
     categorical=("Pattern",),
     row_timeout=ROW_TIMEOUTS["gripper"],
+    shape=gripper_shape,
+    write_files=write_gripper_files,
 )
 CONVERGED_OPTIONS = GripperOptions(converged=True)
 #: the gripper with tightly converged Newton solves: repeatable outputs for new databases

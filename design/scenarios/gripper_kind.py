@@ -28,11 +28,10 @@ from holofold.design.scenarios.gripper import (
     GripperMaterial,
     GripperOptions,
     check,
+    gripper_shape,
     simulate,
+    write_gripper_files,
 )
-from holofold.geometry import export_pattern_files
-from holofold.geometry.gripper import gripper_pattern
-from holofold.geometry.pattern import CreasePattern
 
 __all__ = [
     "GRIPPER_FEATURES",
@@ -53,22 +52,6 @@ PAPER_OPTIONS = GripperOptions()
 def evaluate_gripper(options: GripperOptions, row) -> dict:
     """freqFinal (rad/s), finalQ (W), Tmax (°C), stiff (N/m) and status of one design."""
     return simulate(row, options).as_row()
-
-
-def gripper_shape(row) -> CreasePattern:
-    """The design's stress-free (flat) gripper pattern, m."""
-    return gripper_pattern(int(round(row["Pattern"])), row["L1"], row["L2"], row["rate"]).pattern
-
-
-def write_gripper_files(row, folder, units: str = "mm") -> dict:
-    """FOLD, SVG (cut and score lines), STL/OBJ and the thick solid of the flat gripper
-    (:func:`~holofold.geometry.export_pattern_files`; meshes in ``units``). Returns label ->
-    path."""
-    paths = export_pattern_files(
-        gripper_shape(row), folder, thickness=float(row["tpanel"]), crease_width=float(row["W"]),
-        units=units,
-    )  # fmt: skip
-    return {p.name: p for p in paths}
 
 
 def gripper_scenario(

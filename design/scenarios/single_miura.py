@@ -96,4 +96,6 @@ SCENARIO = Scenario(
     evaluate=evaluate,
     evaluate_batch=_SHEET.evaluate_batch,
     batch_key=_SHEET.batch_key,
+    shape=_SHEET.shape,
+    write_files=_SHEET.write_files,
 )
