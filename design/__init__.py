@@ -55,6 +55,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "scenarios": [
             "Scenario",
             "Column",
+            "format_value",
+            "DISPLAY_UNITS",
             "SCENARIO_NAMES",
             "get_scenario",
             "load_scenario",
@@ -64,7 +66,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "ScenarioFileError",
         ],
         "store": ["build_database", "generate_database", "load_database"],
-        "tables": ["read_table", "write_table", "check_table_path", "column_roles", "ColumnRoles"],
+        "tables": [
+            "read_table",
+            "write_table",
+            "check_table_path",
+            "column_roles",
+            "table_columns",
+            "ColumnRoles",
+        ],
         "targets": ["parse_target", "Target", "TargetError"],
         "verify": [
             "verify_rule",

@@ -25,6 +25,7 @@ __all__ = [
     "write_table",
     "check_table_path",
     "column_roles",
+    "table_columns",
     "feature_name_file",
 ]
 
@@ -79,6 +80,16 @@ PUBLISHED: dict[str, ColumnRoles] = {
         _SHEET_PERFORMANCE,
         ("pattern", "m", "n"),
     ),
+}
+
+
+#: the shipped scenario each published database was made with (its columns' units)
+PUBLISHED_SCENARIOS = {
+    "data0": "single-miura",
+    "data1": "canopy",
+    "data2": "gripper",
+    "data3": "arch",
+    "data4": "canopy",
 }
 
 
@@ -254,3 +265,50 @@ def column_roles(columns, path=None) -> ColumnRoles | None:
         if cols == set(roles.features + roles.performance):
             return roles
     return None
+
+
+def table_columns(columns, path=None) -> dict:
+    """The :class:`~holofold.design.scenarios.Column` records of a table's columns, where
+    known: name -> Column (unit, display unit, description), for showing values and rules in
+    the units people read.
+
+    A holofold database's ``meta.json`` names its scenario (its file when it still exists, else
+    a shipped scenario of that name; else its stored SI units); a published column set gives the
+    scenario it was made with (:data:`PUBLISHED_SCENARIOS`). Columns of neither are left out
+    (shown as bare numbers).
+    """
+    from holofold.design.scenarios import Column, load_scenario
+
+    cols = [str(c) for c in columns]
+    scenario, units = None, {}
+    if path is not None:
+        meta = Path(path).with_name("meta.json")
+        if meta.is_file():
+            import json
+
+            try:
+                info = json.loads(meta.read_text(encoding="utf-8"))
+                units = {**info.get("features", {}), **info.get("performance", {})}
+                units = {str(k): str(v) for k, v in units.items()}
+                spec = info.get("scenario_file") or info.get("scenario")
+                if spec and (not str(spec).endswith(".toml") or Path(spec).is_file()):
+                    scenario = load_scenario(spec)
+            except (ValueError, KeyError, TypeError, AttributeError, OSError):
+                scenario = None
+    if scenario is None and not units:
+        names = set(cols)
+        for key, roles in PUBLISHED.items():
+            if names == set(roles.features + roles.performance):
+                from holofold.design.scenarios import get_scenario
+
+                scenario = get_scenario(PUBLISHED_SCENARIOS[key])
+                break
+    known = {} if scenario is None else {c.name: c for c in (*scenario.features,
+                                                             *scenario.performance)}  # fmt: skip
+    out = {}
+    for name in cols:
+        if name in known:
+            out[name] = known[name]
+        elif name in units:
+            out[name] = Column(name, units[name])
+    return out

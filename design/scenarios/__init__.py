@@ -8,7 +8,7 @@ performance columns with units and the paper's sampling ranges, a validity check
 
 from __future__ import annotations
 
-from holofold.design.scenarios.base import Column, Scenario
+from holofold.design.scenarios.base import DISPLAY_UNITS, Column, Scenario, format_value
 from holofold.design.scenarios.config import ScenarioFileError
 from holofold.design.scenarios.files import (
     load_scenario,
@@ -20,6 +20,8 @@ from holofold.design.scenarios.files import (
 __all__ = [
     "Column",
     "Scenario",
+    "format_value",
+    "DISPLAY_UNITS",
     "SCENARIO_NAMES",
     "get_scenario",
     "load_scenario",

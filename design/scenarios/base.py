@@ -18,7 +18,53 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import partial
 
-__all__ = ["Column", "Scenario", "single_thread", "check_row", "ROW_TIMEOUTS"]
+__all__ = [
+    "Column",
+    "Scenario",
+    "single_thread",
+    "check_row",
+    "ROW_TIMEOUTS",
+    "DISPLAY_UNITS",
+    "format_value",
+]
+
+#: SI unit -> the display units it may be shown in, with the factor (display value = SI value x
+#: factor). A column's ``display`` must be one of its unit's entries; units not listed here are
+#: shown as they are.
+DISPLAY_UNITS: dict[str, dict[str, float]] = {
+    "m": {"m": 1.0, "mm": 1e3, "um": 1e6},
+    "rad": {"rad": 1.0, "deg": 180.0 / math.pi},
+    "m^3": {"m^3": 1.0, "cm^3": 1e6, "mm^3": 1e9},
+    "kg": {"kg": 1.0, "g": 1e3},
+    "Pa": {"Pa": 1.0, "MPa": 1e-6, "GPa": 1e-9},
+}
+
+
+def _default_display(unit: str, low: float | None, high: float | None) -> str:
+    """The display unit of a column that names none: degrees for angles; for a length with a
+    range, um below 0.1 mm, mm up to 1 m; otherwise the SI unit itself (performance columns
+    keep theirs, so values read like the targets written over them)."""
+    if unit == "rad":
+        return "deg"
+    if unit == "m" and low is not None and high is not None:
+        top = max(abs(low), abs(high))
+        return "um" if top < 1e-4 else "mm" if top <= 1.0 else "m"
+    return unit
+
+
+def format_value(value: float, column: Column | None = None, *, digits: int = 3) -> str:
+    """One value (SI) as people read it: in the column's display unit, labelled.
+
+    ``format_value(7.792e-4, tcrease)`` is ``"0.779 mm"``; ``digits`` significant digits; a
+    unitless column (``"-"``) or no column gives the number alone; infinite values read
+    ``inf``. The one formatting function for values and thresholds in text, pages and charts.
+    """
+    v = float(value)
+    if column is None:
+        return _number(v, digits)
+    shown = _number(v * column.display_factor, digits)
+    unit = column.display_unit
+    return shown if unit in ("", "-") else f"{shown} {unit}"
 
 
 def single_thread():
@@ -35,6 +81,16 @@ def single_thread():
 #: 6): over 100x the slowest row and at least 60 s, 4-7x the first row of a process whose numba
 #: kernels are compiled rather than loaded from their cache (9-13 s); docs/scenarios.md §1.3
 ROW_TIMEOUTS = {"": 60.0, "strip": 60.0, "sheet": 300.0, "gripper": 600.0}
+
+
+def _number(v: float, digits: int) -> str:
+    """``digits`` significant digits, without an exponent from 1e-4 up to 1e6 (6000, not
+    6e+03)."""
+    text = f"{v:.{digits}g}"
+    r = float(text)
+    if math.isfinite(r) and 10**digits <= abs(r) < 1e6:
+        return f"{r:.0f}"
+    return text
 
 
 @dataclass(frozen=True)
@@ -57,6 +113,11 @@ class Column:
         False for optional features (with ``default``).
     default : float or None
         Value used when an optional feature is missing.
+    display : str
+        The unit people read the column in (rules, designs, reports): one of
+        :data:`DISPLAY_UNITS` of ``unit`` ("mm" for a thickness in "m", "deg" for "rad");
+        ``""``: derived from the unit and range (``display_unit``). Values stay SI everywhere
+        else.
     """
 
     name: str
@@ -67,6 +128,38 @@ class Column:
     choices: tuple[float, ...] = ()
     required: bool = True
     default: float | None = None
+    display: str = ""
+
+    def __post_init__(self):
+        if self.display and self.display != self.unit:
+            allowed = DISPLAY_UNITS.get(self.unit, {self.unit: 1.0})
+            if self.display not in allowed:
+                raise ValueError(
+                    f"column {self.name!r}: display unit {self.display!r} is not one of "
+                    f"{', '.join(allowed)} (unit {self.unit!r})"
+                )
+
+    @property
+    def display_unit(self) -> str:
+        """The unit the column is shown in (``display``, or derived from unit and range)."""
+        return self.display or _default_display(self.unit, self.low, self.high)
+
+    @property
+    def display_factor(self) -> float:
+        """Display value per SI value (1e3 for m shown in mm)."""
+        return DISPLAY_UNITS.get(self.unit, {}).get(self.display_unit, 1.0)
+
+    def to_display(self, value):
+        """``value`` (SI, a number or an array) in the display unit."""
+        return value * self.display_factor
+
+    def from_display(self, value):
+        """``value`` given in the display unit, in SI."""
+        return value / self.display_factor
+
+    def format(self, value: float, digits: int = 3) -> str:
+        """:func:`format_value` of ``value`` (SI) in this column's display unit."""
+        return format_value(value, self, digits=digits)
 
     def out_of_range(self, value: float) -> str | None:
         """A warning text if ``value`` is outside the paper's sampling range, else None."""

@@ -763,13 +763,13 @@ def _history(model: GripperModel, heating: HeatingResult, prying: PryingResult |
 
 FEATURES = (
     Column("Pattern", "-", "1 Miura-based, 2 splitted Miura, 3 two-panel", choices=(1, 2, 3)),
-    Column("L1", "m", "arm length", 3e-3, 7e-3),
-    Column("L2", "m", "arm width", 2e-3, 4e-3),
-    Column("t1", "m", "bimorph layer 1 thickness", 0.15e-6, 0.25e-6),
-    Column("t2", "m", "bimorph layer 2 thickness", 0.6e-6, 1.0e-6),
-    Column("tpanel", "m", "panel thickness", 10e-6, 30e-6),
+    Column("L1", "m", "arm length", 3e-3, 7e-3, display="mm"),
+    Column("L2", "m", "arm width", 2e-3, 4e-3, display="mm"),
+    Column("t1", "m", "bimorph layer 1 thickness", 0.15e-6, 0.25e-6, display="um"),
+    Column("t2", "m", "bimorph layer 2 thickness", 0.6e-6, 1.0e-6, display="um"),
+    Column("tpanel", "m", "panel thickness", 10e-6, 30e-6, display="um"),
     Column("rate", "-", "tip-segment fraction of L1", 0.2, 0.6),
-    Column("W", "m", "crease width", 100e-6, 300e-6),
+    Column("W", "m", "crease width", 100e-6, 300e-6, display="um"),
 )
 PERFORMANCE = (
     Column("freqFinal", "rad/s", "lowest angular natural frequency of the flat gripper"),

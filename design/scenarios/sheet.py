@@ -110,12 +110,32 @@ SHEET_FEATURES = (
     Column("pattern", "-", "1 = Miura-ori, 2 = TMP", choices=(1.0, 2.0)),
     Column("m", "-", "panels along x (TMP: even)", choices=(24.0, 30.0, 36.0)),
     Column("n", "-", "panels along y (TMP: multiple of 3)", choices=(6.0, 9.0, 12.0)),
-    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3),
-    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3),
-    Column("W", "m", "crease width", 1e-3, 4e-3),
-    Column("gama", "rad", "Miura sector angle gamma", math.radians(50), math.radians(80)),
-    Column("creaseE", "Pa", "crease Young's modulus", 1e9, 5e9, required=False, default=2e9),
-    Column("panelE", "Pa", "panel Young's modulus", 1e9, 5e9, required=False, default=2e9),
+    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3, display="mm"),
+    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3, display="mm"),
+    Column("W", "m", "crease width", 1e-3, 4e-3, display="mm"),
+    Column(
+        "gama", "rad", "Miura sector angle gamma", math.radians(50), math.radians(80), display="deg"
+    ),
+    Column(
+        "creaseE",
+        "Pa",
+        "crease Young's modulus",
+        1e9,
+        5e9,
+        required=False,
+        default=2e9,
+        display="GPa",
+    ),
+    Column(
+        "panelE",
+        "Pa",
+        "panel Young's modulus",
+        1e9,
+        5e9,
+        required=False,
+        default=2e9,
+        display="GPa",
+    ),
 )
 _OPTIONAL_E = ("creaseE", "panelE")
 

@@ -98,12 +98,12 @@ __all__ = [
 #: the strip's design features with the paper's arch ranges (docs/scenarios.md §5)
 STRIP_FEATURES = (
     Column("m", "-", "number of Miura units", choices=(8.0, 12.0, 16.0, 24.0)),
-    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3),
-    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3),
-    Column("W", "m", "crease width", 1e-3, 4e-3),
-    Column("offset", "m", "zigzag offset l_o of the middle vertices", 0.10, 0.30),
-    Column("stripeWidth", "m", "side-line shift W_s", 0.01, 0.04),
-    Column("extrude", "m", "half-width l_e of the strip", 0.05, 0.25),
+    Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3, display="mm"),
+    Column("tpanel", "m", "panel thickness", 1e-3, 6e-3, display="mm"),
+    Column("W", "m", "crease width", 1e-3, 4e-3, display="mm"),
+    Column("offset", "m", "zigzag offset l_o of the middle vertices", 0.10, 0.30, display="mm"),
+    Column("stripeWidth", "m", "side-line shift W_s", 0.01, 0.04, display="mm"),
+    Column("extrude", "m", "half-width l_e of the strip", 0.05, 0.25, display="mm"),
 )
 
 #: support choices: which nodes of the strip are fixed
