@@ -28,7 +28,16 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "assembly": ["Assembler", "BatchAssembler", "SingularSystemError"],
         "bars": ["bar_forces", "bar_strain"],
         "compat": ["Profile", "PAPER", "PHYSICAL"],
+        "folding": [
+            "fold_pattern",
+            "FoldResult",
+            "fold_targets",
+            "crease_classes",
+            "default_supports",
+            "MAX_FOLD_DEG",
+        ],
         "hinges": ["build_concentrated", "build_compliant", "crease_rest_targets"],
+        "measures": ["model_energy", "ModelEnergy"],
         "modal": ["lumped_mass", "natural_frequencies", "eigenvalues"],
         "solvers": [
             "solve_newton",

@@ -1,0 +1,506 @@
+"""Fold a crease pattern towards its fold angles by rest-angle actuation, and say how far it got.
+
+:func:`fold_pattern` builds the bar-and-hinge model of a pattern in its flat layout (or its
+as-built 3-D state when it has none) with a real material and section, then drives the rest
+angle of every mountain and valley crease from flat towards ``fraction`` x its target fold
+angle (Origami Simulator's "fold percent"), one Newton-converged step at a time
+(:func:`~holofold.mechanics.solvers.solve_selffold`, one increment per call). A step that does
+not converge is retried at half the size, down to 1/16 of the nominal step; then the fold stops
+there and the result says so. Nothing is loaded: the model only moves where its rest angles
+take it.
+
+What each assignment becomes (FOLD codes):
+
+* ``M``, ``V``: driven creases, rest angle ``pi + f phi`` (``phi`` the target in radians,
+  valley > 0). A target of 0 on an M or V crease means "fold fully": -180 or +180 degrees, the
+  convention of Origami Simulator and of holofold's flat sheets. Targets are capped at
+  :data:`MAX_FOLD_DEG` (the dihedral angle of a spring wraps at +-180 degrees).
+* ``F``, ``J``: facets (Origami Simulator's yellow lines, triangulation edges): springs of the
+  panel's thickness over the crease width, kept flat.
+* ``U`` and any other interior edge: passive creases of the crease section, kept flat (no
+  target).
+
+Supports: by default one panel per connected piece (the one nearest the piece's centroid) is
+fixed, which removes the rigid-body motion and nothing else.
+
+The result (:class:`FoldResult`) keeps the path (the vertex coordinates after every step), the
+fraction reached with every step converged, the fold progress (how far the driven creases
+actually turned, length-weighted, against their targets) and a one-line verdict: ``folds
+rigidly``, ``does not fold rigidly`` (panels take more than :data:`RIGID_PANEL_SHARE` of the
+energy, or driven creases turn less than :data:`STUCK_RATIO` of their actuated target),
+``bifurcation at flat`` (driven creases folded the wrong way: the solve left the flat
+state on another branch) or ``stalls`` (a step would not converge).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.compat import PHYSICAL, Profile
+from holofold.mechanics.hinges import build_compliant, build_concentrated, crease_rest_targets
+from holofold.mechanics.measures import ModelEnergy, model_energy
+from holofold.mechanics.status import CONVERGED, Status
+from holofold.mechanics.structure import Structure
+
+__all__ = [
+    "FoldResult",
+    "fold_pattern",
+    "fold_targets",
+    "crease_classes",
+    "default_supports",
+    "MAX_FOLD_DEG",
+    "RIGID_PANEL_SHARE",
+    "MODELS",
+]
+
+#: the largest driven fold angle, degrees: a spring's dihedral angle wraps at +-180
+MAX_FOLD_DEG = 179.0
+#: a fold whose panels store more than this share of the energy does not fold rigidly
+RIGID_PANEL_SHARE = 0.10
+#: a driven crease counts as folded the wrong way beyond this angle of the wrong sign, degrees
+WRONG_WAY_DEG = 10.0
+#: the bar-and-hinge models a pattern can be folded with
+MODELS = ("concentrated", "compliant")
+#: a driven crease that turns less than this share of its actuated target is stuck
+STUCK_RATIO = 0.25
+_MAX_HALVINGS = 4
+
+DRIVEN, FACET, PASSIVE = 0, 1, 2
+
+
+def crease_classes(pattern: CreasePattern) -> np.ndarray:
+    """(ne,) int8: 0 driven (M, V), 1 facet (F, J), 2 passive (U and any other interior
+    edge), -1 not a crease (border, cut, or any edge of one face)."""
+    a = pattern.assignment
+    out = np.full(pattern.n_edges, PASSIVE, np.int8)
+    out[np.isin(a, ("M", "V"))] = DRIVEN
+    out[np.isin(a, ("F", "J"))] = FACET
+    out[~pattern.interior] = -1
+    return out
+
+
+def fold_targets(pattern: CreasePattern, target=None) -> np.ndarray:
+    """(ne,) float: the full-fold target of every edge, degrees (FOLD sign: valley > 0).
+
+    ``target`` (ne,) degrees, default ``pattern.fold_angle``; M/V creases with target 0 get
+    -180/+180; capped at +-:data:`MAX_FOLD_DEG`; 0 for every edge that is not driven.
+    """
+    t = pattern.fold_angle if target is None else np.asarray(target, float)
+    if t.shape != (pattern.n_edges,) or not np.isfinite(t).all():
+        raise ParameterError(
+            f"target must be {pattern.n_edges} finite fold angles (degrees), got shape {t.shape}"
+        )
+    cls = crease_classes(pattern)
+    a = pattern.assignment
+    full = np.where(a == "M", -180.0, 180.0)
+    t = np.where((cls == DRIVEN) & (t == 0.0), full, t)
+    t = np.where(cls == DRIVEN, np.clip(t, -MAX_FOLD_DEG, MAX_FOLD_DEG), 0.0)
+    return t
+
+
+def _components(pattern: CreasePattern) -> np.ndarray:
+    """(nf,) label of the connected piece of every face (faces joined across interior edges)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    nf = pattern.n_faces
+    sizes = np.array([len(f) for f in pattern.faces])
+    owner = np.repeat(np.arange(nf), sizes)
+    fv = np.concatenate(pattern.faces)
+    nxt = np.concatenate([np.roll(f, -1) for f in pattern.faces])
+    nv = pattern.n_vertices
+    key = np.minimum(fv, nxt).astype(np.int64) * nv + np.maximum(fv, nxt)
+    order = np.argsort(key, kind="stable")
+    k = key[order]
+    same = np.flatnonzero(k[1:] == k[:-1])
+    a, b = owner[order[same]], owner[order[same + 1]]
+    g = coo_matrix((np.ones(len(a)), (a, b)), shape=(nf, nf))
+    return connected_components(g, directed=False)[1]
+
+
+def default_supports(pattern: CreasePattern, structure: Structure) -> np.ndarray:
+    """Node ids fixed by default: in every connected piece, the nodes of the panel whose
+    centroid is nearest the piece's centroid (vertex copies in that panel and its centre)."""
+    xy = pattern.flat if pattern.flat is not None else pattern.coords[:, :2]
+    label = _components(pattern)
+    cent = np.array([xy[f].mean(axis=0) for f in pattern.faces])
+    nodes = []
+    for c in np.unique(label):
+        faces = np.flatnonzero(label == c)
+        mid = cent[faces].mean(axis=0)
+        p = int(faces[np.argmin(np.linalg.norm(cent[faces] - mid, axis=1))])
+        nodes.append(structure.vertex_nodes(pattern.faces[p], panel=p))
+        if structure.panel_centres is not None:
+            nodes.append([structure.panel_centres[p]])
+    return np.unique(np.concatenate(nodes)).astype(np.intp)
+
+
+@dataclass(frozen=True, eq=False)
+class FoldResult:
+    """The path of a rest-angle fold and how far it got.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+        The pattern as modelled, in the state the model was built in (flat where it has a
+        flat layout); its fold angles are the input's.
+    structure : Structure
+        The model (stress-free in that state, supports set).
+    target : (ne,) float
+        Full-fold target of every edge, degrees (:func:`fold_targets`).
+    requested : float
+        The fraction of the targets asked for.
+    fractions : (k,) float
+        Actuation fraction of every stored state, from 0 (the start).
+    U : (k, nn, 3) float
+        Node displacements of every stored state, m.
+    coords : (k, nv, 3) float
+        Pattern vertex coordinates of every state, m (the mean of a vertex's node copies in a
+        compliant model).
+    fold_angles : (k, ne) float
+        Measured fold angles of every state, degrees (FOLD sign).
+    rest : (ns,) float
+        Spring rest angles of the last state, rad.
+    status : Status
+        Converged (every step met the tolerance up to ``requested``) or not converged, why.
+    verdict : str
+        ``folds rigidly``, ``does not fold rigidly``, ``bifurcation at flat`` or ``stalls``.
+    note : str
+        One sentence behind the verdict (numbers).
+    energy : ModelEnergy
+        Energy by panel and crease in the last state.
+    wrong_way : (n,) int
+        Driven creases folded against their assignment in the last state.
+    halvings : int
+        Steps retried at a smaller size.
+    """
+
+    pattern: CreasePattern
+    structure: Structure
+    target: np.ndarray
+    requested: float
+    fractions: np.ndarray
+    U: np.ndarray
+    coords: np.ndarray
+    fold_angles: np.ndarray
+    rest: np.ndarray
+    status: Status
+    verdict: str
+    note: str
+    energy: ModelEnergy
+    wrong_way: np.ndarray = field(default_factory=lambda: np.zeros(0, np.intp))
+    halvings: int = 0
+
+    @property
+    def reached(self) -> float:
+        """The actuation fraction reached with every step converged."""
+        return float(self.fractions[-1])
+
+    @property
+    def progress(self) -> float:
+        """How far the driven creases turned, against their full targets: the sum of
+        length x measured angle (signed by the target) over the sum of length x |target|,
+        in the last state (1 = every driven crease at its full target)."""
+        return _progress(self.pattern, self.target, self.fold_angles[-1])
+
+    @property
+    def complete(self) -> bool:
+        """True when the requested fraction was reached."""
+        return self.reached >= self.requested - 1e-12
+
+    def folded(self, state: int = -1) -> CreasePattern:
+        """The pattern in stored state ``state`` (default the last): its vertices moved, flat
+        layout, faces and assignments kept, fold angles measured."""
+        a = self.fold_angles[state]
+        asg = self.pattern.assignment.copy()
+        cls = crease_classes(self.pattern)
+        keep = np.isin(asg, ("B", "C")) | ~self.pattern.interior
+        ang = np.where(keep, 0.0, a)
+        mv = cls == DRIVEN
+        asg[mv] = np.where(ang[mv] > 0, "V", np.where(ang[mv] < 0, "M", asg[mv]))
+        ang = np.where(np.isin(asg, ("F", "J")), 0.0, ang)  # facets stay F/J: angle 0
+        from dataclasses import replace
+
+        return replace(self.pattern, coords=self.coords[state], fold_angle=ang, assignment=asg)
+
+    def summary(self) -> str:
+        """One line: verdict, fraction reached of the requested, fold progress, note."""
+        return (
+            f"{self.verdict}: reached {100 * self.reached:.0f} % of {100 * self.requested:.0f} % "
+            f"(fold progress {100 * self.progress:.0f} %); {self.note}"
+        )
+
+
+def _progress(pattern: CreasePattern, target: np.ndarray, measured: np.ndarray) -> float:
+    driven = (crease_classes(pattern) == DRIVEN) & (target != 0)
+    if not driven.any():
+        return 1.0
+    L = pattern.flat_edge_lengths if pattern.flat is not None else pattern.edge_lengths
+    w = L[driven]
+    turned = (w * measured[driven] * np.sign(target[driven])).sum()
+    return float(turned / (w * np.abs(target[driven])).sum())
+
+
+def _section(value, n: int, name: str) -> np.ndarray:
+    a = np.asarray(value, float)
+    a = np.full(n, float(a)) if a.ndim == 0 else a
+    if a.shape != (n,) or not np.isfinite(a).all() or (a <= 0).any():
+        raise ParameterError(f"{name} must be a positive number or {n} positive numbers")
+    return a
+
+
+def fold_pattern(
+    pattern: CreasePattern,
+    fraction: float = 1.0,
+    *,
+    panel_thickness,
+    crease_thickness,
+    crease_width,
+    E: float = 2e9,
+    nu: float = 0.3,
+    model: str = "concentrated",
+    target=None,
+    supports=None,
+    max_step_deg: float = 3.0,
+    rel_tol: float = 1e-7,
+    max_iter: int = 30,
+    profile: Profile = PHYSICAL,
+) -> FoldResult:
+    """Fold ``pattern`` towards ``fraction`` x its target fold angles (see the module
+    docstring).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+        Flat crease pattern (its ``flat`` layout) or an as-built 3-D pattern without one.
+    fraction : float
+        Fold fraction in [0, 1] (Origami Simulator's fold percent / 100).
+    panel_thickness : float or (nf,) float
+        m.
+    crease_thickness, crease_width : float or (ne,) float
+        m (facets take the panel thickness).
+    E, nu : float
+        Young's modulus (Pa) and Poisson's ratio of panels and creases.
+    model : {"concentrated", "compliant"}
+        One rotational spring per crease, or creases of finite width.
+    target : (ne,) float, optional
+        Full-fold targets, degrees (default ``pattern.fold_angle``; see :func:`fold_targets`).
+    supports : node ids, optional
+        Fixed nodes of the model (all three directions); default :func:`default_supports`.
+    max_step_deg : float
+        Largest change of any driven rest angle per step, degrees.
+    rel_tol : float
+        Newton tolerance on the residual, relative to the force the full actuation exerts on
+        the unfolded model.
+    max_iter : int
+        Newton iteration cap per step (``max_iter - 1`` iterations).
+    profile : Profile
+        Model switches (default :data:`~holofold.mechanics.compat.PHYSICAL`).
+
+    Returns
+    -------
+    FoldResult
+    """
+    from holofold.mechanics.assembly import Assembler
+    from holofold.mechanics.solvers import solve_selffold
+
+    fraction = check_range("fraction", fraction, 0.0, 1.0)
+    max_step_deg = check_range("max_step_deg", max_step_deg, 0.0, 90.0, low_open=True)
+    rel_tol = check_range("rel_tol", rel_tol, 0.0, 1.0, low_open=True)
+    if model not in MODELS:
+        raise ParameterError(f"model = {model!r}; allowed: {', '.join(MODELS)}")
+    if not pattern.faces:
+        raise ParameterError("the pattern has no faces to fold")
+    if pattern.flat is not None:
+        base = CreasePattern(
+            np.column_stack([pattern.flat, np.zeros(pattern.n_vertices)]),
+            pattern.faces, pattern.edges, pattern.assignment, pattern.fold_angle,
+            flat=pattern.flat, meta=pattern.meta,
+        )  # fmt: skip
+    else:
+        base = pattern
+    ne, nf = base.n_edges, base.n_faces
+    cls = crease_classes(base)
+    tgt = fold_targets(base, target)
+    tp = _section(panel_thickness, nf, "panel_thickness")
+    tc = _section(crease_thickness, ne, "crease_thickness")
+    W = _section(crease_width, ne, "crease_width")
+    # facets: the thinner adjacent panel's thickness
+    facet = cls == FACET
+    if facet.any():
+        fmin = np.full(ne, np.inf)
+        sizes = np.array([len(f) for f in base.faces])
+        np.minimum.at(fmin, _face_edges(base), np.repeat(tp, sizes))
+        tc = np.where(facet & np.isfinite(fmin), fmin, tc)
+    build = build_concentrated if model == "concentrated" else build_compliant
+    structure = build(
+        base, crease_width=W, crease_thickness=tc, panel_thickness=tp, E_panel=E, E_crease=E,
+        nu_panel=nu, nu_crease=nu, profile=profile,
+    )  # fmt: skip
+    fixed = default_supports(base, structure) if supports is None else supports
+    structure = structure.fixed(np.asarray(fixed, np.intp), "xyz")
+    base_angle = np.full(ne, math.pi)  # crease-level rest angle per edge (spring convention)
+
+    def rest(f: float) -> np.ndarray:
+        theta = base_angle + np.radians(f * tgt)
+        return crease_rest_targets(structure, theta, profile=profile)
+
+    asm = Assembler(structure)
+    nn = structure.n_nodes
+    U = np.zeros((nn, 3))
+    _, f_full = asm.internal_force(U, rest(max(fraction, 1e-3)))
+    scale = float(np.linalg.norm(f_full[asm.free_dofs]))
+    tol = rel_tol * scale if scale > 0 else 1e-12
+    top = float(np.abs(tgt).max(initial=0.0)) * fraction
+    n_steps = max(2, math.ceil(top / max_step_deg)) if top > 0 else 1
+    h0 = fraction / n_steps
+    done, h, halvings = 0.0, h0, 0
+    fr, Us = [0.0], [U.copy()]
+    stalled = ""
+    while done < fraction - 1e-12:
+        nxt = done + h
+        if nxt > fraction - 1e-9 * h0:
+            nxt = fraction
+        res = solve_selffold(
+            structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
+            max_iter=max_iter, U0=U, assembler=asm,
+        )  # fmt: skip
+        if res.ok and np.isfinite(res.U).all():
+            U = res.U.copy()
+            done = nxt
+            fr.append(done)
+            Us.append(U.copy())
+            h = min(h0, 2.0 * h)
+            continue
+        if h <= h0 / 2**_MAX_HALVINGS:
+            why = "; ".join(res.status.reasons) or "non-finite displacement"
+            stalled = f"step {100 * done:.1f} -> {100 * nxt:.1f} % does not converge ({why})"
+            break
+        h *= 0.5
+        halvings += 1
+    fractions = np.array(fr)
+    Uh = np.stack(Us)
+    coords = _vertex_coords(base, structure, Uh)
+    angles = _fold_angles(base, structure, Uh)
+    final_rest = rest(done)
+    energy = model_energy(structure, Uh[-1], final_rest, n_edges=ne)
+    driven = (cls == DRIVEN) & (tgt != 0)
+    last = angles[-1]
+    against = (np.sign(last) != np.sign(tgt)) & (np.abs(last) > WRONG_WAY_DEG)
+    wrong = np.flatnonzero(driven & against)
+    ratio = np.where(driven, last / np.where(tgt != 0, tgt, 1.0), 1.0)
+    stuck = np.flatnonzero(driven & (ratio < STUCK_RATIO * done)) if done > 0 else wrong[:0]
+    e_flat = asm.internal_force(np.zeros((nn, 3)), final_rest)[0]  # held flat: the reference
+    share = energy.panel_share if energy.total > 1e-9 * e_flat else 0.0
+    if stalled:
+        verdict = "stalls"
+        note = stalled
+        status = Status.not_converged(f"fold stops at {100 * done:.1f} %: {stalled}")
+    else:
+        status = CONVERGED
+        if wrong.size:
+            verdict = "bifurcation at flat"
+            note = (
+                f"{wrong.size} of {int(driven.sum())} driven creases folded against their "
+                f"assignment (first: edge {int(wrong[0])})"
+            )
+        elif stuck.size:
+            verdict = "does not fold rigidly"
+            note = (
+                f"{stuck.size} of {int(driven.sum())} driven creases turn less than "
+                f"{100 * STUCK_RATIO:.0f} % of their target (first: edge {int(stuck[0])}); "
+                f"panels store {100 * share:.0f} % of the energy"
+            )
+        elif share > RIGID_PANEL_SHARE:
+            verdict = "does not fold rigidly"
+            note = (
+                f"panels store {100 * share:.0f} % of the energy; largest panel strain "
+                f"{energy.panel_strain.max(initial=0.0):.2g}"
+            )
+        else:
+            verdict = "folds rigidly"
+            if energy.total <= 1e-9 * e_flat:
+                note = "the folded state is stress free (the targets are compatible)"
+            else:
+                note = f"panels store {100 * share:.1f} % of the energy"
+    if stalled and wrong.size:
+        note += f"; {wrong.size} driven creases folded against their assignment"
+    return FoldResult(
+        pattern=base, structure=structure, target=tgt, requested=fraction, fractions=fractions,
+        U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
+        verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
+    )  # fmt: skip
+
+
+def _face_edges(pattern: CreasePattern) -> np.ndarray:
+    """Edge id of every face side (corner to next corner), faces concatenated."""
+    nv = pattern.n_vertices
+    keys = pattern.edges[:, 0].astype(np.int64) * nv + pattern.edges[:, 1]
+    order = np.argsort(keys)
+    face = np.concatenate(pattern.faces)
+    nxt = np.concatenate([np.roll(f, -1) for f in pattern.faces])
+    q = np.minimum(face, nxt).astype(np.int64) * nv + np.maximum(face, nxt)
+    return order[np.searchsorted(keys, q, sorter=order)]
+
+
+def _fold_angles(pattern: CreasePattern, structure: Structure, Uh: np.ndarray) -> np.ndarray:
+    """(k, ne) fold angles, degrees (FOLD sign), from the normals of the panels as modelled
+    (their own node copies in a compliant model, so a crease strip's width does not distort
+    them); 0 for edges of one face."""
+    X = structure.nodes[None] + Uh
+    sizes = np.array([len(f) for f in pattern.faces])
+    fv = np.concatenate(pattern.faces)
+    owner = np.repeat(np.arange(len(sizes)), sizes)
+    start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    nxt = np.arange(len(fv)) + 1
+    nxt[start + sizes - 1] = start
+    if structure.creases is not None and structure.creases.compliant:
+        corner = np.arange(len(fv))  # corner q of the faces is node q (docs/bar-and-hinge.md §4.1)
+    else:
+        corner = fv
+    P = X[:, corner]  # (k, N, 3)
+    cr = np.cross(P, P[:, nxt])
+    n = np.stack([np.stack([np.bincount(owner, weights=c[:, d], minlength=len(sizes))
+                            for d in range(3)], -1) for c in cr])  # fmt: skip
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-300)
+    nv = pattern.n_vertices
+    a, b = fv, fv[nxt]
+    key = np.minimum(a, b).astype(np.int64) * nv + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    k = key[order]
+    pair = np.flatnonzero(k[1:] == k[:-1])
+    i, j = order[pair], order[pair + 1]  # two occurrences of one interior edge
+    ekeys = pattern.edges[:, 0].astype(np.int64) * nv + pattern.edges[:, 1]
+    eorder = np.argsort(ekeys)
+    e = eorder[np.searchsorted(ekeys, key[i], sorter=eorder)]
+    Xv = _vertex_coords(pattern, structure, Uh)
+    t = Xv[:, b[i]] - Xv[:, a[i]]
+    t /= np.maximum(np.linalg.norm(t, axis=-1, keepdims=True), 1e-300)
+    na, nb = n[:, owner[i]], n[:, owner[j]]
+    s = -np.einsum("kij,kij->ki", np.cross(na, nb), t)
+    c = np.einsum("kij,kij->ki", na, nb)
+    out = np.zeros((len(Uh), pattern.n_edges))
+    out[:, e] = np.degrees(np.arctan2(s, c))
+    return out
+
+
+def _vertex_coords(pattern: CreasePattern, structure: Structure, Uh: np.ndarray) -> np.ndarray:
+    """(k, nv, 3) vertex positions: the mean of each vertex's nodes."""
+    X = structure.nodes[None] + Uh
+    nv = pattern.n_vertices
+    nvx = structure.node_vertex
+    if nvx is None:
+        return X[:, :nv]
+    ok = nvx >= 0
+    idx = nvx[ok]
+    out = np.zeros((len(Uh), nv, 3))
+    cnt = np.bincount(idx, minlength=nv).astype(float)
+    for d in range(3):
+        for s in range(len(Uh)):
+            out[s, :, d] = np.bincount(idx, weights=X[s, ok, d], minlength=nv)
+    return out / np.maximum(cnt, 1.0)[None, :, None]

@@ -1,0 +1,145 @@
+"""Where a deformed bar-and-hinge model stores its energy: per panel and per crease.
+
+:func:`model_energy` splits the elastic energy of a :class:`~holofold.mechanics.structure.Structure`
+at a displacement ``U`` (and rest angles) over the pattern's panels and creases, and gives the
+largest bar strain of each panel::
+
+    panel_energy   (nf,) J   the panel's bars (a bar on an edge shared by two panels split in
+                             half) and its bending springs
+    panel_strain   (nf,) -   largest |Green-Lagrange strain| of the panel's bars
+    crease_energy  (ne,) J   per pattern edge: its hinge (concentrated) or its strip's bars and
+                             springs (compliant); 0 for edges that are not creases
+
+Bars and springs are assigned through the model's triangles (``tri_panel``, ``tri_crease``):
+a bar belongs to the panels or creases whose triangles have it as a side, a panel spring to
+the panel of its hinge bar, a crease spring to ``spring_crease``. A rigid-folding pattern keeps
+almost all of its energy in the creases; panels that carry a large share bend or stretch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from holofold.mechanics.bars import bar_strain
+from holofold.mechanics.structure import SpringRole, Structure
+
+__all__ = ["ModelEnergy", "model_energy"]
+
+
+@dataclass(frozen=True)
+class ModelEnergy:
+    """Energy of a deformed model by panel and by crease (see the module docstring).
+
+    Attributes
+    ----------
+    panel_energy : (nf,) float
+        J.
+    panel_strain : (nf,) float
+        Largest |strain| of each panel's bars (dimensionless).
+    crease_energy : (ne,) float
+        J, per pattern edge (0 where the edge is not a crease).
+    total : float
+        Energy of the whole model, J (the sum of the two splits up to bars of no panel or
+        crease, which the builders do not make).
+    """
+
+    panel_energy: np.ndarray
+    panel_strain: np.ndarray
+    crease_energy: np.ndarray
+    total: float
+
+    @property
+    def panel_share(self) -> float:
+        """Fraction of the total energy stored in the panels (0 when there is no energy)."""
+        return float(self.panel_energy.sum() / self.total) if self.total > 0 else 0.0
+
+
+def _bar_owners(structure: Structure):
+    """For each triangle side that is a bar: (bar id, panel or -1, crease or -1)."""
+    tri = structure.triangles
+    nn = structure.n_nodes
+    sides = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    owner_p = np.tile(structure.tri_panel, 3)
+    owner_c = np.tile(structure.tri_crease, 3)
+    keys = np.minimum(sides[:, 0], sides[:, 1]).astype(np.int64) * nn + sides.max(axis=1)
+    b = structure.bars
+    bkeys = np.minimum(b[:, 0], b[:, 1]).astype(np.int64) * nn + b.max(axis=1)
+    order = np.argsort(bkeys)
+    pos = np.minimum(np.searchsorted(bkeys[order], keys), len(order) - 1)
+    bar = order[pos]
+    hit = bkeys[bar] == keys
+    return bar[hit], owner_p[hit], owner_c[hit]
+
+
+def model_energy(
+    structure: Structure, U, spring_rest=None, *, n_edges: int | None = None
+) -> ModelEnergy:
+    """Energy by panel and crease, and the largest bar strain per panel, at displacement ``U``.
+
+    Parameters
+    ----------
+    structure : Structure
+        Built by :func:`~holofold.mechanics.hinges.build_concentrated` or
+        :func:`~holofold.mechanics.hinges.build_compliant` (it needs ``tri_panel`` and
+        ``tri_crease``).
+    U : (nn, 3) float
+        Displacement, m.
+    spring_rest : (ns,) float, optional
+        Rest angles (default ``structure.spring_rest``), rad.
+    n_edges : int, optional
+        Number of pattern edges (length of ``crease_energy``; default: the largest crease id
+        + 1).
+    """
+    from holofold.mechanics.assembly import Assembler
+
+    U = np.asarray(U, float).reshape(-1, 3)
+    bar_resp, spring_resp = Assembler(structure).element_response(U, spring_rest, tangent=False)
+    eb = np.asarray(bar_resp.energy, float).reshape(-1)
+    es = np.asarray(spring_resp.energy, float).reshape(-1)
+    nf = len(structure.panel_centres) if structure.panel_centres is not None else 0
+    nf = max(nf, int(structure.tri_panel.max(initial=-1)) + 1)
+    if n_edges is None:
+        top = max(structure.spring_crease.max(initial=-1), structure.tri_crease.max(initial=-1))
+        n_edges = int(top) + 1
+    strain = np.abs(bar_strain(structure.nodes, U, structure.bars, structure.bar_length))
+
+    bar, pan, cre = _bar_owners(structure)
+    # a bar shared by k owners gives each 1/k of its energy
+    _, inv, counts = np.unique(bar, return_inverse=True, return_counts=True)
+    share = eb[bar] / counts[inv]
+    panel_energy = np.zeros(nf)
+    crease_energy = np.zeros(n_edges)
+    on_p, on_c = pan >= 0, (pan < 0) & (cre >= 0)
+    np.add.at(panel_energy, pan[on_p], share[on_p])
+    np.add.at(crease_energy, cre[on_c], share[on_c])
+    panel_strain = np.zeros(nf)
+    np.maximum.at(panel_strain, pan[on_p], strain[bar[on_p]])
+
+    # springs: panel springs to the panel of their hinge bar, crease springs to their crease
+    role = structure.spring_role
+    is_panel = role == SpringRole.PANEL
+    if is_panel.any():
+        hinge = structure.springs[is_panel][:, 1:3]
+        nn = structure.n_nodes
+        hk = hinge.min(axis=1).astype(np.int64) * nn + hinge.max(axis=1)
+        tri = structure.triangles
+        sides = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+        sk = sides.min(axis=1).astype(np.int64) * nn + sides.max(axis=1)
+        sp_owner = np.tile(structure.tri_panel, 3)
+        keep = sp_owner >= 0
+        sk, sp_owner = sk[keep], sp_owner[keep]
+        order = np.argsort(sk, kind="stable")
+        pos = np.minimum(np.searchsorted(sk[order], hk), len(order) - 1)
+        owner = np.where(sk[order][pos] == hk, sp_owner[order][pos], -1)
+        ok = owner >= 0
+        np.add.at(panel_energy, owner[ok], es[is_panel][ok])
+    crease_spring = ~is_panel & (structure.spring_crease >= 0)
+    np.add.at(crease_energy, structure.spring_crease[crease_spring], es[crease_spring])
+    return ModelEnergy(
+        panel_energy=panel_energy,
+        panel_strain=panel_strain,
+        crease_energy=crease_energy,
+        total=float(eb.sum() + es.sum()),
+    )

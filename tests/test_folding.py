@@ -1,0 +1,107 @@
+"""Folding a crease pattern by rest-angle actuation (mechanics/folding.py, measures.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from holofold.geometry import CreasePattern, miura_sheet
+from holofold.mechanics import fold_pattern, fold_targets, model_energy
+
+SECTION = dict(panel_thickness=1e-3, crease_thickness=0.3e-3, crease_width=1e-3)
+
+
+def _pattern(flat, faces, assignment, angle):
+    """A flat pattern whose interior edges get ``assignment`` and ``angle`` (degrees)."""
+    flat = np.asarray(flat, float)
+    p = CreasePattern.from_faces(np.c_[flat, np.zeros(len(flat))], faces, flat=flat)
+    asg = np.where(p.interior, assignment, "B")
+    ang = np.where(p.interior, angle, 0.0)
+    return CreasePattern(p.coords, p.faces, p.edges, asg, ang, flat=flat)
+
+
+def _distances(X):
+    return np.linalg.norm(X[:, None] - X[None], axis=-1)
+
+
+@pytest.mark.parametrize("model", ["concentrated", "compliant"])
+def test_one_crease_reaches_its_target_stress_free(model):
+    flat = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [2, 0], [2, 1]]) * 0.05
+    p = _pattern(flat, [[0, 1, 2, 3], [1, 4, 5, 2]], "V", 90.0)
+    r = fold_pattern(p, 1.0, model=model, **SECTION)
+    assert r.verdict == "folds rigidly" and r.complete and r.status.converged
+    assert r.fold_angles[-1][p.interior] == pytest.approx([90.0], abs=1e-6)
+    assert r.progress == pytest.approx(1.0, abs=1e-8)
+    assert r.fractions[0] == 0.0 and r.fractions[-1] == 1.0
+
+
+def test_miura_folds_to_its_rigid_state():
+    """A Miura sheet driven to the fold angles of its rigid state at Ext = 0.6 reaches exactly
+    that state (distances between all vertices as in miura_sheet(ext=0.6), 1e-9 relative)."""
+    folded = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
+    r = fold_pattern(folded, 1.0, **SECTION)
+    assert r.verdict == "folds rigidly" and "stress free" in r.note
+    D, D0 = _distances(r.coords[-1]), _distances(folded.coords)
+    assert np.abs(D - D0).max() <= 1e-9 * D0.max()
+    assert r.fold_angles[-1] == pytest.approx(folded.fold_angle, abs=1e-6)
+    half = fold_pattern(folded, 0.5, **SECTION)
+    assert half.reached == 0.5 and 0.4 < half.progress < 0.6
+
+
+def test_flat_miura_with_mv_only_folds_towards_180():
+    """M/V creases without angles are driven to -+180 degrees (capped at 179)."""
+    flat = miura_sheet(3, 3, a=0.02, b=0.02, gamma=math.radians(60), ext=1.0)
+    assert not flat.fold_angle.any()
+    t = fold_targets(flat)
+    assert set(np.unique(t[flat.assignment == "M"])) == {-179.0}
+    assert set(np.unique(t[flat.assignment == "V"])) == {179.0}
+    r = fold_pattern(flat, 0.5, **SECTION)
+    assert r.verdict == "folds rigidly" and r.complete
+    assert r.wrong_way.size == 0
+    assert 0.45 < r.progress < 0.55
+
+
+def test_a_degree_three_vertex_does_not_fold_rigidly():
+    """Three valleys meeting inside a square (none collinear): no rigid motion folds them."""
+    flat = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.0], [0.45, 0.55]]) * 0.05
+    p = _pattern(flat, [[0, 4, 5, 3], [4, 1, 2, 5], [5, 2, 3]], "V", 60.0)
+    r = fold_pattern(p, 1.0, **SECTION)
+    assert r.verdict == "does not fold rigidly"
+    assert r.energy.panel_share > 0.2
+    assert r.energy.panel_strain.max() > 1e-4
+
+
+def test_collinear_creases_fold_and_the_third_is_stuck():
+    """Two collinear valleys fold as one line; the third crease of the vertex cannot follow."""
+    flat = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]]) * 0.05
+    p = _pattern(flat, [[0, 1, 4], [1, 2, 4], [2, 3, 0, 4]], "V", 60.0)
+    r = fold_pattern(p, 1.0, **SECTION)
+    assert r.verdict == "does not fold rigidly" and "turn less than" in r.note
+
+
+def test_a_step_that_cannot_converge_stops_the_fold():
+    p = miura_sheet(2, 2, a=0.02, b=0.02, gamma=1.0, ext=0.6)
+    r = fold_pattern(p, 1.0, max_iter=2, **SECTION)  # one Newton iteration per step
+    assert r.verdict == "stalls" and not r.complete and not r.status.converged
+    assert r.reached < 1.0 and r.halvings == 4
+    assert "does not converge" in r.summary()
+
+
+def test_energy_split_adds_up():
+    p = miura_sheet(3, 3, a=0.02, b=0.02, gamma=1.0, ext=1.0)
+    r = fold_pattern(p, 0.5, **SECTION)
+    e = model_energy(r.structure, r.U[-1], r.rest, n_edges=p.n_edges)
+    assert e.total > 0
+    assert e.panel_energy.sum() + e.crease_energy.sum() == pytest.approx(e.total, rel=1e-10)
+    assert (e.crease_energy[~p.interior] == 0).all()
+
+
+def test_folded_pattern_keeps_layout_and_assignment():
+    p = miura_sheet(2, 2, a=0.02, b=0.02, gamma=1.0, ext=0.7)
+    r = fold_pattern(p, 1.0, **SECTION)
+    q = r.folded()
+    assert np.array_equal(q.flat, p.flat)
+    assert np.array_equal(q.assignment, p.assignment)
+    assert q.fold_angle == pytest.approx(p.fold_angle, abs=1e-6)
