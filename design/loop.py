@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.design.folder_lock import locks_folder
 from holofold.design.mining import mine_rules
 from holofold.design.rulefile import rules_to_records, write_rules
 from holofold.design.rules import FewRulesWarning
@@ -282,6 +283,7 @@ def _clean(v):
     return v
 
 
+@locks_folder("folder")  # one run per design folder (its databases are locked on their own)
 def run_design(
     scenario: Scenario | str | os.PathLike,
     target: str,
@@ -485,12 +487,25 @@ def run_design(
         from holofold.design.report_page import write_report_page
 
         write_report_page(out, summary)
+    _check_own_summary(out, summary)
     vp = rule.get("verified_precision")
     say(f"chosen: {', '.join(f'{k} = {v:.4g}' for k, v in features.items())}\n"
         f"  {', '.join(f'{k} = {performance[k]:.4g} {units[k]}' for k in tgt.columns)}; "
         f"worst margin {summary['worst_margin']:.3g}; rule verified precision "
         f"{'n/a' if vp is None else f'{vp:.2f}'}; files in {out}/")  # fmt: skip
     return DesignOutcome(summary, table, out)
+
+
+def _check_own_summary(out: Path, summary: dict) -> None:
+    """Before the run reports success: ``design.json`` in ``out`` is the one it wrote."""
+    import json
+
+    try:
+        stored = json.loads((out / "design.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{out}/design.json cannot be read back ({exc})") from None
+    if stored != json.loads(json.dumps(summary)):
+        raise ValueError(f"{out}/design.json is not this run's: another run wrote the folder")
 
 
 def _scenario_summary(sc: Scenario) -> dict:

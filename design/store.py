@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.design.folder_lock import folder_lock
 from holofold.design.row_limits import resolve_row_timeout
 from holofold.design.runner import (
     check_scheduler,
@@ -134,23 +135,29 @@ def build_database(
     # every row checked before anything runs
     checked = validate_designs(scenario, designs, on_invalid)
     folder = Path(folder)
+    designs = designs.reset_index(drop=True)
+    if folder.is_dir() and not _writable(folder):
+        return _read_only(folder, designs)
+    with folder_lock(folder):  # one writer per folder, for the whole run
+        _build_locked(
+            scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
+            on_invalid, timeout,
+        )  # fmt: skip
+        _check_own(folder, designs, meta)
+        return load_database(folder, _write=True)
+
+
+def _build_locked(
+    scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
+    on_invalid, timeout,
+) -> None:  # fmt: skip
+    """The body of :func:`build_database`, run holding the folder's lock."""
     chunks = folder / "chunks"
     chunks.mkdir(parents=True, exist_ok=True)
-    designs = designs.reset_index(drop=True)
     dpath = folder / "designs.parquet"
     meta_path = folder / "meta.json"
     if dpath.exists():
-        old = _read_parquet(dpath, "the design table")
-        same = list(old.columns) == list(designs.columns) and len(old) == len(designs)
-        if same:
-            a = old.to_numpy(dtype=float, na_value=np.nan)
-            b = designs.to_numpy(dtype=float, na_value=np.nan)
-            same = np.array_equal(a, b, equal_nan=True)
-        if not same:
-            raise ValueError(
-                f"{folder} already holds a different design table; use another folder "
-                "(or delete it) instead of mixing two databases"
-            )
+        _check_designs(folder, designs)
         stored = _stored_layout(meta_path, chunks, len(designs))
         if stored is not None and stored != chunk_size:
             warnings.warn(
@@ -207,7 +214,71 @@ def build_database(
     finally:
         if bar is not None:
             bar.close()
-    return load_database(folder, _write=True)
+
+
+def _check_designs(folder: Path, designs: pd.DataFrame) -> None:
+    """Refuse ``folder`` unless its ``designs.parquet`` holds exactly ``designs``."""
+    old = _read_parquet(folder / "designs.parquet", "the design table")
+    same = list(old.columns) == list(designs.columns) and len(old) == len(designs)
+    if same:
+        a = old.to_numpy(dtype=float, na_value=np.nan)
+        b = designs.to_numpy(dtype=float, na_value=np.nan)
+        same = np.array_equal(a, b, equal_nan=True)
+    if not same:
+        raise ValueError(
+            f"{folder} already holds a different design table; use another folder "
+            "(or delete it) instead of mixing two databases"
+        )
+
+
+def _check_own(folder: Path, designs: pd.DataFrame, meta: dict | None) -> None:
+    """Before a run reports success: the folder holds its design table and its settings
+    (``meta.json``'s rows and every key of ``meta``), else one line saying so."""
+    import json
+
+    _check_designs(folder, designs)
+    try:
+        stored = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{folder}/meta.json cannot be read back ({exc})") from None
+    mine = {"rows": len(designs), **json.loads(json.dumps(meta or {}))}
+    for k, v in mine.items():
+        if stored.get(k) != v:
+            raise ValueError(
+                f"{folder}/meta.json records {k} = {stored.get(k)!r}, not this run's {v!r}: "
+                "another run wrote this folder; use another folder"
+            )
+
+
+def _writable(folder: Path) -> bool:
+    """Whether a file can be created in ``folder`` (tried: permissions, a read-only file
+    system or an immutable folder, whoever runs)."""
+    import tempfile
+
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".holofold-", dir=folder)
+    except OSError:
+        return False
+    os.close(fd)
+    os.unlink(tmp)
+    return True
+
+
+def _read_only(folder: Path, designs: pd.DataFrame) -> pd.DataFrame:
+    """A complete database in a folder this process cannot write: its rows, nothing written;
+    an incomplete one is refused in one line."""
+    _check_designs(folder, designs)
+    chunk_size = _stored_layout(folder / "meta.json", folder / "chunks", len(designs))
+    chunk_size = chunk_size or max(len(designs), 1)
+    n_chunks = (len(designs) + chunk_size - 1) // chunk_size
+    good = scan_chunks(folder, designs, chunk_size, move=False)
+    if len(good) < n_chunks:
+        raise PermissionError(
+            f"{folder} is not writable and holds {len(good)} of {n_chunks} chunks: the "
+            "missing rows cannot be simulated there; make it writable or use another folder"
+        )
+    log.info("%s is read-only and complete: read without writing", folder)
+    return pd.concat([pd.read_parquet(good[k]) for k in range(n_chunks)], ignore_index=True)
 
 
 _CHUNK = re.compile(r"part-(\d{5})(?:-([0-9a-f]{16}))?\.parquet$")
@@ -267,14 +338,17 @@ def _damaged(path: Path, why: str) -> None:
     )
 
 
-def scan_chunks(folder, designs: pd.DataFrame, chunk_size: int) -> dict[int, Path]:
+def scan_chunks(
+    folder, designs: pd.DataFrame, chunk_size: int, *, move: bool = True
+) -> dict[int, Path]:
     """The sound chunks of a database folder: chunk index -> path.
 
     A chunk is sound when its name's checksum matches its bytes and it holds exactly rows
     ``k * chunk_size ...`` of ``designs`` (same sample ids and feature values). Every other
     chunk file (truncated, empty, altered, a duplicate or outside the layout) is moved to
     ``chunks/damaged/`` with a warning. A chunk of an older holofold (no checksum in its
-    name) that holds the right rows is renamed with its checksum.
+    name) that holds the right rows is renamed with its checksum. ``move=False`` (a
+    read-only folder): nothing is moved or renamed; damaged chunks are left out.
     """
     chunks = Path(folder) / "chunks"
     n = len(designs)
@@ -283,7 +357,8 @@ def scan_chunks(folder, designs: pd.DataFrame, chunk_size: int) -> dict[int, Pat
     for p in sorted(chunks.glob("part-*.parquet")):
         m = _CHUNK.match(p.name)
         if m is None:
-            _damaged(p, "not a chunk name")
+            if move:
+                _damaged(p, "not a chunk name")
             continue
         k = int(m[1])
         data = p.read_bytes()
@@ -297,9 +372,10 @@ def scan_chunks(folder, designs: pd.DataFrame, chunk_size: int) -> dict[int, Pat
         else:
             why = _content_problem(data, designs.iloc[k * chunk_size : (k + 1) * chunk_size])
         if why:
-            _damaged(p, why)
+            if move:
+                _damaged(p, why)
             continue
-        if m[2] is None:  # older layout: add the checksum to the name
+        if m[2] is None and move:  # older layout: add the checksum to the name
             named = p.with_name(f"part-{k:05d}-{_digest(data)}.parquet")
             os.replace(p, named)
             p = named
