@@ -65,6 +65,10 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "shipped_scenarios",
             "shipped_text",
             "ScenarioFileError",
+            "ScenarioKind",
+            "register_kind",
+            "scenario_kinds",
+            "kind_names",
         ],
         "store": ["build_database", "generate_database", "load_database"],
         "tables": [

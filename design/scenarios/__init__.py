@@ -16,6 +16,13 @@ from holofold.design.scenarios.files import (
     shipped_scenarios,
     shipped_text,
 )
+from holofold.design.scenarios.kinds import (
+    ScenarioKind,
+    get_kind,
+    kind_names,
+    register_kind,
+    scenario_kinds,
+)
 
 __all__ = [
     "Column",
@@ -29,6 +36,11 @@ __all__ = [
     "shipped_scenarios",
     "shipped_text",
     "ScenarioFileError",
+    "ScenarioKind",
+    "get_kind",
+    "kind_names",
+    "register_kind",
+    "scenario_kinds",
 ]
 
 #: command-line name -> module (its ``SCENARIO``) or ``module:ATTRIBUTE``

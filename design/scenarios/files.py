@@ -1,6 +1,7 @@
 """Scenario files: a designer's own problem in TOML, and the paper's problems shipped as such.
 
-docs/scenarios.md §8. A file names its ``kind`` (``strip``, ``sheet`` or ``gripper``), the
+docs/scenarios.md §8. A file names its ``kind`` (``strip``, ``sheet``, ``gripper`` or one of
+:mod:`~holofold.design.scenarios.kinds`, where other packages add theirs), the
 fixed setting (curve, material, supports, loads) and the design features with their ranges or
 choices. It is parsed with :mod:`tomllib` and never executed; every problem (an unknown key, a
 range with low >= high, a missing file, an unknown unit, a load outside the curve) is refused
@@ -12,7 +13,6 @@ path to a ``.toml`` file is read, and a name is one of the paper's scenarios.
 
 from __future__ import annotations
 
-import importlib
 import os
 import tomllib
 from dataclasses import replace
@@ -20,9 +20,9 @@ from pathlib import Path
 
 from holofold.design.scenarios.base import Scenario
 from holofold.design.scenarios.config import ScenarioFileError, Section
+from holofold.design.scenarios.kinds import get_kind, kind_names
 
 __all__ = [
-    "KINDS",
     "read_scenario",
     "load_scenario",
     "shipped_scenarios",
@@ -30,12 +30,6 @@ __all__ = [
     "ScenarioFileError",
 ]
 
-#: kind -> module with ``from_config(doc, name, description) -> Scenario``
-KINDS = {
-    "strip": "holofold.design.scenarios.strip",
-    "sheet": "holofold.design.scenarios.sheet",
-    "gripper": "holofold.design.scenarios.gripper_kind",
-}
 _SHIPPED = Path(__file__).with_name("shipped")
 
 
@@ -54,15 +48,20 @@ def read_scenario(path: str | os.PathLike) -> Scenario:
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioFileError(f"{path.name}: not valid TOML: {exc}") from None
     doc = Section(data, f"{path.name}: top level", path.resolve().parent)
-    kind = doc.choice("kind", tuple(KINDS))
+    known = kind_names()
+    kind = doc.choice("kind", known)
     if kind is None:
-        raise doc.error(f"missing key 'kind'; allowed: {', '.join(KINDS)}")
+        raise doc.error(f"missing key 'kind'; allowed: {', '.join(known)}")
     name = doc.string("name", path.stem)
     if not name.strip():
         raise doc.error("name must not be empty")
     description = doc.string("description", "")
     doc.where = f"{path.name}"
-    scenario = importlib.import_module(KINDS[kind]).from_config(doc, name, description)
+    try:
+        reader = get_kind(kind)
+    except KeyError as exc:  # a plug-in kind that does not load
+        raise doc.error(str(exc.args[0])) from None
+    scenario = reader.from_config(doc, name, description)
     doc.where = f"{path.name}: top level"
     doc.done()
     return replace(scenario, source=str(path))

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.design import SCENARIO_NAMES, get_scenario, shipped_scenarios, shipped_text
+from holofold.design import (
+    SCENARIO_NAMES,
+    get_scenario,
+    scenario_kinds,
+    shipped_scenarios,
+    shipped_text,
+)
 
 __all__ = ["register", "run"]
 
@@ -40,5 +46,7 @@ def run(args) -> int:
         sc = get_scenario(name)
         file = "  [file: scenarios show " + name + "]" if name in files else ""
         print(f"  {name:18s} {sc.description}{file}")
-    print("scenario file kinds: strip (a Miura strip over any curve), sheet, gripper")
+    print("scenario file kinds (kind = ... in a .toml file):")
+    for name, kind in scenario_kinds().items():
+        print(f"  {name:18s} {kind.description}")
     return 0

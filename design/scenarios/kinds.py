@@ -1,0 +1,159 @@
+"""The registry of scenario-file kinds: ``kind = "strip"``, ``"sheet"``, ``"gripper"`` and any
+kind another package adds.
+
+A kind is a :class:`ScenarioKind`: a name, one line of description and
+``from_config(doc, name, description) -> Scenario``, which reads the file's tables through
+:class:`~holofold.design.scenarios.config.Section` (refusing every problem in one line) and
+returns the :class:`~holofold.design.scenarios.base.Scenario`. :func:`read_scenario` looks the
+file's ``kind`` up here.
+
+Built-in kinds are named by module (imported only when used). Other packages add kinds in two
+ways:
+
+* an entry point in the group :data:`ENTRY_POINT_GROUP` (``holofold.scenario_kinds``) whose name
+  is the kind and whose object is a :class:`ScenarioKind` or a module with ``from_config``
+  (and an optional ``DESCRIPTION``); in a ``pyproject.toml``::
+
+      [project.entry-points."holofold.scenario_kinds"]
+      surface = "mypackage.surface_kind:KIND"
+
+* :func:`register_kind` at run time (a script, a test).
+
+A kind's name is what users write in their files; a name taken by a built-in kind cannot be
+taken again.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import ModuleType
+
+__all__ = [
+    "ScenarioKind",
+    "ENTRY_POINT_GROUP",
+    "BUILTIN_KINDS",
+    "scenario_kinds",
+    "get_kind",
+    "kind_names",
+    "register_kind",
+]
+
+#: the entry-point group other packages add scenario kinds in
+ENTRY_POINT_GROUP = "holofold.scenario_kinds"
+
+
+@dataclass(frozen=True)
+class ScenarioKind:
+    """One kind of scenario file.
+
+    Attributes
+    ----------
+    name : str
+        What a file's ``kind`` says.
+    description : str
+        One line for listings.
+    from_config : callable(doc, name, description) -> Scenario
+        Reads the file (``doc`` a :class:`~holofold.design.scenarios.config.Section` of the
+        top level; the caller refuses unknown top-level keys afterwards).
+    """
+
+    name: str
+    description: str
+    from_config: Callable
+
+
+#: built-in kind -> (module with ``from_config``, description)
+BUILTIN_KINDS = {
+    "strip": ("holofold.design.scenarios.strip", "a Miura strip over any planar curve"),
+    "sheet": ("holofold.design.scenarios.sheet", "Miura-ori and TMP sheets of any footprint"),
+    "gripper": (
+        "holofold.design.scenarios.gripper_kind",
+        "the electro-thermal grippers with your material",
+    ),
+}
+_REGISTERED: dict[str, ScenarioKind] = {}
+
+
+def _from_module(name: str, module: ModuleType, description: str | None = None) -> ScenarioKind:
+    if not callable(getattr(module, "from_config", None)):
+        raise TypeError(f"scenario kind {name!r}: module {module.__name__} has no from_config")
+    text = description or getattr(module, "DESCRIPTION", "") or ""
+    return ScenarioKind(name, text, module.from_config)
+
+
+def _as_kind(name: str, obj) -> ScenarioKind:
+    if isinstance(obj, ScenarioKind):
+        return obj
+    if isinstance(obj, ModuleType):
+        return _from_module(name, obj)
+    if callable(obj):
+        return ScenarioKind(name, getattr(obj, "__doc__", "") or "", obj)
+    raise TypeError(
+        f"scenario kind {name!r}: expected a ScenarioKind, a module with from_config or a "
+        f"function, got {type(obj).__name__}"
+    )
+
+
+def _entry_points() -> dict[str, object]:
+    """name -> entry point of the group (not loaded)."""
+    from importlib.metadata import entry_points
+
+    return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def kind_names() -> tuple[str, ...]:
+    """Every kind a file may name: built-in, registered, then from entry points."""
+    names = list(BUILTIN_KINDS)
+    names += [n for n in _REGISTERED if n not in names]
+    names += [n for n in _entry_points() if n not in names]
+    return tuple(names)
+
+
+def get_kind(name: str) -> ScenarioKind:
+    """The kind called ``name`` (raises ``KeyError`` naming the known kinds)."""
+    if name in BUILTIN_KINDS:
+        module, text = BUILTIN_KINDS[name]
+        return _from_module(name, importlib.import_module(module), text)
+    if name in _REGISTERED:
+        return _REGISTERED[name]
+    eps = _entry_points()
+    if name in eps:
+        try:
+            obj = eps[name].load()
+        except Exception as exc:  # noqa: BLE001 - a broken plug-in: say which, do not crash
+            raise KeyError(
+                f"scenario kind {name!r} (entry point {eps[name].value}) cannot be loaded: "
+                f"{type(exc).__name__}: {exc}"
+            ) from None
+        return _as_kind(name, obj)
+    raise KeyError(f"unknown scenario kind {name!r}; known: {', '.join(kind_names())}")
+
+
+def scenario_kinds() -> dict[str, ScenarioKind]:
+    """name -> kind of every kind that loads (a plug-in that fails to load is left out)."""
+    out = {}
+    for n in kind_names():
+        try:
+            out[n] = get_kind(n)
+        except (KeyError, TypeError, ImportError):
+            continue
+    return out
+
+
+def register_kind(kind: ScenarioKind | ModuleType, name: str | None = None) -> ScenarioKind:
+    """Add a kind at run time (a :class:`ScenarioKind`, or a module with ``from_config``
+    registered under ``name``); returns it. A built-in name cannot be replaced."""
+    if isinstance(kind, ModuleType):
+        if not name:
+            raise ValueError("register_kind(module, name): give the kind's name")
+        kind = _from_module(name, kind)
+    elif not isinstance(kind, ScenarioKind):
+        raise TypeError(f"expected a ScenarioKind or a module, got {type(kind).__name__}")
+    if not kind.name or not kind.name.replace("-", "_").isidentifier():
+        raise ValueError(f"scenario kind name {kind.name!r} must be a word such as 'surface'")
+    if kind.name in BUILTIN_KINDS:
+        raise ValueError(f"scenario kind {kind.name!r} is built in; choose another name")
+    _REGISTERED[kind.name] = kind
+    return kind
