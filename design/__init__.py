@@ -50,6 +50,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "check_scheduler",
             "dask_scheduler",
         ],
+        "row_status": ["failed_rows", "converged_rows", "row_statuses", "with_state"],
+        "faults": ["as_environment_fault"],
         "row_limits": ["RowTimeout", "ON_INVALID", "check_on_invalid", "resolve_row_timeout"],
         "sampling": ["sample_designs", "METHODS"],
         "scenarios.strip": ["StripSetting", "StripLoad", "strip_scenario", "STRIP_FEATURES"],

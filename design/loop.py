@@ -32,6 +32,7 @@ import pandas as pd
 
 from holofold.design.folder_lock import locks_folder
 from holofold.design.mining import mine_rules
+from holofold.design.row_status import converged_rows, failed_rows
 from holofold.design.rulefile import rules_to_records, write_rules
 from holofold.design.rules import FewRulesWarning
 from holofold.design.runner import check_workers
@@ -43,7 +44,6 @@ from holofold.design.targets import parse_target
 from holofold.design.verify import Verification, rule_mask, rule_ranges
 from holofold.geometry.outputs import write_json
 from holofold.geometry.units import length_factor
-from holofold.mechanics.status import converged_mask, failed_mask
 
 __all__ = ["run_design", "DesignOutcome", "refine_designs", "choose_design", "STAGES"]
 
@@ -129,8 +129,8 @@ def choose_design(
     Converged rows are preferred; without one inside the box, every row meeting the target
     is considered (and the returned text says so).
     """
-    ok = ~failed_mask(table["status"])
-    conv = converged_mask(table["status"])
+    ok = ~failed_rows(table)
+    conv = converged_rows(table)
     meets = np.zeros(len(table), bool)
     meets[ok] = target.evaluate(table.loc[ok])
     inside = rule_mask(table, bounds) if bounds is not None else np.ones(len(table), bool)
@@ -461,7 +461,7 @@ def run_design(
         "chosen": {"how": how, "origin": str(row["origin"])},
         "database": {
             "rows": int(len(table)),
-            "failed": int(failed_mask(table["status"]).sum()),
+            "failed": int(failed_rows(table).sum()),
             "path": os.path.relpath(dbf, out),
         },  # fmt: skip
         "rounds": [{k: h[k] for k in ("round", "rows", "rules", "best")} for h in history],
@@ -565,7 +565,7 @@ def _write_files(sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt,
     else:  # the target's column against the rule's first continuous feature
         x = next((k for k in rule["bounds"] if k not in sc.categorical), mined.features[0])
         y = cols[0]
-    ok = table.loc[~failed_mask(table["status"])]
+    ok = table.loc[~failed_rows(table)]
     save_figure(plot_target_scatter(ok, tgt, x, y, chosen=row, units=units), out / "scatter.png")
     images["scatter"] = "scatter.png"
     return files, images

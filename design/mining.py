@@ -23,10 +23,10 @@ from holofold.design.evaluation import (
     holdout,
     split_indices,
 )
+from holofold.design.row_status import failed_rows
 from holofold.design.rules import ForestRuleMiner
 from holofold.design.tables import ColumnRoles
 from holofold.design.targets import Target, parse_target
-from holofold.mechanics.status import failed_mask
 
 __all__ = [
     "MinedRules",
@@ -267,8 +267,8 @@ def mine_rules(
         class, or an invalid miner parameter (one line naming it).
     """
     n_failed = 0
-    if "status" in table.columns:
-        failed = failed_mask(table["status"])
+    if "status" in table.columns or "state" in table.columns:
+        failed = failed_rows(table)
         n_failed = int(failed.sum())
         table = table.loc[~failed]
     table = table.reset_index(drop=True)

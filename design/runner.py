@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from holofold.design.faults import as_environment_fault
 from holofold.design.row_limits import (
     RowTimeout,
     call_with_limit,
@@ -37,8 +38,9 @@ from holofold.design.row_limits import (
     resolve_row_timeout,
     timeout_reason,
 )
+from holofold.design.row_status import STATE_COLUMNS, status_columns
 from holofold.design.scenarios import Scenario, load_scenario
-from holofold.design.scenarios.base import single_thread
+from holofold.design.scenarios.base import check_row, single_thread
 from holofold.mechanics.status import Status
 
 __all__ = [
@@ -163,8 +165,8 @@ def validate_designs(
                 bad.append(f"{c.name} is {'missing' if math.isnan(v) else 'infinite'}")
                 continue
             row[c.name] = v
-        if not bad:
-            bad = scenario.check(row)
+        if not bad:  # the one check of the row: check_row's, as Scenario.evaluate's
+            bad = check_row(scenario.features, scenario.check, row, scenario.name)
         if bad:
             problems.append(f"row {i}: " + "; ".join(bad))
             invalid[i - 1] = "; ".join(bad)
@@ -227,12 +229,21 @@ def _evaluate_one(
     ``failed: ...`` status, running past the limit ``failed: timeout after ... s``."""
     try:
         with single_thread() if limit_threads else nullcontext():
-            out = call_with_limit(timeout, scenario.evaluate, row)
+            out = call_with_limit(timeout, scenario.simulate, row)  # the row checked before
         return _checked_output(scenario, out)
     except RowTimeout:
         return _failed_output(scenario, Status.failed(timeout_reason(timeout)))
     except Exception as exc:  # noqa: BLE001 - a failed row must not stop the batch
+        _raise_environment_fault(scenario, exc)
         return _failed(scenario, exc)
+
+
+def _raise_environment_fault(scenario: Scenario, exc: BaseException) -> None:
+    """Raise the :class:`~holofold.geometry.errors.EnvironmentFault` that ``exc`` is (the run
+    stops, nothing stored); return if it is the design's own failure."""
+    fault = as_environment_fault(exc, f"a design of {scenario.name}")
+    if fault is not None:
+        raise fault from None
 
 
 #: rows per task when a scenario evaluates batches (``Scenario.evaluate_batch``): enough to
@@ -268,7 +279,9 @@ def _evaluate_batch(
         with single_thread() if limit_threads else nullcontext():
             outs = call_with_limit(limit, scenario.evaluate_batch, rows)
         return [_checked_output(scenario, o) for o in outs]
-    except (Exception, RowTimeout):  # noqa: BLE001 - fall back to the rows one by one
+    except (Exception, RowTimeout) as exc:  # noqa: BLE001 - fall back to the rows one by one
+        if isinstance(exc, Exception):
+            _raise_environment_fault(scenario, exc)
         return [_evaluate_one(scenario, r, limit_threads, timeout) for r in rows]
 
 
@@ -404,7 +417,11 @@ def _iter_on_dask(
         where = {f.key: i for i, f in enumerate(futures)}
         try:
             for f in as_completed(futures, loop=client.loop):
-                out = _failed(scenario, f.exception()) if f.status == "error" else f.result()
+                if f.status == "error":  # the worker died (KilledWorker), or the environment
+                    _raise_environment_fault(scenario, f.exception())
+                    out = _failed(scenario, f.exception())
+                else:
+                    out = f.result()
                 f.release()  # the cluster forgets the result; the caller holds the only copy
                 yield where[f.key], out
         finally:  # interrupted (Ctrl-C, lost scheduler): leave nothing running on the cluster
@@ -550,13 +567,14 @@ def results_table(scenario: Scenario, table: pd.DataFrame, outs: list) -> pd.Dat
     """The input rows (index kept), then the performance columns and ``status`` (text) of
     ``outs`` (one output of :func:`iter_results` per row, in row order)."""
     perf = scenario.performance_names
-    keep = [c for c in table.columns if c not in perf and c != "status"]
-    replaced = [c for c in table.columns if c in perf or c == "status"]
+    keep = [c for c in table.columns if c not in perf and c not in STATE_COLUMNS]
+    replaced = [c for c in table.columns if c in perf or c in STATE_COLUMNS]
     if replaced:
         log.info("input column(s) %s replaced by the computed values", ", ".join(replaced))
     res = table[keep].reset_index(drop=True).copy()
     for c in perf:
         res[c] = np.array([o.get(c, np.nan) for o in outs], dtype=float)
-    res["status"] = [str(o["status"]) for o in outs]
+    for name, values in status_columns(o["status"] for o in outs).items():
+        res[name] = values
     res.index = table.index
     return res

@@ -43,6 +43,7 @@ import pandas as pd
 
 from holofold.design.folder_lock import folder_lock
 from holofold.design.row_limits import resolve_row_timeout
+from holofold.design.row_status import STATE_COLUMNS, stale_rows, with_state
 from holofold.design.runner import (
     check_scheduler,
     check_workers,
@@ -84,6 +85,7 @@ def build_database(
     scheduler: str | None = None,
     on_invalid: str = "fail",
     row_timeout: float | str | None = None,
+    retry_failed: bool = False,
 ) -> pd.DataFrame:
     """Simulate ``designs`` into ``folder``, resuming whatever an earlier run left there.
 
@@ -116,6 +118,12 @@ def build_database(
         ``"skip"`` invalid rows are stored as failed rows with their reason; a row past its
         time limit is stored as ``failed: timeout after ... s`` (a resume keeps it: chunks on
         disk are never simulated again).
+    retry_failed : bool
+        Simulate the stored failed rows again (their chunks are rewritten). Without it a
+        resume simulates again only the stored rows whose failure was not the design's own
+        (an environment fault an older version stored as a row, ``failed:
+        ModuleNotFoundError: ...``). An environment fault while simulating stops the run
+        (:class:`~holofold.geometry.errors.EnvironmentFault`) and is never stored.
 
     Returns
     -------
@@ -141,7 +149,7 @@ def build_database(
     with folder_lock(folder):  # one writer per folder, for the whole run
         _build_locked(
             scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
-            on_invalid, timeout,
+            on_invalid, timeout, retry_failed,
         )  # fmt: skip
         _check_own(folder, designs, meta)
         return load_database(folder, _write=True)
@@ -149,7 +157,7 @@ def build_database(
 
 def _build_locked(
     scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
-    on_invalid, timeout,
+    on_invalid, timeout, retry_failed=False,
 ) -> None:  # fmt: skip
     """The body of :func:`build_database`, run holding the folder's lock."""
     chunks = folder / "chunks"
@@ -183,6 +191,8 @@ def _build_locked(
         write_json(meta_path, info)
     n_chunks = (len(designs) + chunk_size - 1) // chunk_size
     done = scan_chunks(folder, designs, chunk_size)
+    _redo_stale(scenario, designs, done, chunk_size, workers, scheduler, on_invalid, timeout,
+                retry_failed)  # fmt: skip
     todo = [k for k in range(n_chunks) if k not in done]
     if len(todo) < n_chunks:
         log.info("resuming: %d of %d chunks already done", n_chunks - len(todo), n_chunks)
@@ -220,10 +230,8 @@ def _check_designs(folder: Path, designs: pd.DataFrame) -> None:
     """Refuse ``folder`` unless its ``designs.parquet`` holds exactly ``designs``."""
     old = _read_parquet(folder / "designs.parquet", "the design table")
     same = list(old.columns) == list(designs.columns) and len(old) == len(designs)
-    if same:
-        a = old.to_numpy(dtype=float, na_value=np.nan)
-        b = designs.to_numpy(dtype=float, na_value=np.nan)
-        same = np.array_equal(a, b, equal_nan=True)
+    if same and _content_problem(_parquet_bytes(designs), old, outcome=False) is not None:
+        same = False
     if not same:
         raise ValueError(
             f"{folder} already holds a different design table; use another folder "
@@ -278,7 +286,49 @@ def _read_only(folder: Path, designs: pd.DataFrame) -> pd.DataFrame:
             "missing rows cannot be simulated there; make it writable or use another folder"
         )
     log.info("%s is read-only and complete: read without writing", folder)
-    return pd.concat([pd.read_parquet(good[k]) for k in range(n_chunks)], ignore_index=True)
+    frames = [pd.read_parquet(good[k]) for k in range(n_chunks)]
+    return with_state(pd.concat(frames, ignore_index=True))
+
+
+def _redo_stale(
+    scenario, designs, done, chunk_size, workers, scheduler, on_invalid, timeout, retry_failed
+) -> None:
+    """Simulate again the stored rows of the sound chunks ``done`` that
+    :func:`~holofold.design.row_status.stale_rows` names; each such chunk is rewritten (new
+    checksum name) and ``done`` updated."""
+    found = {}
+    for k, p in done.items():
+        cols = [c for c in pq_names(p) if c in STATE_COLUMNS]
+        stale = np.flatnonzero(stale_rows(pd.read_parquet(p, columns=cols), retry_failed))
+        if len(stale):
+            found[k] = stale
+    if not found:
+        return
+    n = sum(len(v) for v in found.values())
+    what = "failed rows" if retry_failed else "rows whose stored failure was not the design's own"
+    warnings.warn(f"simulating again {n} stored {what}", stacklevel=4)
+    for k, stale in found.items():
+        old = with_state(pd.read_parquet(done[k]))
+        part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
+        res = evaluate_designs(
+            scenario, part.iloc[stale], workers=workers, progress=False, log_warnings=False,
+            scheduler=scheduler, on_invalid=on_invalid, row_timeout=timeout or 0,
+        )  # fmt: skip
+        new = old.copy()
+        for c in res.columns:
+            if c in new.columns and c not in part.columns:
+                new.loc[new.index[stale], c] = res[c].to_numpy()
+        path = write_chunk(new, done[k].parent, k)
+        if path != done[k]:
+            done[k].unlink()
+        done[k] = path
+
+
+def pq_names(path) -> list[str]:
+    """Column names of a Parquet file, from its schema only."""
+    import pyarrow.parquet as pq
+
+    return list(pq.read_schema(path).names)
 
 
 _CHUNK = re.compile(r"part-(\d{5})(?:-([0-9a-f]{16}))?\.parquet$")
@@ -295,6 +345,12 @@ def write_chunk(frame: pd.DataFrame, chunks: Path, k: int) -> Path:
     data = buf.getvalue()
     path = Path(chunks) / f"part-{k:05d}-{_digest(data)}.parquet"
     return atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))
+
+
+def _parquet_bytes(frame: pd.DataFrame) -> bytes:
+    buf = io.BytesIO()
+    frame.to_parquet(buf, index=False)
+    return buf.getvalue()
 
 
 def _read_parquet(path: Path, what: str) -> pd.DataFrame:
@@ -383,7 +439,7 @@ def scan_chunks(
     return good
 
 
-def _content_problem(data: bytes, part: pd.DataFrame) -> str | None:
+def _content_problem(data: bytes, part: pd.DataFrame, outcome: bool = True) -> str | None:
     """Why a chunk's bytes do not hold exactly the design rows ``part`` (None if they do)."""
     try:
         res = pd.read_parquet(io.BytesIO(data))
@@ -392,7 +448,7 @@ def _content_problem(data: bytes, part: pd.DataFrame) -> str | None:
     if len(res) != len(part):
         return f"{len(res)} rows instead of {len(part)}"
     cols = [c for c in part.columns if c in res.columns]
-    if len(cols) != len(part.columns) or "status" not in res.columns:
+    if len(cols) != len(part.columns) or (outcome and "status" not in res.columns):
         return "columns missing"
     for c in cols:
         a, b = res[c], part[c]
@@ -486,6 +542,7 @@ def generate_database(
     csv: bool = False,
     on_invalid: str = "skip",
     row_timeout: float | str | None = None,
+    retry_failed: bool = False,
 ) -> pd.DataFrame:
     """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
 
@@ -508,7 +565,7 @@ def generate_database(
     db = build_database(
         scenario, designs, folder, chunk_size=chunk_size, workers=workers, progress=progress,
         meta={"seed": seed, "method": method, "ranges": recorded}, scheduler=scheduler,
-        on_invalid=on_invalid, row_timeout=row_timeout,
+        on_invalid=on_invalid, row_timeout=row_timeout, retry_failed=retry_failed,
     )  # fmt: skip
     if csv:
         write_table(db, Path(folder) / "database.csv")
@@ -528,7 +585,7 @@ def load_database(folder: str | os.PathLike, *, _write: bool = False) -> pd.Data
         parts = sorted((folder / "chunks").glob("part-*.parquet"))
     if not parts:
         raise FileNotFoundError(f"{folder} holds no finished chunks")
-    df = pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True)
+    df = with_state(pd.concat([pd.read_parquet(p) for p in parts], ignore_index=True))
     if _write:
         write_table(df, folder / "database.parquet")
     return df

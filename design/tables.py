@@ -222,7 +222,7 @@ def write_table(frame: pd.DataFrame, path) -> Path:
     return atomic_write(path, lambda tmp: frame.to_parquet(tmp, index=False))
 
 
-_BOOKKEEPING = {"sample", "status", "origin", "meets_target"}
+_BOOKKEEPING = {"sample", "status", "state", "reason", "origin", "meets_target"}
 
 
 def column_roles(columns, path=None) -> ColumnRoles | None:

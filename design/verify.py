@@ -18,13 +18,13 @@ import numpy as np
 import pandas as pd
 
 from holofold.design.row_limits import check_on_invalid, resolve_row_timeout
+from holofold.design.row_status import failed_rows
 from holofold.design.runner import dask_scheduler, evaluate_designs
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.tables import write_table
 from holofold.design.targets import parse_target
 from holofold.geometry.outputs import write_json
-from holofold.mechanics.status import failed_mask
 
 __all__ = [
     "rule_ranges",
@@ -126,7 +126,7 @@ class Verification:
     def of(cls, results: pd.DataFrame, target) -> Verification:
         """Count the simulated ``results`` (with ``status``) meeting ``target`` (a Target)."""
         res = results.copy()
-        failed = pd.Series(failed_mask(res["status"]), index=res.index)
+        failed = pd.Series(failed_rows(res), index=res.index)
         meets = pd.Series(False, index=res.index)
         ok = res.loc[~failed]
         if len(ok):

@@ -26,7 +26,7 @@ def test_csv_in_csv_out(tmp_path, data0, capsys):
     out = tmp_path / "results.csv"
     assert main(["evaluate", "single-miura", str(src), "-o", str(out)]) == 0
     res = pd.read_csv(out)
-    assert res.columns.tolist() == FEATS + ["label"] + PERF + ["status"]
+    assert res.columns.tolist() == FEATS + ["label"] + PERF + ["status", "state", "reason"]
     assert res["label"].tolist() == ["a", "b", "c"]
     assert np.allclose(res[PERF].to_numpy(), data0[PERF].to_numpy(), rtol=1e-4)
     assert (res["status"] == "converged").all()

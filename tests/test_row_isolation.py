@@ -69,8 +69,9 @@ def _with_invalid_rows(designs: pd.DataFrame) -> pd.DataFrame:
 
 
 def _same(a: pd.DataFrame, b: pd.DataFrame) -> None:
-    assert a["status"].tolist() == b["status"].tolist()
-    for c in a.columns.drop("status"):
+    for c in ("status", "state", "reason"):
+        assert a[c].tolist() == b[c].tolist()
+    for c in a.columns.drop(["status", "state", "reason"]):
         x, y = a[c].to_numpy(dtype=float), b[c].to_numpy(dtype=float)
         assert np.array_equal(x, y, equal_nan=True), c
 
@@ -89,8 +90,8 @@ def test_skip_records_invalid_rows_in_place_and_simulates_the_rest(miura):
     assert res.loc[[1, 3, 4], sc.performance_names].isna().all().all()
     valid = [0, 2, 5]
     alone = evaluate_designs(sc, designs.iloc[valid])  # the valid rows on their own
-    _same(res.loc[valid, sc.performance_names + ["status"]],
-          alone[sc.performance_names + ["status"]])  # fmt: skip
+    cols = [*sc.performance_names, "status", "state", "reason"]
+    _same(res.loc[valid, cols], alone[cols])
 
 
 def test_fail_keeps_refusing_the_table():

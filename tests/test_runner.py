@@ -80,7 +80,7 @@ def test_failed_row_is_recorded_and_batch_goes_on(workers):
 def test_performance_columns_in_input_are_replaced():
     df = pd.DataFrame({"a": [2.0], "double": [99.0], "status": ["old"]})
     res = evaluate_designs(TOY, df)
-    assert res.columns.tolist() == ["a", "double", "status"]
+    assert res.columns.tolist() == ["a", "double", "status", "state", "reason"]
     assert res["double"].tolist() == [4.0] and res["status"].tolist() == ["converged"]
 
 

@@ -281,8 +281,9 @@ def test_evaluate_command_takes_a_scenario_file(tmp_path, capsys):
     import pandas as pd
 
     res = pd.read_csv(out)
-    assert list(res.columns[-8:]) == [
-        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance", "status"
+    assert list(res.columns[-10:]) == [
+        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance", "status",
+        "state", "reason",
     ]  # fmt: skip
     direct = read_scenario(p).evaluate(ROW)
     assert math.isclose(res["Vstiff"][0], direct["Vstiff"], rel_tol=1e-12)

@@ -250,6 +250,13 @@ class Scenario:
         object.__setattr__(self, "evaluate", wrapped)
 
     @property
+    def simulate(self) -> Callable[[Mapping[str, float]], dict]:
+        """The evaluator without the row check of :attr:`evaluate`, for callers that checked
+        the row already (the runner checks each row once, in
+        :func:`~holofold.design.runner.validate_designs`, and each output once)."""
+        return self.evaluate.args[0]
+
+    @property
     def feature_names(self) -> list[str]:
         return [c.name for c in self.features]
 

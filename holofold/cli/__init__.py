@@ -16,7 +16,10 @@ an import-linter contract in pyproject.toml keeps it so.
 
 User errors (``ValueError``, ``OSError``) become one line on stderr and exit status 2;
 nothing is written in that case (the library checks its inputs before it creates any output
-file, and writes every file atomically). Warnings become one line each on stderr.
+file, and writes every file atomically). An environment fault (a missing module, a library
+that fails to load, out of memory, a compile failure:
+``holofold.geometry.EnvironmentFault``) stops the run with one line naming the cause and the
+fix, exit status 3; nothing of it is stored. Warnings become one line each on stderr.
 """
 
 from __future__ import annotations
@@ -110,10 +113,15 @@ def main(argv: list[str] | None = None) -> int:
     def one_line(message, category, *_args, **_kw):
         print(f"holofold {args.command}: warning: {message}", file=sys.stderr)
 
+    from holofold.geometry import EnvironmentFault  # a lazy face: loads geometry.errors only
+
     try:
         with warnings.catch_warnings():
             warnings.showwarning = one_line
             return int(args._run(args) or 0)
+    except EnvironmentFault as exc:
+        print(f"holofold {args.command}: error: {exc}", file=sys.stderr)
+        return 3
     except (ValueError, OSError) as exc:
         print(f"holofold {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -87,13 +87,14 @@ def _epilog() -> str:
 def run(args) -> int:
     from holofold.design import (
         check_table_path,
+        converged_rows,
         evaluate_designs,
+        failed_rows,
         load_scenario,
         read_table,
         validate_designs,
         write_table,
     )
-    from holofold.mechanics import converged_mask, failed_mask
 
     scenario = load_scenario(args.scenario)
     check_table_path(args.output)
@@ -119,8 +120,8 @@ def run(args) -> int:
         row_timeout=row_timeout,
     )
     write_table(res, args.output)
-    ok = int(converged_mask(res["status"]).sum())
-    failed = int(failed_mask(res["status"]).sum())
+    ok = int(converged_rows(res).sum())
+    failed = int(failed_rows(res).sum())
     print(
         f"{len(res)} design(s) evaluated with {scenario.name}: {ok} converged, "
         f"{len(res) - ok - failed} not converged, {failed} failed -> {args.output}"

@@ -42,6 +42,12 @@ def register(subparsers) -> argparse.ArgumentParser:
     add_row_arguments(p, on_invalid="skip")
     p.add_argument("--chunk-size", type=int, default=100, help="rows per result chunk")
     p.add_argument("--csv", action="store_true", help="also write database.csv")
+    p.add_argument(
+        "--retry-failed",
+        action="store_true",
+        help="simulate the stored failed rows again (a resume always simulates again the rows "
+        "whose stored failure was the environment's, not the design's)",
+    )
     return p
 
 
@@ -65,8 +71,7 @@ def _parse_ranges(items):
 def run(args) -> int:
     from pathlib import Path
 
-    from holofold.design import generate_database
-    from holofold.mechanics import failed_mask
+    from holofold.design import failed_rows, generate_database
 
     workers, scheduler = parallel_settings(args)
     on_invalid, row_timeout = row_settings(args)
@@ -74,9 +79,9 @@ def run(args) -> int:
         args.scenario, args.samples, args.output,
         seed=args.seed, method=args.method, ranges=_parse_ranges(args.range),
         chunk_size=args.chunk_size, workers=workers, scheduler=scheduler, csv=args.csv,
-        on_invalid=on_invalid, row_timeout=row_timeout,
+        on_invalid=on_invalid, row_timeout=row_timeout, retry_failed=args.retry_failed,
     )  # fmt: skip
-    failed = int(failed_mask(db["status"]).sum())
+    failed = int(failed_rows(db).sum())
     where = Path(args.output) / "database.parquet"
     print(f"{args.scenario}: {len(db)} designs in {where} ({failed} failed)")
     return 0
