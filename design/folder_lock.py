@@ -26,6 +26,8 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from holofold.geometry.outputs import check_output_folder
+
 __all__ = ["FolderBusyError", "LOCK_NAME", "folder_lock", "locks_folder", "lock_holder"]
 
 #: name of the lock file inside a locked folder
@@ -116,6 +118,7 @@ def folder_lock(folder, *, wait: float | None = None, say=None):
     """
     folder = Path(folder)
     created = not folder.exists()
+    check_output_folder(folder)  # one line naming the folder if it cannot be written
     folder.mkdir(parents=True, exist_ok=True)
     key = folder.resolve()
     with _GUARD:

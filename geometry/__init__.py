@@ -41,7 +41,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "miura_nodes_batch",
             "miura_faces",
         ],
-        "outputs": ["check_output_path", "atomic_write", "write_text", "write_json"],
+        "outputs": [
+            "check_output_path",
+            "check_output_folder",
+            "check_writable_folder",
+            "atomic_write",
+            "write_text",
+            "write_json",
+        ],
         "pattern": ["CreasePattern", "ASSIGNMENTS", "MAX_PANELS", "non_simple_faces"],
         "printable": [
             "PrintableLayout",

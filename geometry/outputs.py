@@ -15,7 +15,14 @@ import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-__all__ = ["check_output_path", "atomic_write", "write_json", "write_text"]
+__all__ = [
+    "check_output_path",
+    "check_writable_folder",
+    "check_output_folder",
+    "atomic_write",
+    "write_json",
+    "write_text",
+]
 
 
 def check_output_path(path, what: str = "output", suffixes: Sequence[str] | None = None) -> Path:
@@ -29,7 +36,38 @@ def check_output_path(path, what: str = "output", suffixes: Sequence[str] | None
     parent = path.resolve().parent
     if not parent.is_dir():
         raise OSError(f"{what} folder {parent} does not exist")
+    if path.is_dir():
+        raise IsADirectoryError(f"{what} {path} is a folder, not a file")
+    check_writable_folder(parent, f"{what} {path}")
     return path
+
+
+def check_output_folder(folder, what: str = "output folder") -> Path:
+    """``folder`` as a Path if it can be written, or created: the folder itself if it exists
+    (and is a folder), else its nearest existing parent (:func:`check_writable_folder`)."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise NotADirectoryError(f"{what} {folder} exists and is not a folder")
+    probe = folder
+    while not probe.exists():
+        probe = probe.parent
+    check_writable_folder(probe, f"{what} {folder}")
+    return folder
+
+
+def check_writable_folder(folder, what: str = "output folder") -> Path:
+    """``folder`` as a Path if a file can be created in it, tried by creating (and removing)
+    an empty temporary file: permissions, a read-only file system and an immutable folder
+    are all seen, whoever runs. Raises ``PermissionError`` naming ``what`` otherwise."""
+    folder = Path(folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".holofold-", dir=folder)
+    except OSError as exc:
+        why = exc.strerror or type(exc).__name__
+        raise PermissionError(f"{what}: cannot write in {folder} ({why})") from None
+    os.close(fd)
+    os.unlink(tmp)
+    return folder
 
 
 def _umask() -> int:

@@ -48,8 +48,12 @@ def run(args) -> int:
     on_invalid, row_timeout = row_settings(args)
     if args.top is not None and args.top < 1:
         raise ValueError(f"--top = {args.top} must be >= 1")
-    if args.output is not None and Path(args.output).exists() and not Path(args.output).is_dir():
-        raise ValueError(f"--output {args.output!r} exists and is not a folder")
+    if args.output is not None:  # before any simulation: a folder that can be written
+        from holofold.geometry import check_output_folder
+
+        if Path(args.output).exists() and not Path(args.output).is_dir():
+            raise ValueError(f"--output {args.output!r} exists and is not a folder")
+        check_output_folder(args.output, "--output")
     rules = read_rules(args.rules)[: args.top]
     results = verify_rules(
         args.scenario, rules, args.target, args.samples,
