@@ -35,6 +35,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "CurveSelectionWarning",
             "MAX_SVG_BYTES",
             "MAX_SVG_NESTING",
+            "MAX_SVG_ELEMENTS",
+            "MAX_SVG_POINTS",
             "PLAUSIBLE_SIZE",
             "check_curve_size",
             "read_points_csv",

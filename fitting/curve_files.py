@@ -34,6 +34,8 @@ __all__ = [
     "CurveSelectionWarning",
     "MAX_SVG_BYTES",
     "MAX_SVG_NESTING",
+    "MAX_SVG_ELEMENTS",
+    "MAX_SVG_POINTS",
     "PLAUSIBLE_SIZE",
     "check_curve_size",
     "read_points_csv",
@@ -53,6 +55,14 @@ MAX_SVG_BYTES = 64 * 2**20
 #: the deepest element nesting read: drawings nest groups a few levels deep; svgelements
 #: recurses per level and fails near 1000 (at Python's default recursion limit)
 MAX_SVG_NESTING = 100
+#: the most elements read after every reference (``<use href="#id">``, and any other element
+#: that refers to another by ``href``) is expanded: svgelements takes about 0.2 ms per element
+#: (10,000 flat paths: 1.8 s), so 20,000 is about 4 s; a 25-level ``<use>`` doubling bomb
+#: (2^25 elements from 1.8 kB) is refused before it is parsed
+MAX_SVG_ELEMENTS = 20_000
+#: the most path points (coordinate pairs of ``d`` and ``points``) after expansion:
+#: svgelements takes about 40 us per segment (100,000 in one path: 4 s)
+MAX_SVG_POINTS = 200_000
 
 
 class CurveUnitWarning(UserWarning):
@@ -258,6 +268,9 @@ def _check_svg_structure(file: str) -> None:
         )
     parser = expat.ParserCreate()
     depth = [0]
+    # expanded size: each open element's own (elements, points) and the ids it refers to
+    stack: list = [[0, 0, {}]]
+    named: dict = {}  # id -> (elements, points, {referenced id: count}) of its subtree
 
     class Deep(Exception):
         pass
@@ -266,9 +279,23 @@ def _check_svg_structure(file: str) -> None:
         depth[0] += 1
         if depth[0] > MAX_SVG_NESTING:
             raise Deep(name)
+        points = sum(len(_NUMBER.findall(attrs.get(k, ""))) // 2 for k in ("d", "points"))
+        refs = {}
+        href = attrs.get("xlink:href") or attrs.get("href") or ""
+        if href.startswith("#"):
+            refs[href[1:]] = 1
+        stack.append([1, points, refs, attrs.get("id")])
 
     def end(name):
         depth[0] -= 1
+        n, pts, refs, ident = stack.pop()
+        if ident:
+            named[ident] = (n, pts, refs)
+        parent = stack[-1]
+        parent[0] += n
+        parent[1] += pts
+        for k, c in refs.items():
+            parent[2][k] = parent[2].get(k, 0) + c
 
     parser.StartElementHandler, parser.EndElementHandler = start, end
     try:
@@ -288,6 +315,49 @@ def _check_svg_structure(file: str) -> None:
         ) from None
     except OSError as exc:
         raise CurveFormatError(f"cannot read SVG file {file!r}: {exc.strerror}") from None
+    elements, points = _expanded(stack[0][0], stack[0][1], stack[0][2], named, file)
+    for count, limit, what in ((elements, MAX_SVG_ELEMENTS, "elements"),
+                               (points, MAX_SVG_POINTS, "path points")):  # fmt: skip
+        if count > limit:
+            raise CurveFormatError(
+                f"cannot read SVG file {file!r}: {_size(count, limit)} {what} once its <use> "
+                f"references are expanded; expected at most {limit:,} (docs/limits.md)"
+            )
+
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _size(count: int, limit: int) -> str:
+    return f"over {limit:,}" if count > 10 * limit else f"{count:,}"
+
+
+def _expanded(elements: int, points: int, refs: dict, named: dict, file: str) -> tuple[int, int]:
+    """(elements, points) of a subtree with every reference expanded, saturated just above the
+    limits (a doubling bomb's 2^25 is never built), refusing a reference cycle."""
+    cap = (10 * MAX_SVG_ELEMENTS + 1, 10 * MAX_SVG_POINTS + 1)
+    memo: dict = {}
+
+    def size(ident, seen):
+        if ident in memo:
+            return memo[ident]
+        if ident in seen:
+            raise CurveFormatError(f"cannot read SVG file {file!r}: <use> of #{ident} refers to "
+                                   "itself (a reference cycle)")  # fmt: skip
+        if ident not in named:
+            return (0, 0)  # a dangling reference: svgelements skips it
+        n, p, r = named[ident]
+        out = total(n, p, r, seen | {ident})
+        memo[ident] = out
+        return out
+
+    def total(n, p, r, seen):
+        for k, c in r.items():
+            a, b = size(k, seen)
+            n, p = min(cap[0], n + c * a), min(cap[1], p + c * b)
+        return n, p
+
+    return total(elements, points, refs, frozenset())
 
 
 def _curve_of(path, name: str, source: str, scale: float) -> PlanarCurve:

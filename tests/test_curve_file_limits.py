@@ -110,3 +110,55 @@ def test_any_tag_soup_gives_a_curve_or_the_curve_error(tmp_path, tags, ref):
             read_svg_curve(f"{f}{ref}")
         except CurveError as exc:
             assert "\n" not in str(exc)
+
+
+# ---------------------------------------------------------------- expansion (issue 23 item 4)
+def _doubling(levels: int) -> str:
+    """<use> doubling: level i uses level i-1 twice, so the last level is 2^levels paths."""
+    defs = ['<path id="l0" d="M0,0 L1,1"/>']
+    defs += [f'<g id="l{i}"><use href="#l{i - 1}"/><use xlink:href="#l{i - 1}" '
+             'transform="translate(1,0)"/></g>' for i in range(1, levels + 1)]  # fmt: skip
+    return (
+        '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink">'
+        f'<defs>{"".join(defs)}</defs><use href="#l{levels}"/>'
+        '<path id="arc" d="M 0 0 C 10 -20 30 -20 40 0"/></svg>'
+    )
+
+
+def test_a_use_doubling_bomb_is_refused_in_one_line_within_a_second(tmp_path, capsys):
+    import time
+
+    from holofold.cli import main
+
+    f = tmp_path / "bomb.svg"
+    f.write_text(_doubling(25))
+    assert f.stat().st_size < 2500  # 2 kB that svgelements would expand to 2^25 elements
+    t0 = time.monotonic()
+    _refused(f"{f}#arc", r"over 20,000 elements once its <use> references are expanded")
+    assert time.monotonic() - t0 < 1.0
+    # the commands that read curves: one line, exit 2
+    t0 = time.monotonic()
+    assert main(["fit", "--curve", f"{f}#arc", "--m", "8", "--offset", "0.2", "--strip-width",
+                 "0.02", "--extrude", "0.1", "-o", str(tmp_path / "fit")]) == 2  # fmt: skip
+    assert time.monotonic() - t0 < 5
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "references are expanded" in err
+
+
+def test_expansion_within_the_limits_reads_and_cycles_are_refused(tmp_path):
+    f = tmp_path / "ok.svg"
+    f.write_text(_doubling(8))  # 256 copies: a drawing may use <use>
+    assert read_svg_curve(f"{f}#arc", check_size=False).length > 0
+    f = _write(tmp_path, '<g id="a"><use href="#b"/></g><g id="b"><use href="#a"/></g>'
+               '<path id="p" d="M 0 0 L 1 1"/>', "cycle.svg")  # fmt: skip
+    _refused(f"{f}#p", r"refers to itself \(a reference cycle\)")
+
+
+def test_path_points_after_expansion_are_bounded(tmp_path):
+    from holofold.fitting import MAX_SVG_POINTS
+
+    d = "M0,0 " + " ".join(f"L{i},{i % 3}" for i in range(1, 2001))  # 2001 points
+    body = f'<defs><path id="long" d="{d}"/></defs>' + '<use href="#long"/>' * 120
+    f = _write(tmp_path, body + '<path id="p" d="M 0 0 L 1 1"/>', "long.svg")
+    msg = _refused(f"{f}#p", r"path points once its <use> references are expanded")
+    assert f"at most {MAX_SVG_POINTS:,}" in msg
