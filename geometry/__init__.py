@@ -18,7 +18,10 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "EnvironmentFault",
             "check_range",
         ],
+        "arrangement": ["Arrangement", "arrange_lines"],
+        "cuts": ["separate_cuts"],
         "export": ["export", "export_pattern_files", "EXPORT_TYPES"],
+        "facets": ["split_faces", "nonconvex_faces", "SPLIT_MODES"],
         "fold_io": ["export_fold", "fold_dict", "load_fold", "read_fold", "FoldWarning"],
         "gripper": [
             "GripperPattern",
@@ -50,6 +53,15 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "write_json",
         ],
         "pattern": ["CreasePattern", "ASSIGNMENTS", "MAX_PANELS", "non_simple_faces"],
+        "readers": [
+            "read_pattern",
+            "register_reader",
+            "reader_for",
+            "READERS",
+            "PatternReader",
+            "PatternWarning",
+            "pattern_from_lines",
+        ],
         "printable": [
             "PrintableLayout",
             "printable_layout",

@@ -252,7 +252,8 @@ def measure_fold_angles(coords: np.ndarray, faces, edges: np.ndarray) -> np.ndar
 
 
 def _segments_cross(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Whether 2-D segments p-q and r-s intersect (touching included), vectorised."""
+    """Whether 2-D segments p-q and r-s intersect (touching included), vectorised; collinear
+    segments only where they overlap."""
 
     def orient(a, b, c):
         return (b[..., 0] - a[..., 0]) * (c[..., 1] - a[..., 1]) - (b[..., 1] - a[..., 1]) * (
@@ -261,7 +262,14 @@ def _segments_cross(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) 
 
     d1, d2 = orient(r, s, p), orient(r, s, q)
     d3, d4 = orient(p, q, r), orient(p, q, s)
-    return (d1 * d2 <= 0) & (d3 * d4 <= 0)
+    # the bounding boxes must overlap too: collinear segments (all four orientations zero, or
+    # rounding noise around zero) cross only where they overlap along their line
+    boxes = np.ones(d1.shape, bool)
+    for c in (0, 1):
+        lo1, hi1 = np.minimum(p[..., c], q[..., c]), np.maximum(p[..., c], q[..., c])
+        lo2, hi2 = np.minimum(r[..., c], s[..., c]), np.maximum(r[..., c], s[..., c])
+        boxes &= (lo1 <= hi2) & (lo2 <= hi1)
+    return (d1 * d2 <= 0) & (d3 * d4 <= 0) & boxes
 
 
 def _check_simple(t: _FaceTable, pts2d: np.ndarray) -> np.ndarray:

@@ -1,0 +1,224 @@
+"""DXF crease patterns (CAD, laser software) read into a crease pattern, with ezdxf.
+
+The layer of an entity gives its assignment (:data:`LAYER_CODES`: the layers holofold's DXF
+writer uses, ``BOUNDARY``, ``CUT``, ``SCORE_M``, ``SCORE_V``, ``SCORE_F``, ``SCORE_U``, and the
+usual names ``MOUNTAIN``, ``VALLEY``, ``BORDER``, ``OUTLINE``, ``FACET``, ``UNDRIVEN``, ``M``,
+``V``, ... in any case); an entity on another layer is assigned by its colour as in Origami
+Simulator's SVG convention (AutoCAD colour index 1 red mountain, 5 blue valley, 7 black/white
+border, 3 green cut, 2 yellow facet, 6 magenta undriven, or the same true colours; ``BYLAYER``
+resolved). ``REGISTRATION`` and layers of no known name or colour are left out with a warning
+naming them. A DXF has no fold angle: mountains and valleys fold fully (-+180 degrees) unless
+the entity is transparent, where the angle is 180 x (1 - transparency) (the opacity rule of
+Origami Simulator's SVG).
+
+Entities: ``LINE``, ``LWPOLYLINE`` and ``POLYLINE`` (straight pieces; bulges are arcs),
+``ARC``, ``CIRCLE``, ``ELLIPSE``, ``SPLINE`` (curves: flattened for borders and cuts, refused
+for creases unless ``curves="flatten"``) and ``INSERT`` (block references, exploded with their
+transformation). Units from ``$INSUNITS`` (unitless drawings are read as millimetres, with a
+warning); ``unit`` (metres per drawing unit) overrides.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
+
+__all__ = ["read_dxf_pattern", "dxf_lines", "LAYER_CODES", "ACI_CODES", "MAX_DXF_BYTES"]
+
+#: layer name (upper case) -> FOLD code; holofold's writer uses the first of each group
+LAYER_CODES = {
+    **dict.fromkeys(("BOUNDARY", "BORDER", "OUTLINE", "B"), "B"),
+    **dict.fromkeys(("CUT", "CUTS", "C"), "C"),
+    **dict.fromkeys(("SCORE_M", "MOUNTAIN", "MOUNTAINS", "M"), "M"),
+    **dict.fromkeys(("SCORE_V", "VALLEY", "VALLEYS", "V"), "V"),
+    **dict.fromkeys(("SCORE_F", "FLAT", "FACET", "FACETS", "F"), "F"),
+    **dict.fromkeys(("JOIN", "J"), "J"),
+    **dict.fromkeys(("SCORE_U", "UNDRIVEN", "UNASSIGNED", "HINGE", "U"), "U"),
+}
+#: layers that are never crease lines
+IGNORED_LAYERS = ("REGISTRATION", "DEFPOINTS")
+#: AutoCAD colour index -> FOLD code
+ACI_CODES = {1: "M", 5: "V", 7: "B", 3: "C", 2: "F", 6: "U"}
+_RGB_CODES = {(255, 0, 0): "M", (0, 0, 255): "V", (0, 0, 0): "B", (255, 255, 255): "B",
+              (0, 255, 0): "C", (255, 255, 0): "F", (255, 0, 255): "U"}  # fmt: skip
+#: the largest DXF file read, bytes
+MAX_DXF_BYTES = 64 * 2**20
+_CURVES = ("ARC", "CIRCLE", "ELLIPSE", "SPLINE")
+
+
+def _code(entity, doc) -> str | None:
+    layer = str(entity.dxf.get("layer", "0"))
+    key = layer.strip().upper()
+    if key in IGNORED_LAYERS:
+        return None
+    if key in LAYER_CODES:
+        return LAYER_CODES[key]
+    rgb = entity.rgb if entity.dxf.hasattr("true_color") else None
+    if rgb is None:
+        aci = entity.dxf.get("color", 256)
+        if aci == 256:  # BYLAYER
+            try:
+                lay = doc.layers.get(layer)
+                aci = lay.color
+                if lay.has_dxf_attrib("true_color"):
+                    rgb = lay.rgb
+            except Exception:  # noqa: BLE001 - an undefined layer: no colour
+                return ""
+        if rgb is None:
+            return ACI_CODES.get(abs(int(aci)), "")
+    return _RGB_CODES.get(tuple(int(c) for c in rgb), "")
+
+
+def _angle(code: str, entity) -> float:
+    if code not in ("M", "V"):
+        return 0.0
+    t = 0.0
+    try:
+        if entity.dxf.hasattr("transparency"):
+            t = float(entity.transparency)
+    except Exception:  # noqa: BLE001
+        t = 0.0
+    return (-180.0 if code == "M" else 180.0) * (1.0 - min(max(t, 0.0), 1.0))
+
+
+def _entities(space, depth: int = 0):
+    for e in space:
+        if e.dxftype() == "INSERT" and depth < 16:
+            try:
+                yield from _entities(e.virtual_entities(), depth + 1)
+            except Exception:  # noqa: BLE001 - a broken block: skip it
+                continue
+        else:
+            yield e
+
+
+def dxf_lines(path, *, curves: str = "refuse"):
+    """The straight lines of a DXF crease pattern: (segments (n, 2, 2) in drawing units,
+    codes, fold angles in degrees, metres per drawing unit, notes)."""
+    try:
+        import ezdxf
+        from ezdxf import path as ezpath
+        from ezdxf import units as ezunits
+    except ImportError as exc:  # a dependency of holofold: the environment is broken
+        raise EnvironmentFault(f"ezdxf cannot be imported ({exc}); pip install ezdxf") from None
+    if curves not in ("refuse", "flatten"):
+        raise ParameterError(f"curves = {curves!r}; allowed: refuse, flatten")
+    name = Path(path).name
+    size = Path(path).stat().st_size
+    if size > MAX_DXF_BYTES:
+        raise FormatError(f"{name}: {size} bytes; at most {MAX_DXF_BYTES} (64 MiB) are read")
+    try:
+        doc = ezdxf.readfile(str(path))
+    except (OSError, ezdxf.DXFError) as exc:
+        raise FormatError(f"{name}: not a readable DXF file ({exc})") from None
+    except Exception as exc:  # noqa: BLE001 - a malformed file: one line
+        raise FormatError(
+            f"{name}: not a readable DXF file ({type(exc).__name__}: {exc})"
+        ) from None
+    notes = []
+    insunits = int(doc.header.get("$INSUNITS", 0) or 0)
+    if insunits == 0:
+        unit = 1e-3
+        notes.append("the drawing states no unit ($INSUNITS 0): read as millimetres; give unit")
+    else:
+        try:
+            unit = float(ezunits.conversion_factor(insunits, ezunits.M))
+        except Exception:  # noqa: BLE001 - an unknown unit code
+            unit = 1e-3
+            notes.append(f"unknown $INSUNITS {insunits}: read as millimetres; give unit")
+    segs, codes, angles = [], [], []
+    skipped: Counter = Counter()
+    curved_creases = 0
+    flattened = 0
+    ents = list(_entities(doc.modelspace()))
+    pts_all = []
+    for e in ents:
+        t = e.dxftype()
+        if t not in ("LINE", "LWPOLYLINE", "POLYLINE", *_CURVES):
+            continue
+        code = _code(e, doc)
+        if code is None:
+            continue
+        if code == "":
+            skipped[str(e.dxf.get("layer", "0"))] += 1
+            continue
+        ang = _angle(code, e)
+        if t == "LINE":
+            a, b = e.dxf.start, e.dxf.end
+            pieces = [np.array([[a.x, a.y], [b.x, b.y]])]
+        else:
+            try:
+                p = ezpath.make_path(e)
+            except Exception:  # noqa: BLE001 - an entity ezdxf cannot trace
+                skipped[f"{t} on {e.dxf.get('layer', '0')}"] += 1
+                continue
+            curved = t in _CURVES or p.has_curves
+            if curved and code not in ("B", "C") and curves != "flatten":
+                curved_creases += 1
+                continue
+            pieces = []
+            for sub in p.sub_paths():
+                if sub.has_curves:
+                    flattened += 1
+                    ext = max(
+                        1e-12,
+                        float(
+                            np.ptp(
+                                np.array([(v.x, v.y) for v in sub.control_vertices()]), axis=0
+                            ).max()
+                        ),
+                    )
+                    vs = list(sub.flattening(distance=1e-3 * ext))
+                else:
+                    vs = [v for v in sub.control_vertices()]
+                P = np.array([[v.x, v.y] for v in vs])
+                if len(P) >= 2:
+                    pieces.append(P)
+        for P in pieces:
+            pts_all.append(P)
+            for a, b in zip(P[:-1], P[1:], strict=True):
+                segs.append([a, b])
+                codes.append(code)
+                angles.append(ang)
+    if curved_creases:
+        raise FormatError(
+            f"{name}: {curved_creases} curved crease(s); holofold folds straight creases: draw "
+            "them as lines, or read with curves='flatten' (--curves flatten)"
+        )
+    if skipped:
+        listed = ", ".join(f"{k} ({n})" for k, n in skipped.most_common(5))
+        notes.append(
+            f"{sum(skipped.values())} entit(ies) on layers of no crease name or colour left out: "
+            f"{listed}; layers: BOUNDARY, CUT, SCORE_M, SCORE_V, SCORE_F, SCORE_U (or colours)"
+        )
+    if flattened:
+        notes.append(f"{flattened} curved piece(s) flattened into segments")
+    if not segs:
+        raise FormatError(
+            f"{name}: no crease-pattern lines (LINE/LWPOLYLINE/POLYLINE on crease layers or in "
+            "crease colours)"
+        )
+    return np.array(segs, float), np.array(codes, dtype="<U1"), np.array(angles), unit, notes
+
+
+def read_dxf_pattern(path, *, tol: float | None = None, unit: float | None = None,
+                     split: str = "as-needed", curves: str = "refuse"):  # fmt: skip
+    """The crease pattern of a DXF file (see the module docstring), metres."""
+    from holofold.geometry.readers import pattern_from_lines
+
+    name = Path(path).name
+    S, codes, angles, file_unit, notes = dxf_lines(path, curves=curves)
+    if unit is not None:
+        notes = [n for n in notes if "$INSUNITS" not in n]
+    u = file_unit if unit is None else unit
+    if not (isinstance(u, int | float) and math.isfinite(u) and u > 0):
+        raise ParameterError(f"unit = {u!r} must be a length in metres > 0")
+    return pattern_from_lines(
+        S, codes, angles, name=name, unit=float(u), tol=tol, split=split,
+        meta={"kind": "dxf", "source": name}, notes=notes,
+    )  # fmt: skip

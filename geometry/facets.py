@@ -1,0 +1,99 @@
+"""Faces split into triangles where the bar-and-hinge model needs it; added edges are facets.
+
+The models of :mod:`holofold.mechanics.hinges` fan every panel from the mean of its corners.
+That is right for a convex panel of any number of sides, but a spoke of a non-convex panel can
+leave the panel (or cross its side), so :func:`split_faces` triangulates such panels (ear
+clipping by manifold3d, no new vertices) and marks every added edge ``J`` (a join: a facet that
+stays flat, Origami Simulator's yellow triangulation line). ``mode="all"`` triangulates every
+face with more than three vertices, as Origami Simulator does; ``"none"`` leaves them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from holofold.geometry.errors import ParameterError
+
+__all__ = ["split_faces", "nonconvex_faces", "SPLIT_MODES"]
+
+#: which faces :func:`split_faces` triangulates
+SPLIT_MODES = ("as-needed", "all", "none")
+
+
+def _cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def nonconvex_faces(xy, faces, rel_tol: float = 1e-9) -> np.ndarray:
+    """Ids of the counter-clockwise faces with a reflex corner (turning clockwise by more than
+    ``rel_tol`` x the squared size of the face; straight corners count as convex)."""
+    xy = np.asarray(xy, float)
+    bad = []
+    for k, f in enumerate(faces):
+        if len(f) <= 3:
+            continue
+        p = xy[f]
+        d_in = p - np.roll(p, 1, axis=0)
+        d_out = np.roll(p, -1, axis=0) - p
+        size2 = float(np.ptp(p, axis=0).max()) ** 2
+        if (_cross(d_in, d_out) < -rel_tol * size2).any():
+            bad.append(k)
+    return np.array(bad, np.intp)
+
+
+def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed"):
+    """Triangulate faces (see the module docstring).
+
+    Parameters
+    ----------
+    xy : (nv, 2) float
+        Flat layout (faces counter-clockwise in it).
+    faces : sequence of (k,) int
+    edges : (ne, 2) int
+    assignment : (ne,) str
+    fold_angle : (ne,) float
+    mode : {"as-needed", "all", "none"}
+
+    Returns
+    -------
+    faces, edges, assignment, fold_angle, n_split
+        The new faces (a split face's triangles in its place), the edges with the added ``J``
+        edges last, and how many faces were split.
+    """
+    if mode not in SPLIT_MODES:
+        raise ParameterError(f"mode = {mode!r}; allowed: {', '.join(SPLIT_MODES)}")
+    xy = np.asarray(xy, float)
+    faces = [np.asarray(f, np.int64) for f in faces]
+    edges = np.asarray(edges, np.int64).reshape(-1, 2)
+    asg = np.asarray(assignment)
+    ang = np.asarray(fold_angle, float)
+    if mode == "none":
+        return faces, edges, asg, ang, 0
+    if mode == "all":
+        todo = {k for k, f in enumerate(faces) if len(f) > 3}
+    else:
+        todo = set(nonconvex_faces(xy, faces).tolist())
+    if not todo:
+        return faces, edges, asg, ang, 0
+    import manifold3d
+
+    out: list[np.ndarray] = []
+    have = {tuple(x) for x in np.sort(edges, axis=1).tolist()}
+    added: list[tuple[int, int]] = []
+    for k, f in enumerate(faces):
+        if k not in todo:
+            out.append(f)
+            continue
+        tris = np.asarray(manifold3d.triangulate([xy[f]]), np.int64)
+        for t in f[tris]:
+            out.append(t)
+            for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+                key = (min(a, b), max(a, b))
+                if key not in have:
+                    have.add(key)
+                    added.append(key)
+    if added:
+        edges = np.vstack([edges, np.array(added, np.int64)])
+        asg = np.concatenate([asg, np.full(len(added), "J", dtype=asg.dtype)])
+        ang = np.concatenate([ang, np.zeros(len(added))])
+    return out, edges, asg, ang, len(todo)

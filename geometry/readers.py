@@ -1,0 +1,218 @@
+"""Reading crease patterns drawn in other tools: one entry point, a registry of formats by suffix.
+
+:func:`read_pattern` reads ``.fold`` (FOLD 1.2, any frame), ``.svg`` (Origami Simulator's
+colours), ``.dxf`` (layers or colours), ``.opx`` (ORIPA) and ``.cp`` (ORIPA's line list)
+files into a :class:`~holofold.geometry.pattern.CreasePattern` in metres, with its flat
+layout, assignments and target fold angles (degrees). Every reader refuses a file it cannot
+use with one :class:`~holofold.geometry.errors.FormatError` line naming the file and the
+problem, and
+reports every repair it made (merged vertices, dropped lines, separated cuts, split faces) as
+one :class:`PatternWarning` line each. Line drawings go through the same steps
+(:func:`pattern_from_lines`): the planar arrangement
+(:func:`~holofold.geometry.arrangement.arrange_lines`), cuts separated
+(:func:`~holofold.geometry.cuts.separate_cuts`), faces split where the model needs it
+(:func:`~holofold.geometry.facets.split_faces`).
+
+Other formats are added with :func:`register_reader` (a function ``path, **options ->
+CreasePattern``).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from holofold.geometry.errors import FormatError, ParameterError
+from holofold.geometry.pattern import MAX_PANELS, CreasePattern
+
+__all__ = [
+    "PatternWarning",
+    "PatternReader",
+    "READERS",
+    "read_pattern",
+    "register_reader",
+    "reader_for",
+    "pattern_from_lines",
+    "finish_pattern",
+]
+
+
+class PatternWarning(UserWarning):
+    """A crease-pattern file read with a repair or an assumption (named in the message)."""
+
+
+@dataclass(frozen=True)
+class PatternReader:
+    """One file format.
+
+    Attributes
+    ----------
+    suffix : str
+        ``".svg"``.
+    name : str
+        What the format is.
+    read : callable(path, **options) -> CreasePattern
+    options : tuple of str
+        The keyword options it takes (``tol``, ``unit``, ``frame``, ``split``, ...).
+    """
+
+    suffix: str
+    name: str
+    read: Callable
+    options: tuple[str, ...] = ()
+
+
+def _fold(path, **kw):
+    from holofold.geometry.fold_reader import read_fold_pattern
+
+    return read_fold_pattern(path, **kw)
+
+
+def _svg(path, **kw):
+    from holofold.geometry.svg_reader import read_svg_pattern
+
+    return read_svg_pattern(path, **kw)
+
+
+def _dxf(path, **kw):
+    from holofold.geometry.dxf_reader import read_dxf_pattern
+
+    return read_dxf_pattern(path, **kw)
+
+
+def _opx(path, **kw):
+    from holofold.geometry.opx_reader import read_opx_pattern
+
+    return read_opx_pattern(path, **kw)
+
+
+def _cp(path, **kw):
+    from holofold.geometry.opx_reader import read_cp_pattern
+
+    return read_cp_pattern(path, **kw)
+
+
+#: suffix -> reader
+READERS: dict[str, PatternReader] = {
+    ".fold": PatternReader(".fold", "FOLD 1.2", _fold, ("frame", "unit", "split")),
+    ".svg": PatternReader(
+        ".svg", "SVG (Origami Simulator colours)", _svg, ("tol", "unit", "split", "curves")
+    ),
+    ".dxf": PatternReader(
+        ".dxf", "DXF (layers or colours)", _dxf, ("tol", "unit", "split", "curves")
+    ),
+    ".opx": PatternReader(".opx", "ORIPA", _opx, ("tol", "unit", "split")),
+    ".cp": PatternReader(".cp", "ORIPA/Oriedita lines", _cp, ("tol", "unit", "split")),
+}
+
+
+def register_reader(reader: PatternReader) -> PatternReader:
+    """Add (or replace) the reader of ``reader.suffix``."""
+    if not reader.suffix.startswith(".") or len(reader.suffix) < 2:
+        raise ValueError(f"suffix {reader.suffix!r} must look like '.ext'")
+    READERS[reader.suffix.lower()] = reader
+    return reader
+
+
+def reader_for(path) -> PatternReader:
+    """The reader of ``path``'s suffix (one FormatError line naming the known ones)."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in READERS:
+        raise FormatError(
+            f"{Path(path).name}: unknown crease-pattern format {suffix or '(no suffix)'!r}; "
+            f"known: {', '.join(READERS)}"
+        )
+    return READERS[suffix]
+
+
+def read_pattern(path: str | os.PathLike, **options) -> CreasePattern:
+    """The crease pattern of a file, by its suffix (:data:`READERS`); ``options`` go to the
+    format's reader (each reader names the ones it takes: ``tol`` merge distance in drawing
+    units, ``unit`` metres per drawing unit, ``frame`` of a FOLD file, ``split`` one of
+    :data:`~holofold.geometry.facets.SPLIT_MODES`)."""
+    reader = reader_for(path)
+    bad = sorted(set(options) - set(reader.options))
+    if bad:
+        raise ParameterError(
+            f"{reader.name} files take no option {bad[0]!r}; allowed: {', '.join(reader.options)}"
+        )
+    p = Path(path)
+    if not p.is_file():
+        raise FormatError(f"{p}: no such file")
+    return reader.read(p, **{k: v for k, v in options.items() if v is not None})
+
+
+def _check_split(split: str) -> str:
+    from holofold.geometry.facets import SPLIT_MODES
+
+    if split not in SPLIT_MODES:
+        raise ParameterError(f"split = {split!r}; allowed: {', '.join(SPLIT_MODES)}")
+    return split
+
+
+def finish_pattern(
+    xy, faces, edges, assignment, fold_angle, *, name: str, notes=(), split: str = "as-needed",
+    meta: dict | None = None, coords3=None,
+) -> CreasePattern:  # fmt: skip
+    """A :class:`CreasePattern` from a flat layout (metres) and its faces: cuts separated,
+    faces split as the model needs (``split``), each repair warned about in one line."""
+    from holofold.geometry.cuts import separate_cuts
+    from holofold.geometry.facets import split_faces
+
+    split = _check_split(split)
+    notes = list(notes)
+    xy = np.asarray(xy, float)
+    xy, faces, edges, asg, ang, origin, more = separate_cuts(
+        xy, faces, edges, assignment, fold_angle
+    )
+    notes += more
+    n_cut = len(origin) - len(np.unique(origin))
+    if n_cut:
+        notes.append(f"cuts separated: {n_cut} vertex copies made along them")
+    faces, edges, asg, ang, n_split = split_faces(xy, faces, edges, asg, ang, split)
+    if n_split:
+        why = "non-convex" if split == "as-needed" else "with more than 3 vertices"
+        notes.append(f"{n_split} {why} face(s) split into triangles (added edges J)")
+    if len(faces) > MAX_PANELS:
+        raise FormatError(f"{name}: {len(faces)} panels; at most {MAX_PANELS} are read")
+    c3 = np.column_stack([xy, np.zeros(len(xy))]) if coords3 is None else coords3[origin]
+    try:
+        pattern = CreasePattern(c3, faces, edges, asg, ang, flat=xy, meta=meta or {})
+    except ValueError as exc:
+        raise FormatError(f"{name}: {exc}") from None
+    inside = int((pattern.interior & np.isin(pattern.assignment, ("B", "C"))).sum())
+    if inside:
+        notes.append(
+            f"{inside} border or cut line(s) run inside the sheet (two panels each): folded as "
+            "passive creases; are they the outline?"
+        )
+    for n in notes:
+        warnings.warn(f"{name}: {n}", PatternWarning, stacklevel=3)
+    return pattern
+
+
+def pattern_from_lines(
+    segments, assignment, fold_angle, *, name: str, unit: float, tol: float | None = None,
+    split: str = "as-needed", meta: dict | None = None, notes=(),
+) -> CreasePattern:  # fmt: skip
+    """The crease pattern of drawn lines (drawing units; ``unit`` metres per drawing unit;
+    ``tol`` the merge distance in drawing units, default 1e-3 of the drawing's larger side)."""
+    from holofold.geometry.arrangement import arrange_lines
+
+    if not (np.isfinite(unit) and unit > 0):
+        raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
+    if tol is not None and not (np.isfinite(tol) and tol > 0):
+        raise ParameterError(f"tol = {tol!r} must be a distance > 0 in drawing units")
+    try:
+        arr = arrange_lines(segments, assignment, fold_angle, tol=tol)
+    except FormatError as exc:
+        raise FormatError(f"{name}: {exc}") from None
+    return finish_pattern(
+        arr.vertices * unit, arr.faces, arr.edges, arr.assignment, arr.fold_angle,
+        name=name, notes=[*notes, *arr.notes], split=split, meta=meta,
+    )  # fmt: skip

@@ -1,0 +1,253 @@
+"""SVG crease patterns in Origami Simulator's convention, read into a crease pattern.
+
+Stroke colours give the assignment: mountain red ``#ff0000``, valley blue ``#0000ff``, border
+black ``#000000``, cut green ``#00ff00``, facet yellow ``#ffff00`` (``F``: stays flat),
+undriven magenta ``#ff00ff`` (``U``: a passive crease); a colour within 16/255 per channel of
+one of these counts as it, any other is left out with a warning naming it. The fold angle of a
+mountain or valley is ``-+180 x opacity x stroke-opacity`` degrees (Origami Simulator's
+encoding, 1 = a full fold); ``data-assignment`` and ``data-foldAngle`` attributes (Rabbit
+Ear's and holofold's own) take precedence over the colour and the opacity.
+
+The file is parsed by svgelements: ``<line>``, ``<polyline>``, ``<polygon>``, ``<rect>`` and
+``<path>`` elements anywhere in groups (but a legend, ``<g id="legend">``, and registration
+marks, ``data-role="registration"``), with every ``transform``, CSS class and style, and the
+document's units and ``viewBox`` honoured (one user unit is 1/96 inch unless the document says
+otherwise, so a drawing in millimetres reads in millimetres); elements hidden by ``display:
+none`` are left out. The y axis is turned up, so that the pattern is not mirrored (a mirrored
+pattern swaps mountains and valleys). Straight lines only: a curved border or cut (an arc, a
+circle) is flattened into short segments with a warning; a curved crease is refused unless
+``curves="flatten"``. Then :func:`~holofold.geometry.readers.pattern_from_lines` merges end
+points within ``tol``, splits crossing lines and finds the faces.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from holofold.geometry.errors import FormatError, ParameterError
+
+__all__ = ["read_svg_pattern", "svg_lines", "SVG_COLOURS", "CURVE_MODES", "MAX_SVG_BYTES"]
+
+#: stroke colour (r, g, b) -> FOLD code (Origami Simulator's import convention)
+SVG_COLOURS = {
+    (0, 0, 0): "B",
+    (255, 0, 0): "M",
+    (0, 0, 255): "V",
+    (0, 255, 0): "C",
+    (255, 255, 0): "F",
+    (255, 0, 255): "U",
+}
+_COLOUR_TOL = 16
+#: what to do with curved lines: refuse curved creases (flatten curved borders and cuts), or
+#: flatten every curve into segments
+CURVE_MODES = ("refuse", "flatten")
+#: the largest SVG file read, bytes (Origami Simulator's largest example is 0.7 MB)
+MAX_SVG_BYTES = 64 * 2**20
+#: metres per SVG px (1/96 inch)
+PX = 0.0254 / 96.0
+_CODES = {"M", "V", "B", "F", "C", "J", "U"}
+
+
+def _code(colour) -> str | None:
+    if colour is None or colour.value is None:
+        return None
+    rgb = np.array([colour.red, colour.green, colour.blue])
+    for key, code in SVG_COLOURS.items():
+        if np.abs(rgb - np.array(key)).max() <= _COLOUR_TOL:
+            return code
+    return ""
+
+
+def _number(text, default: float = 1.0) -> float:
+    if text is None:
+        return default
+    try:
+        v = float(str(text).strip().rstrip("%"))
+    except ValueError:
+        return default
+    return v / 100.0 if str(text).strip().endswith("%") else v
+
+
+def _pieces(seg, n: int) -> np.ndarray:
+    """``n`` straight pieces of a curved segment, (n + 1, 2) points."""
+    pts = [seg.point(x) for x in np.linspace(0.0, 1.0, n + 1)]
+    return np.array([[float(p.x), float(p.y)] for p in pts])
+
+
+# svgelements converts absolute units to px with rounded factors (1 mm = 3.7795296 px, not
+# 96 / 25.4); a px of a document sized in those units is undone with the same factor, so a
+# drawing in millimetres reads back to the nanometre
+_SE_PX = {"mm": 96 * 0.0393701 / 1e-3, "cm": 96 * 0.393701 / 1e-2, "in": 96 / 0.0254}
+
+
+def _metres_per_px(svg) -> float:
+    import re
+
+    width = str(svg.values.get("width", "")).strip()
+    m = re.fullmatch(r"[-+0-9.eE]+\s*([a-z%]*)", width)
+    unit = m.group(1) if m else ""
+    return 1.0 / _SE_PX[unit] if unit in _SE_PX else PX
+
+
+def _without_legend(data: bytes):
+    """The file as a stream, less a legend group (``<g id="legend">``) and registration marks
+    (``data-role="registration"``): drawings, not creases (holofold's SVG writer adds them)."""
+    import io
+
+    if b'id="legend"' not in data and b'data-role="registration"' not in data:
+        return io.BytesIO(data)
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.fromstring(data)
+    except ET.ParseError:
+        return io.BytesIO(data)  # svgelements says what is wrong
+    for parent in list(root.iter()):
+        for child in list(parent):
+            if child.get("id") == "legend" or child.get("data-role") == "registration":
+                parent.remove(child)
+    return io.BytesIO(ET.tostring(root))
+
+
+def svg_lines(path, *, curves: str = "refuse"):
+    """The straight lines of an SVG crease pattern, in SVG px with y up.
+
+    Returns
+    -------
+    segments : (n, 2, 2) float
+    assignment : (n,) str
+    fold_angle : (n,) float
+        Degrees (valley > 0).
+    notes : list of str
+    metres_per_px : float
+        The length of one px of ``segments``.
+    """
+    import svgelements as se
+
+    if curves not in CURVE_MODES:
+        raise ParameterError(f"curves = {curves!r}; allowed: {', '.join(CURVE_MODES)}")
+    name = Path(path).name
+    size = os.path.getsize(path)
+    if size > MAX_SVG_BYTES:
+        raise FormatError(f"{name}: {size} bytes; at most {MAX_SVG_BYTES} (64 MiB) are read")
+    source = _without_legend(Path(path).read_bytes())
+    try:
+        svg = se.SVG.parse(source, reify=True, ppi=96.0)
+    except Exception as exc:  # noqa: BLE001 - any parse failure of a user file: one line
+        raise FormatError(
+            f"{name}: not a readable SVG file ({type(exc).__name__}: {exc})"
+        ) from None
+    segs, codes, angles = [], [], []
+    bad_colours: Counter = Counter()
+    flattened = 0
+    curved_creases = []
+    no_stroke = 0
+    for el in svg.elements():
+        if not isinstance(el, se.Shape) or isinstance(el, se.Text):
+            continue
+        v = el.values
+        if str(v.get("display", "")).strip() == "none" or str(v.get("visibility", "")).strip() in (
+            "hidden",
+            "collapse",
+        ):
+            continue
+        code = v.get("data-assignment")
+        if code is not None:
+            code = str(code).strip().upper()
+            if code not in _CODES:
+                raise FormatError(
+                    f"{name}: element {el.id or type(el).__name__} has data-assignment "
+                    f"{code!r}; allowed: {' '.join(sorted(_CODES))}"
+                )
+        else:
+            code = _code(el.stroke)
+            if code is None:
+                no_stroke += 1
+                continue
+            if code == "":
+                bad_colours[el.stroke.hexrgb] += 1
+                continue
+        angle = v.get("data-foldAngle", v.get("data-foldangle"))
+        if angle is not None:
+            try:
+                ang = float(angle)
+            except ValueError:
+                raise FormatError(
+                    f"{name}: element {el.id or type(el).__name__} has data-foldAngle "
+                    f"{angle!r}; expected degrees"
+                ) from None
+        else:
+            op = _number(v.get("opacity")) * _number(v.get("stroke-opacity"))
+            ang = {"M": -180.0, "V": 180.0}.get(code, 0.0) * min(max(op, 0.0), 1.0)
+        try:
+            path_el = se.Path(el)
+        except Exception:  # noqa: BLE001
+            continue
+        for seg in path_el.segments():
+            if isinstance(seg, se.Move):
+                continue
+            if isinstance(seg, (se.Line, se.Close)):
+                if seg.start is None or seg.end is None:
+                    continue
+                pts = np.array([[seg.start.x, seg.start.y], [seg.end.x, seg.end.y]])
+            else:  # a curve
+                if code in ("B", "C") or curves == "flatten":
+                    pts = _pieces(seg, 16)
+                    flattened += 1
+                else:
+                    curved_creases.append(el.id or type(el).__name__)
+                    continue
+            for a, b in zip(pts[:-1], pts[1:], strict=True):
+                segs.append([a, b])
+                codes.append(code)
+                angles.append(ang)
+    if curved_creases:
+        raise FormatError(
+            f"{name}: {len(curved_creases)} curved crease(s) (first: {curved_creases[0]}); "
+            "holofold folds straight creases: redraw them as segments, or read with "
+            "curves='flatten' (--curves flatten)"
+        )
+    notes = []
+    if bad_colours:
+        listed = ", ".join(f"{c} ({n})" for c, n in bad_colours.most_common(5))
+        notes.append(
+            f"{sum(bad_colours.values())} line(s) of other colours left out: {listed}; crease "
+            "colours: red M, blue V, black B, green C, yellow F, magenta U"
+        )
+    if flattened:
+        notes.append(f"{flattened} curved piece(s) flattened into segments")
+    if not segs:
+        why = f"; {no_stroke} element(s) without a stroke" if no_stroke else ""
+        raise FormatError(
+            f"{name}: no crease-pattern lines (stroked in the crease colours){why}"
+            + (f"; other colours: {', '.join(bad_colours)}" if bad_colours else "")
+        )
+    S = np.array(segs, float)
+    S[..., 1] *= -1.0  # y up
+    return S, np.array(codes, dtype="<U1"), np.array(angles, float), notes, _metres_per_px(svg)
+
+
+def read_svg_pattern(
+    path, *, tol: float | None = None, unit: float | None = None, split: str = "as-needed",
+    curves: str = "refuse",
+):  # fmt: skip
+    """The crease pattern of an SVG file (see the module docstring), metres.
+
+    ``tol``: merge distance in SVG px (default 2e-3 of the drawing's larger side); ``unit``:
+    metres per SVG px (default: as the document's width says; 0.0254/96 for a CSS pixel);
+    ``split``: which faces to triangulate (:data:`~holofold.geometry.facets.SPLIT_MODES`);
+    ``curves``: :data:`CURVE_MODES`.
+    """
+    from holofold.geometry.readers import pattern_from_lines
+
+    name = Path(path).name
+    S, codes, angles, notes, per_px = svg_lines(path, curves=curves)
+    meta = {"kind": "svg", "source": name}
+    return pattern_from_lines(
+        S, codes, angles, name=name, unit=per_px if unit is None else unit, tol=tol, split=split,
+        meta=meta, notes=notes,
+    )  # fmt: skip
