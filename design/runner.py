@@ -396,27 +396,135 @@ def _iter_on_dask(
     raises. When the generator ends early (an exception, or ``close()``: wrap it in
     :func:`contextlib.closing`), the tasks still pending are cancelled.
     """
-    from distributed import Client, as_completed
+    from distributed import Client
+
+    # distributed's own log lines (reconnection attempts, tracebacks of a lost scheduler) would
+    # bury the one line this run ends with: quieten them for the block, and after it when the
+    # cluster was lost (its client threads go on logging while they shut down)
+    levels = {
+        name: logging.getLogger(name).level
+        for name in ["distributed", *logging.root.manager.loggerDict]
+        if name.split(".")[0] == "distributed"
+    }
+    for name in levels:
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+    lost = True
+    try:
+        try:
+            client = Client(address, set_as_default=False, timeout=SCHEDULER_TIMEOUT)
+        except (OSError, TimeoutError) as exc:
+            raise ClusterError(
+                f"cannot reach the Dask scheduler at {address} within {SCHEDULER_TIMEOUT:g} s "
+                f"({type(exc).__name__}); start it, or check the address"
+            ) from None
+        try:
+            yield from _on_client(client, scenario, rows, limit_threads, address, timeout)
+            lost = False
+        except GeneratorExit:
+            lost = False
+            raise
+        finally:
+            try:
+                client.close(timeout=2)
+            except Exception:  # noqa: BLE001 - a lost scheduler: nothing left to close
+                pass
+    finally:
+        if not lost:
+            for name, level in levels.items():
+                logging.getLogger(name).setLevel(level)
+
+
+#: seconds a run waits to reach its Dask scheduler, or to see it again once lost
+SCHEDULER_TIMEOUT = 20.0
+
+
+def worker_timeout() -> float:
+    """Seconds a Dask run waits while its cluster has no worker, before it stops with one
+    line: ``HOLOFOLD_WORKER_TIMEOUT`` (default 120)."""
+    import os
+
+    text = os.environ.get("HOLOFOLD_WORKER_TIMEOUT", "120")
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not value > 0:
+        raise ValueError(f"HOLOFOLD_WORKER_TIMEOUT = {text!r} must be seconds > 0")
+    return value
+
+
+class ClusterError(OSError):
+    """The Dask cluster cannot go on (its scheduler is lost, or it has no workers); the
+    message is one line with what to do (finished database chunks are kept: run again)."""
+
+
+def _lost(address: str, exc: BaseException) -> ClusterError:
+    return ClusterError(
+        f"lost the Dask scheduler at {address} ({type(exc).__name__}); every finished chunk "
+        "is stored: start the scheduler and workers again and run the same command to resume"
+    )
+
+
+def _n_workers(client) -> int:
+    """Workers the scheduler knows now (raises if it cannot be asked)."""
+    return len(client.sync(client.scheduler.ncores, workers=None))
+
+
+def _on_client(client, scenario, rows, limit_threads, address, timeout):
+    """:func:`_iter_on_dask` on a connected ``client``."""
+    import concurrent.futures
+    import time
+
+    from distributed import as_completed
 
     n = len(rows)
-    with Client(address, set_as_default=False) as client:
-        # a worker that cannot unpickle a task drops out of the cluster and the batch would wait
-        # forever; client.run reports the same failure instead
-        try:
-            ready = client.run(_worker_ready, scenario)
-        except Exception as exc:  # noqa: BLE001 - whatever the workers raised
-            raise ValueError(
-                f"the Dask workers of {address} cannot run holofold ({exc}); install it on "
-                'every worker: pip install "holofold[cluster]"'
-            ) from None
-        if not ready:
-            log.warning("no Dask workers at %s yet: the designs wait for some to join", address)
-        futures = client.map(
-            _evaluate_one, [scenario] * n, rows, [limit_threads] * n, [timeout] * n, pure=False
-        )
-        where = {f.key: i for i, f in enumerate(futures)}
-        try:
-            for f in as_completed(futures, loop=client.loop):
+    limit = worker_timeout()
+    try:
+        if not _n_workers(client):
+            log.info("no Dask workers at %s yet: waiting up to %g s", address, limit)
+            try:
+                client.wait_for_workers(1, timeout=limit)
+            except TimeoutError:
+                raise ClusterError(_no_workers(address, limit)) from None
+    except ClusterError:
+        raise
+    except (OSError, concurrent.futures.CancelledError) as exc:
+        raise _lost(address, exc) from None
+    # a worker that cannot unpickle a task drops out of the cluster and the batch would wait
+    # forever; client.run reports the same failure instead
+    try:
+        client.run(_worker_ready, scenario)
+    except (OSError, concurrent.futures.CancelledError) as exc:
+        raise _lost(address, exc) from None
+    except Exception as exc:  # noqa: BLE001 - whatever the workers raised
+        raise ValueError(
+            f"the Dask workers of {address} cannot run holofold ({exc}); install it on "
+            'every worker: pip install "holofold[cluster]"'
+        ) from None
+    futures = client.map(
+        _evaluate_one, [scenario] * n, rows, [limit_threads] * n, [timeout] * n, pure=False
+    )
+    where = {f.key: i for i, f in enumerate(futures)}
+    done = as_completed(futures, loop=client.loop)
+    checked = idle = time.monotonic()
+    try:
+        while not done.is_empty():
+            if not done.has_ready():
+                time.sleep(0.05)
+                now = time.monotonic()
+                if now - checked < 1.0:
+                    continue
+                checked = now  # once a second: is the scheduler there, has it workers?
+                if client.status != "running":
+                    raise _lost(address, ConnectionError(f"client {client.status}"))
+                if _n_workers(client):
+                    idle = now
+                elif now - idle > limit:
+                    raise ClusterError(_no_workers(address, limit))
+                continue
+            for f in done.next_batch(block=False):
+                if f.status == "cancelled":  # the scheduler forgot it: lost
+                    raise _lost(address, concurrent.futures.CancelledError())
                 if f.status == "error":  # the worker died (KilledWorker), or the environment
                     _raise_environment_fault(scenario, f.exception())
                     out = _failed(scenario, f.exception())
@@ -424,8 +532,22 @@ def _iter_on_dask(
                     out = f.result()
                 f.release()  # the cluster forgets the result; the caller holds the only copy
                 yield where[f.key], out
-        finally:  # interrupted (Ctrl-C, lost scheduler): leave nothing running on the cluster
+    except (OSError, concurrent.futures.CancelledError, TimeoutError) as exc:
+        if isinstance(exc, ClusterError):
+            raise
+        raise _lost(address, exc) from None
+    finally:  # interrupted (Ctrl-C, lost scheduler): leave nothing running on the cluster
+        try:
             client.cancel([f for f in futures if not f.done()])
+        except Exception:  # noqa: BLE001 - a lost scheduler cancelled them already
+            pass
+
+
+def _no_workers(address: str, limit: float) -> str:
+    return (
+        f"no Dask worker at {address} for {limit:g} s (HOLOFOLD_WORKER_TIMEOUT); start some "
+        f"(dask worker {address} --nthreads 1) and run the same command to resume"
+    )
 
 
 def iter_results(
