@@ -300,6 +300,7 @@ def run_design(
     progress: bool | None = None,
     files: bool = True,
     mesh_units: str = "mm",
+    cutter=None,
     say: Callable[[str], None] = lambda text: None,
 ) -> DesignOutcome:
     """Run the design loop (module docstring) into ``folder``; resumable.
@@ -332,7 +333,10 @@ def run_design(
     files : bool
         Write the chosen design's fabrication files, pictures and the report page.
     mesh_units : {"mm", "m"}
-        Length unit of the mesh files (STL, OBJ); FOLD stays in m, SVG in mm.
+        Length unit of the mesh files (STL, OBJ); FOLD stays in m, SVG and DXF in mm.
+    cutter : CutterOptions, optional
+        How the SVG and DXF of the flat pattern are drawn (a
+        :class:`~holofold.geometry.CutterOptions`; default Origami Simulator's convention).
     say : callable
         Receives one line of progress per stage.
     """
@@ -475,7 +479,7 @@ def run_design(
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             summary["files"], summary["images"] = _write_files(
-                sc, row, out, mined, rule, table, tgt, mesh_units
+                sc, row, out, mined, rule, table, tgt, mesh_units, cutter
             )
         summary["warnings"] = list(dict.fromkeys(str(w.message) for w in caught))
         for w in summary["warnings"]:
@@ -532,7 +536,9 @@ def _scenario_summary(sc: Scenario) -> dict:
     }
 
 
-def _write_files(sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt, mesh_units: str):
+def _write_files(
+    sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt, mesh_units: str, cutter
+):
     from holofold.design.report import (
         plot_folded_design,
         plot_rule_boxes,
@@ -543,8 +549,8 @@ def _write_files(sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt,
     files, images = {}, {}
     design = {c.name: float(row[c.name]) for c in sc.features if c.name in row}
     if sc.write_files is not None:
-        for label, p in sc.write_files(design, out / "files", units=mesh_units).items():
-            files[label] = os.path.relpath(p, out)
+        fab = sc.write_files(design, out / "files", units=mesh_units, cutter=cutter)
+        files = fab.record(out)  # stable key -> {"path", "label"}
     if sc.shape is not None:
         pat = sc.shape(design)
         creases = pat.edges[pat.interior] if hasattr(pat, "interior") else None

@@ -492,7 +492,8 @@ def _files(folder: Path, summary: Mapping) -> str:
         out.append("<p>No files were written.</p></section>")
         return "".join(out)
     out.append('<ul class="files">')
-    for label, rel in files.items():
+    for key, entry in files.items():
+        rel, label = entry.get("path"), entry.get("label") or key
         if not rel:
             continue
         rel = str(rel).replace("\\", "/")

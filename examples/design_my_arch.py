@@ -112,9 +112,9 @@ def main(folder="my-arch", samples=400, verify=30, workers=2) -> dict:
     files = scenario.write_files(design, out / "files")
     summary = {"features": design, "performance": performance, "rule": rules[best],
                "verified_precision": checks[best].precision, "margins": margins,
-               "scenario": scenario.name, "files": [str(p) for p in files.values()]}  # fmt: skip
+               "scenario": scenario.name, "files": files.record(out)}  # fmt: skip
     write_json(out / "design.json", summary)
-    print(f"files: {', '.join(sorted(files))} in {out / 'files'}/")
+    print(f"files: {', '.join(f.path.name for f in files)} in {out / 'files'}/")
     RESULT.clear()
     RESULT.update(summary, table=table)
     return summary

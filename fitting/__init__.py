@@ -44,7 +44,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "error": ["ClosestPointError", "closest_point_error", "index_matched_error", "paper_error"],
         "strip": ["SAMPLINGS", "MAX_M", "StripGeometry", "strip_geometry"],
-        "strip_files": ["export_strip_files"],
+        "strip_files": ["export_strip_files", "write_strip_set"],
         "strip_fit": ["StripFit", "fit_strip"],
     },
 )

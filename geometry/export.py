@@ -1,64 +1,163 @@
-"""One entry point for writing crease patterns and meshes: :func:`export`; and the set of
-fabrication files of a pattern: :func:`export_pattern_files`.
+"""One entry point for writing crease patterns and meshes, :func:`export`, over a registry of
+output formats, :data:`FORMATS`.
 
-The file type comes from the suffix (or ``file_type``): ``.fold`` and ``.svg`` take a
-:class:`CreasePattern`; ``.stl``, ``.obj`` and ``.ply`` take a pattern (its folded surface,
-:func:`~holofold.geometry.mesh.folded_mesh`) or a ``trimesh.Trimesh`` (e.g. a thick solid).
-Units: meshes are written in millimetres unless ``units`` says otherwise (slicers and CAD read
-STL/OBJ/PLY as mm), FOLD in metres (``frame_unit`` "m"), SVG in millimetres (``width`` and
-``height`` say so). Every file is written atomically (:mod:`holofold.geometry.outputs`).
+A :class:`Format` names its suffix, what it takes (a :class:`CreasePattern`, a mesh, or both:
+a pattern is written as its folded surface, :func:`~holofold.geometry.mesh.folded_mesh`), its
+unit policy and its writer. The unit policy is one of two: the format fixes its unit and says
+so in the file (FOLD metres, ``frame_unit``; SVG and DXF millimetres; glTF metres, as its
+specification requires), and another ``units`` is refused; or the format carries no unit (STL,
+OBJ, PLY) and the caller's ``units`` is used, millimetres by default (what slicers and CAD
+programs read) and named in a header or comment. A new format is one :func:`register_format`
+call; an unknown suffix is refused with the list of known ones, before anything is written.
+Every file is written atomically (:mod:`holofold.geometry.outputs`).
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-import trimesh
-
-from holofold.geometry.errors import ParameterError, check_range
-from holofold.geometry.fold_io import export_fold
-from holofold.geometry.mesh import MESH_TYPES, MESH_UNITS, export_mesh, folded_mesh
+from holofold.geometry.errors import ParameterError
+from holofold.geometry.mesh import MESH_UNITS
 from holofold.geometry.outputs import atomic_write
 from holofold.geometry.pattern import CreasePattern
-from holofold.geometry.solid import shrunk_panels, thick_solid
-from holofold.geometry.svg import export_svg
 
-__all__ = ["export", "export_pattern_files", "EXPORT_TYPES"]
+__all__ = ["Format", "FORMATS", "register_format", "export", "EXPORT_TYPES"]
 
-EXPORT_TYPES = ("fold", "svg", *MESH_TYPES)
+
+@dataclass(frozen=True)
+class Format:
+    """An output format.
+
+    Attributes
+    ----------
+    suffix : str
+        Without the dot, lower case ("stl").
+    takes : str
+        "pattern" (a CreasePattern), "mesh" (a trimesh.Trimesh, or a pattern's folded surface).
+    unit : str or None
+        The unit the format fixes (a name of :data:`~holofold.geometry.units.LENGTH_UNITS`), or
+        None: the caller's (default :data:`~holofold.geometry.mesh.MESH_UNITS`).
+    write : callable(obj, unit, **kw) -> str or bytes
+        The file's content; ``obj`` is a CreasePattern for "pattern", a trimesh.Trimesh for
+        "mesh"; ``unit`` the resolved unit.
+    description : str
+        What the file is, for people.
+    """
+
+    suffix: str
+    takes: str
+    unit: str | None
+    write: Callable
+    description: str
+
+
+#: suffix -> Format
+FORMATS: dict[str, Format] = {}
+
+
+def register_format(fmt: Format) -> Format:
+    """Add ``fmt`` to :data:`FORMATS` (a suffix is registered once)."""
+    if fmt.takes not in ("pattern", "mesh"):
+        raise ValueError(f"format {fmt.suffix!r}: takes must be 'pattern' or 'mesh'")
+    if fmt.suffix in FORMATS:
+        raise ValueError(f"format {fmt.suffix!r} is already registered")
+    FORMATS[fmt.suffix] = fmt
+    return fmt
+
+
+def _fold(obj, unit, **kw):
+    from holofold.geometry.fold_io import export_fold
+
+    return export_fold(obj, **kw)
+
+
+def _svg(obj, unit, **kw):
+    from holofold.geometry.svg import export_svg
+
+    return export_svg(obj, **kw)
+
+
+def _dxf(obj, unit, **kw):
+    from holofold.geometry.dxf import export_dxf
+
+    return export_dxf(obj, **kw)
+
+
+def _mesh_writer(kind: str):
+    def write(obj, unit, **kw):
+        from holofold.geometry.mesh import export_mesh
+
+        if kw:
+            raise TypeError(f".{kind} export takes no options, got {', '.join(kw)}")
+        return export_mesh(obj, kind, unit)
+
+    return write
+
+
+def _glb(obj, unit, **kw):
+    import trimesh
+
+    if kw:
+        raise TypeError(f".glb export takes no options, got {', '.join(kw)}")
+    return trimesh.exchange.export.export_mesh(obj, None, file_type="glb")
+
+
+for _fmt in (
+    Format("fold", "pattern", "m", _fold, "FOLD 1.2 crease pattern and folded state"),
+    Format("svg", "pattern", "mm", _svg, "SVG of the flat crease pattern for a cutter profile"),
+    Format("dxf", "pattern", "mm", _dxf, "DXF of the flat crease pattern, a layer per role"),
+    Format("stl", "mesh", None, _mesh_writer("stl"), "binary STL surface"),
+    Format("obj", "mesh", None, _mesh_writer("obj"), "Wavefront OBJ surface"),
+    Format("ply", "mesh", None, _mesh_writer("ply"), "binary PLY surface"),
+    Format("glb", "mesh", "m", _glb, "binary glTF 2.0 (metres, as glTF requires)"),
+):
+    register_format(_fmt)
+
+#: the suffixes :func:`export` knows (the keys of :data:`FORMATS`)
+EXPORT_TYPES = tuple(FORMATS)
 
 
 def export(
     obj, path: str | os.PathLike, file_type: str | None = None, *, units: str | None = None, **kw
 ) -> Path:
-    """Write ``obj`` to ``path``; returns the path. ``kw`` go to the format's writer.
+    """Write ``obj`` to ``path`` in the format of its suffix (or ``file_type``); returns the path.
 
-    ``units`` (a name of :data:`~holofold.geometry.units.LENGTH_UNITS`) is the length unit of a
-    mesh file (default "mm"); FOLD (metres) and SVG (millimetres) state their own unit and
-    refuse another.
+    ``units`` is the length unit of a format without one (default "mm"); a format that fixes
+    its unit refuses another. ``kw`` go to the format's writer. Nothing is written if the
+    format, the object or the unit is wrong.
     """
+    import trimesh
+
+    from holofold.geometry.units import length_factor
+
     path = Path(path)
     kind = (file_type or path.suffix).lower().lstrip(".")
-    if kind not in EXPORT_TYPES:
+    fmt = FORMATS.get(kind)
+    if fmt is None:
         raise ValueError(
-            f"cannot export {path.name!r}: unknown file type {kind!r}; known: "
-            + ", ".join(EXPORT_TYPES)
+            f"cannot export {path.name!r}: unknown file type {kind!r}; known: " + ", ".join(FORMATS)
         )
-    if kind in ("fold", "svg"):
-        if not isinstance(obj, CreasePattern):
-            raise TypeError(f".{kind} export needs a CreasePattern, got {type(obj).__name__}")
-        own = "m" if kind == "fold" else "mm"
-        if units not in (None, own):
-            raise ParameterError(
-                f".{kind} files are written in {own} (the file says so); units={units!r} "
-                "applies to mesh files only"
-            )
-        data = export_fold(obj, **kw) if kind == "fold" else export_svg(obj, **kw)
-    else:
-        mesh = obj if isinstance(obj, trimesh.Trimesh) else folded_mesh(obj)
-        data = export_mesh(mesh, kind, MESH_UNITS if units is None else units)
+    if fmt.takes == "pattern" and not isinstance(obj, CreasePattern):
+        raise TypeError(f".{kind} export needs a CreasePattern, got {type(obj).__name__}")
+    if fmt.takes == "mesh" and not isinstance(obj, trimesh.Trimesh | CreasePattern):
+        raise TypeError(
+            f".{kind} export needs a trimesh.Trimesh or a CreasePattern, got {type(obj).__name__}"
+        )
+    if fmt.unit is not None and units not in (None, fmt.unit):
+        raise ParameterError(
+            f".{kind} files are written in {fmt.unit} (the file says so); units={units!r} "
+            "applies to mesh files only (those without a unit: stl, obj, ply)"
+        )
+    unit = fmt.unit or (MESH_UNITS if units is None else units)
+    length_factor(unit)
+    if fmt.takes == "mesh" and isinstance(obj, CreasePattern):
+        from holofold.geometry.mesh import folded_mesh
+
+        obj = folded_mesh(obj)
+    data = fmt.write(obj, unit, **kw)
     mode = "wb" if isinstance(data, bytes) else "w"
 
     def write(tmp):
@@ -66,62 +165,3 @@ def export(
             fh.write(data)
 
     return atomic_write(path, write)
-
-
-def export_pattern_files(
-    pattern: CreasePattern,
-    folder: str | os.PathLike,
-    *,
-    thickness: float | None = None,
-    crease_width: float = 0.0,
-    crease_thickness: float | None = None,
-    units: str = MESH_UNITS,
-) -> list[Path]:
-    """The fabrication files of a sheet, in ``folder`` (created if needed).
-
-    ``pattern.fold`` (flat crease pattern + folded frame, with the crease width, m),
-    ``pattern.svg`` (cut/score layers, mm), ``folded.stl`` / ``folded.obj`` (folded surface)
-    and, with ``thickness`` (m), ``thick.stl`` (the folded panels of that thickness with hinge
-    gaps ``crease_width``, m, as loose bodies) and, with ``crease_thickness`` too (m),
-    ``printable.stl``: the flat part to print, panels joined by hinge strips of that thickness
-    and width ``crease_width`` (:func:`~holofold.geometry.printable.printable_solid`), and
-    ``printable_folded.stl``, the same part folded with its hinges bent
-    (:func:`~holofold.geometry.printable.folded_printable_solid`; left out, with a warning,
-    where the hinges are thicker than the panels). Meshes in ``units`` (default mm).
-    Everything is built, and can fail, before the first file is written.
-    """
-    from holofold.geometry.printable import folded_printable, printable_solid
-    from holofold.geometry.units import length_factor
-
-    length_factor(units)
-    W = check_range("crease_width", crease_width, 0.0, None)
-    solid = part = bent = None
-    if crease_thickness is not None:
-        if thickness is None or W <= 0:
-            raise ParameterError(
-                "a printable part needs a panel thickness and a crease width > 0 besides the "
-                "crease thickness"
-            )
-        tc = check_range("crease_thickness", crease_thickness, 0.0, None, low_open=True)
-    if thickness is not None:
-        t = check_range("thickness", thickness, 0.0, None, low_open=True)
-        shrunk_panels(pattern, W)  # a crease wider than a panel fails here
-        solid = thick_solid(pattern, t, W)
-        if crease_thickness is not None:
-            part = printable_solid(pattern, t, tc, W)
-            bent = folded_printable(pattern, t, tc, W)
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    written = [
-        export(pattern, out / "pattern.fold", crease_width=np.where(pattern.interior, W, 0.0)),
-        export(pattern, out / "pattern.svg"),
-        export(pattern, out / "folded.stl", units=units),
-        export(pattern, out / "folded.obj", units=units),
-    ]
-    if solid is not None:
-        written.append(export(solid, out / "thick.stl", units=units))
-    if part is not None:
-        written.append(export(part, out / "printable.stl", units=units))
-    if bent is not None:
-        written.append(export(bent, out / "printable_folded.stl", units=units))
-    return written

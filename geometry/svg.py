@@ -25,7 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.geometry.errors import FormatError, check_range
+from holofold.geometry.cutter import (
+    DEFAULT_PROFILE,
+    ROLES,
+    CutterProfile,
+    cutter_drawing,
+    get_profile,
+    hole_points,
+)
+from holofold.geometry.errors import FormatError, ParameterError, check_range
 from holofold.geometry.pattern import CreasePattern
 
 __all__ = ["COLOURS", "export_svg", "polylines_svg", "load_svg", "SvgLines"]
@@ -77,60 +85,159 @@ def _legend(
 def export_svg(
     pattern: CreasePattern,
     *,
+    profile: str | CutterProfile = DEFAULT_PROFILE,
     margin_mm: float = 5.0,
-    stroke_mm: float = 0.2,
+    stroke_mm: float | None = None,
     show_facets: bool = False,
     min_opacity: float = 0.3,
-    legend: bool = True,
+    legend: bool | None = None,
+    dash: float | None = None,
+    gap: float | None = None,
+    vertex_gap: float | None = None,
+    side: str = "both",
 ) -> str:
-    """SVG text of the flat crease pattern (metres in, millimetres out).
+    """SVG text of the flat crease pattern for a cutter ``profile`` (metres in, mm out).
 
-    ``show_facets`` also draws ``J`` edges (triangulation lines); they are left out by default
-    because they are neither cut nor folded. ``min_opacity`` in [0, 1] keeps shallow creases
-    visible; ``legend`` adds the legend above the pattern.
+    ``origami-simulator`` (default): ``<line>`` elements as the module docstring says;
+    ``show_facets`` also draws ``J`` edges (triangulation lines, left out by default because they
+    are neither cut nor folded), ``min_opacity`` in [0, 1] keeps shallow creases visible,
+    ``legend`` (default the profile's) adds the legend above the pattern, ``stroke_mm``
+    overrides the profile's width. ``laser`` / ``cricut``: one ``<path>`` per line (its dashes
+    as subpaths) in a layer per role (Inkscape layers, ``<g id=...>``), no text; ``dash``,
+    ``gap`` and ``vertex_gap`` (mm) override the profile's crease drawing and ``side`` ("front"
+    or "back") draws one face of a two-pass job (:func:`~holofold.geometry.cutter.
+    cutter_drawing`).
     """
-    if pattern.flat is None:
-        raise ValueError(
-            "this pattern has no flat layout to draw as a crease pattern; export FOLD instead"
-        )
+    prof = get_profile(profile)
     min_opacity = check_range("min_opacity", min_opacity, 0.0, 1.0)
-    xy = pattern.flat * 1000.0  # mm
-    lo, hi = xy.min(axis=0), xy.max(axis=0)
-    w, h = hi - lo + 2 * margin_mm
+    legend = prof.legend if legend is None else bool(legend)
+    if legend and not prof.legend:
+        raise ParameterError(
+            f"the {prof.name} profile has no text: a cutter would cut or engrave a legend"
+        )
+    width = {r: prof.strokes[r].width if stroke_mm is None else stroke_mm for r in ROLES}
     top = 0.0
     if legend:
-        key, key_w, key_h = _legend(margin_mm, margin_mm, 3.0, stroke_mm, min_opacity)
+        key, key_w, key_h = _legend(margin_mm, margin_mm, 3.0, width["mountain"], min_opacity)
         top = key_h + margin_mm
-        w, h = max(w, key_w + 2 * margin_mm), h + top
-    px = xy[:, 0] - lo[0] + margin_mm
-    py = hi[1] - xy[:, 1] + margin_mm + top  # flip: SVG y points down
+    draw = cutter_drawing(
+        pattern, prof, dash=dash, gap=gap, vertex_gap=vertex_gap, side=side,
+        margin=margin_mm, top=top,
+    )  # fmt: skip
+    w, h = draw.width, draw.height
+    if legend:
+        w = max(w, key_w + 2 * margin_mm)
+    if prof.opacity:
+        body = [key] if legend else []
+        body += _simulator_groups(pattern, draw, width, min_opacity, show_facets)
+        head = f'<svg xmlns="{_SVG_NS}" '
+        title = f"holofold crease pattern ({pattern.meta.get('kind', 'pattern')})"
+    else:
+        body = _cutter_layers(draw, width)
+        head = f'<svg xmlns="{_SVG_NS}" xmlns:inkscape="{_INKSCAPE_NS}" '
+        face = {"both": "", "front": ", front face", "back": ", back face (mirrored)"}[side]
+        title = (
+            f"holofold crease pattern ({pattern.meta.get('kind', 'pattern')}), "
+            f"{prof.name} profile{face}"
+        )
+        body.insert(0, f"<desc>{_DESC[side]}</desc>")
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        + head
+        + f'width="{w:.6f}mm" height="{h:.6f}mm" viewBox="0 0 {w:.6f} {h:.6f}">\n'
+        f"<title>{title}</title>\n" + "\n".join(body) + "\n</svg>\n"
+    )
+
+
+_INKSCAPE_NS = "http://www.inkscape.org/namespaces/inkscape"
+_DESC = {
+    "both": "Lines by layer: cut (through), score-mountain, score-valley; millimetres.",
+    "front": "Pass 1 of 2: cut the registration holes and score the mountains on this face; "
+    "then flip the sheet about the vertical axis onto pins through the holes.",
+    "back": "Pass 2 of 2 (mirrored): score the valleys, then cut; the registration holes "
+    "repeat those of pass 1.",
+}
+
+
+def _simulator_groups(pattern, draw, width, min_opacity, show_facets) -> list[str]:
+    """Origami Simulator's groups: ``cut`` (B, C) and ``score`` (the rest), one ``<line>`` per
+    edge with its fold angle as opacity and as ``data-foldAngle``."""
     groups: dict[str, list[str]] = {"cut": [], "score": []}
-    for i, (a, b) in enumerate(pattern.edges):
+    P = {int(e): seg for role, segs in draw.lines.items()
+         for e, seg in zip(draw.edges[role], segs, strict=True)}  # fmt: skip
+    for i in range(pattern.n_edges):
         code = str(pattern.assignment[i])
         if code == "J" and not show_facets:
             continue
+        if code == "J":
+            a, b = pattern.edges[i]
+            seg = _page_segment(pattern, draw, a, b)
+        else:
+            seg = P[i]
         ang = float(pattern.fold_angle[i])
         opacity = max(abs(ang) / 180.0, min_opacity) if code in ("M", "V") and ang != 0 else 1.0
+        (x1, y1), (x2, y2) = seg
         groups["cut" if code in _CUT else "score"].append(
-            f'<line x1="{px[a]:.6f}" y1="{py[a]:.6f}" x2="{px[b]:.6f}" y2="{py[b]:.6f}" '
+            f'<line x1="{x1:.6f}" y1="{y1:.6f}" x2="{x2:.6f}" y2="{y2:.6f}" '
             f'stroke="{COLOURS[code]}" stroke-opacity="{opacity:.6g}" '
             f'data-assignment="{code}" data-foldAngle="{ang:.12g}" data-edge="{i}"/>'
         )
-    body = [key] if legend else []
-    for gid, lines in groups.items():
-        body.append(
-            f'<g id="{gid}" fill="none" stroke-width="{stroke_mm}" stroke-linecap="round">\n  '
-            + "\n  ".join(lines)
-            + "\n</g>"
-        )
-    return (
-        '<?xml version="1.0" encoding="UTF-8"?>\n'
-        f'<svg xmlns="{_SVG_NS}" width="{w:.6f}mm" height="{h:.6f}mm" '
-        f'viewBox="0 0 {w:.6f} {h:.6f}">\n'
-        f"<title>holofold crease pattern ({pattern.meta.get('kind', 'pattern')})</title>\n"
-        + "\n".join(body)
-        + "\n</svg>\n"
-    )
+    stroke = width["mountain"]
+    return [
+        f'<g id="{gid}" fill="none" stroke-width="{stroke}" stroke-linecap="round">\n  '
+        + "\n  ".join(lines)
+        + "\n</g>"
+        for gid, lines in groups.items()
+    ]
+
+
+def _page_segment(pattern, draw, a, b) -> np.ndarray:
+    """Page coordinates (2, 2) of the flat edge a-b (for lines no role draws: joins)."""
+    xy = pattern.flat * 1000.0
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    margin = (draw.width - (hi[0] - lo[0])) / 2
+    pts = np.array([[xy[v, 0] - lo[0] + margin, hi[1] - xy[v, 1] + margin + draw.top]
+                    for v in (a, b)])  # fmt: skip
+    return pts
+
+
+def _cutter_layers(draw, width) -> list[str]:
+    """One Inkscape layer per profile layer: a ``<path>`` per edge (dashes as subpaths) and the
+    registration holes."""
+    prof = draw.profile
+    out = []
+    for layer in prof.layers:
+        items = []
+        for role in ROLES:
+            st = prof.strokes[role]
+            if st.layer != layer:
+                continue
+            if role == "registration":
+                for c in draw.holes:
+                    pts = hole_points(c, draw.hole_radius)[:-1]
+                    d = "M " + " L ".join(f"{x:.4f} {y:.4f}" for x, y in pts) + " Z"
+                    items.append(
+                        f'<path d="{d}" stroke="{st.colour}" stroke-width="{width[role]}"/>'
+                    )
+                continue
+            segs, owner = draw.lines.get(role), draw.edges.get(role)
+            if segs is None or not len(segs):
+                continue
+            cuts = np.flatnonzero(np.diff(owner)) + 1
+            for part, e in zip(np.split(segs, cuts), owner[np.r_[0, cuts]], strict=True):
+                d = " ".join(
+                    f"M {x1:.4f} {y1:.4f} L {x2:.4f} {y2:.4f}" for (x1, y1), (x2, y2) in part
+                )
+                items.append(
+                    f'<path d="{d}" stroke="{st.colour}" stroke-width="{width[role]}" '
+                    f'data-role="{role}" data-edge="{int(e)}"/>'
+                )
+        if items:
+            out.append(
+                f'<g id="{layer}" inkscape:groupmode="layer" inkscape:label="{layer}" '
+                'fill="none" stroke-linecap="butt">\n  ' + "\n  ".join(items) + "\n</g>"
+            )
+    return out
 
 
 def polylines_svg(

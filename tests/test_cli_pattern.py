@@ -17,7 +17,9 @@ def test_miura_writes_all_files(tmp_path, capsys):
             "-o", str(out)]  # fmt: skip
     assert main(argv) == 0
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["folded.obj", "folded.stl", "pattern.fold", "pattern.svg", "thick.stl"]
+    assert names == [
+        "folded.obj", "folded.stl", "pattern.dxf", "pattern.fold", "pattern.svg", "thick.stl"
+    ]  # fmt: skip
     summary = capsys.readouterr().out
     assert "25 vertices, 24 creases, 16 panels" in summary
     p = load_fold((out / "pattern.fold").read_text())

@@ -167,8 +167,10 @@ def test_design_loop_on_a_users_curve_writes_a_verified_design(designed):
     for f in ("design.png", "rule.png", "scatter.png", "report.html", "files/strip.fold",
               "files/strip.svg", "files/strip.stl", "files/strip_solid.stl"):  # fmt: skip
         assert (folder / "out" / f).is_file(), f
-    for label, rel in s["files"].items():
-        assert (folder / "out" / rel).is_file(), label
+    for key, entry in s["files"].items():  # stable keys, the label beside the path
+        assert (folder / "out" / entry["path"]).is_file(), key
+        assert entry["label"] and key.replace("_", "").isalpha()
+    assert {"printable", "fold", "svg", "dxf", "surface_stl", "thick"} <= set(s["files"])
     assert (folder / "out" / "files" / "printable.stl").is_file()
     with open(folder / "out" / "files" / "strip.stl", "rb") as fh:
         assert b"mm" in fh.read(80)  # meshes in mm by default, as slicers read them
@@ -259,8 +261,8 @@ def test_the_report_page_of_a_real_run_loads_in_a_browser(designed, tmp_path):
     assert attrs["data-images-total"] == attrs["data-images-loaded"] == "3"
     assert '<table class="design-table">' in dom and "my-arch" in dom
     assert f"{out.performance['Vstiff']:.4g}" in dom  # the chosen design's number, as shown
-    for rel in out.summary["files"].values():
-        assert f'href="{rel}"' in dom
+    for entry in out.summary["files"].values():
+        assert f'href="{entry["path"]}"' in dom and entry["label"] in dom
 
 
 @pytest.mark.slow

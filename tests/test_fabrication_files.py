@@ -15,7 +15,7 @@ def test_pattern_files_and_their_numbers(tmp_path):
     sheet = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
     written = export_pattern_files(sheet, tmp_path / "p", thickness=0.5e-3, crease_width=2e-3)
     assert [p.name for p in written] == [
-        "pattern.fold", "pattern.svg", "folded.stl", "folded.obj", "thick.stl"
+        "pattern.fold", "pattern.svg", "pattern.dxf", "folded.stl", "folded.obj", "thick.stl"
     ]  # fmt: skip
     back = load_fold((tmp_path / "p" / "pattern.fold").read_text())
     np.testing.assert_allclose(back.coords, sheet.coords, atol=1e-12)
@@ -37,7 +37,7 @@ def test_strip_files(tmp_path):
     fit = fit_strip("half-circle", 8, 0.2, 0.02, 0.1)
     written = export_strip_files(fit, tmp_path / "s", panel_thickness=2e-3, crease_width=3e-3)
     assert [p.name for p in written] == [
-        "strip.fold", "strip.svg", "strip.stl", "strip.obj", "strip_solid.stl"
+        "strip.fold", "strip.svg", "strip.dxf", "strip.stl", "strip.obj", "strip_solid.stl"
     ]  # fmt: skip
     fold = json.loads((tmp_path / "s" / "strip.fold").read_text())
     assert fold["faces_holofold:thickness"][0] == 2e-3
@@ -56,7 +56,7 @@ def test_strip_files_in_metres_with_the_printable_part(tmp_path):
         fit, tmp_path / "s", panel_thickness=2e-3, crease_width=3e-3, crease_thickness=0.8e-3,
         units="m",
     )  # fmt: skip
-    assert [p.name for p in written][-2:] == ["printable.stl", "printable_folded.stl"]
+    assert [p.name for p in written][:2] == ["printable.stl", "printable_folded.stl"]
     mesh = trimesh.load(tmp_path / "s" / "strip.stl")
     np.testing.assert_allclose(mesh.bounds[:, [0, 2]], [[0.0, 0.0], [4.0, 2.0]], atol=0.25)
     part = trimesh.load(tmp_path / "s" / "printable.stl")
@@ -76,9 +76,8 @@ def test_pattern_files_with_the_printable_part_in_mm(tmp_path):
     written = export_pattern_files(
         sheet, tmp_path / "p", thickness=2e-3, crease_width=2e-3, crease_thickness=0.6e-3
     )
-    assert [p.name for p in written][-3:] == [
-        "thick.stl", "printable.stl", "printable_folded.stl"
-    ]  # fmt: skip
+    names = [p.name for p in written]
+    assert names[:2] == ["printable.stl", "printable_folded.stl"] and names[-1] == "thick.stl"
     bent = trimesh.load(tmp_path / "p" / "printable_folded.stl")
     assert bent.is_watertight and bent.body_count == 1
     part = trimesh.load(tmp_path / "p" / "printable.stl")

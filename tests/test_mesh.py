@@ -61,8 +61,31 @@ def test_units_are_checked_before_writing(miura, tmp_path):
 
 
 def test_unknown_export_type_is_named(miura, tmp_path):
-    with pytest.raises(ValueError, match="unknown file type 'dxf'; known: fold, svg, stl"):
-        export(miura, tmp_path / "x.dxf")
-    assert not (tmp_path / "x.dxf").exists()
+    with pytest.raises(ValueError, match="unknown file type 'step'; known: fold, svg, dxf, stl"):
+        export(miura, tmp_path / "x.step")
+    assert not (tmp_path / "x.step").exists()
     with pytest.raises(ValueError, match="unknown mesh type"):
         export_mesh(folded_mesh(miura), "gltf")
+
+
+def test_format_registry_unit_policies(miura, tmp_path):
+    """Each format's own writer and unit: glTF is metres by its specification (a registered
+    format, not a branch that assumes PLY), STL the caller's unit (mm by default)."""
+    import io
+
+    from holofold.geometry import FORMATS, ParameterError
+
+    assert FORMATS["glb"].unit == "m" and FORMATS["stl"].unit is None
+    path = export(miura, tmp_path / "m.glb")
+    assert path.read_bytes()[:4] == b"glTF"
+    scene = trimesh.load(io.BytesIO(path.read_bytes()), file_type="glb")
+    (mesh,) = scene.geometry.values()
+    extent = np.ptp(folded_mesh(miura).vertices, axis=0)  # metres
+    np.testing.assert_allclose(np.sort(np.ptp(mesh.vertices, axis=0)), np.sort(extent), rtol=1e-6)
+    with pytest.raises(ParameterError, match="written in m"):
+        export(miura, tmp_path / "mm.glb", units="mm")
+    stl = trimesh.load(export(miura, tmp_path / "m.stl"))
+    np.testing.assert_allclose(np.ptp(stl.vertices, axis=0), 1000 * extent, rtol=1e-6)
+    with pytest.raises(TypeError, match="needs a CreasePattern"):
+        export(folded_mesh(miura), tmp_path / "x.dxf")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.glb", "m.stl"]

@@ -106,7 +106,10 @@ def make_summary() -> dict:
         "performance": {"Zstiff": 140.2, "error": 0.031},
         "units": {"m": "-", "offset": "m", "Zstiff": "N/m", "E": "Pa"},
         "margins": {"Zstiff > 100": 0.402, "error < 0.05": -0.38, "m == 12": float("inf")},
-        "files": {"FOLD": "files/design.fold", "printable STL": "files/printable.stl"},
+        "files": {
+            "fold": {"path": "files/design.fold", "label": "FOLD"},
+            "printable": {"path": "files/printable.stl", "label": "printable STL"},
+        },
         "images": {"design": "design.png", "rule": "rule.png", "scatter": "scatter.png"},
         "timings": {"database": 41.2, "mine": 3.1, "verify": 10.2, "refine": 30.0, "files": 1.2},
     }

@@ -190,17 +190,20 @@ def test_user_sheet_shape_and_files(tmp_path):
     assert p.n_faces == 12 * 6 and p.meta["ext"] == 0.8  # the least folded state
     assert np.ptp(p.coords[:, 0]) == pytest.approx(0.3 * 0.8 * math.sin(math.radians(60)))
     files = sc.write_files(row, tmp_path / "out")
-    assert set(files) == {"pattern.fold", "pattern.svg", "folded.stl", "folded.obj", "thick.stl",
-                          "printable.stl", "printable_folded.stl"}  # fmt: skip
-    with open(files["folded.stl"], "rb") as fh:
+    assert [f.path.name for f in files] == [
+        "printable.stl", "printable_folded.stl", "pattern.fold", "pattern.svg", "pattern.dxf",
+        "folded.stl", "folded.obj", "thick.stl",
+    ]  # fmt: skip
+    with open(files["surface_stl"].path, "rb") as fh:
         assert b"mm" in fh.read(80)  # the STL header states the unit
-    assert all(f.is_file() and f.stat().st_size > 0 for f in files.values())
+    assert all(f.path.is_file() and f.path.stat().st_size > 0 for f in files)
     # 6 mm panels folded to 0.3 overlap: every file but the thick solid, and a warning
     text = USER_SHEET.format(E=2e9, force=3.0).replace("[0.5, 0.8]", "[0.3]")
     folded = read_scenario(_file(tmp_path, text, "folded.toml"))
     with pytest.warns(UserWarning, match="no thick.stl: the thick panels"):
         files = folded.write_files(folded.complete({**SHEET_ROW, "tpanel": 6e-3}), tmp_path / "f")
-    assert set(files) == {"pattern.fold", "pattern.svg", "folded.stl", "folded.obj"}
+    assert [f.key for f in files] == ["fold", "svg", "dxf", "surface_stl", "surface_obj"]
+    assert "no solids" in files.notes[-1]
 
 
 def test_rectangular_tmp_nodes_repeat_the_geometry_formulas():
@@ -256,7 +259,7 @@ def test_gripper_shape_and_files(tmp_path):
     p = sc.shape(row)
     assert np.abs(p.coords[:, 2]).max() == 0.0  # flat
     files = sc.write_files(row, tmp_path / "g")
-    assert {"pattern.fold", "pattern.svg", "thick.stl"} <= set(files)
+    assert {"pattern.fold", "pattern.svg", "thick.stl"} <= {f.path.name for f in files}
 
 
 # ---------------------------------------------------------------------- refusals

@@ -209,8 +209,10 @@ class Scenario:
         The scenario file it was read from, or ``""``.
     shape : callable(row) -> CreasePattern, optional
         The design's stress-free folded pattern (for pictures and files).
-    write_files : callable(row, folder) -> dict, optional
-        Writes the design's fabrication files into ``folder``; returns label -> path.
+    write_files : callable(row, folder, units="mm", cutter=None) -> FabricationSet, optional
+        Writes the design's fabrication files into ``folder`` (meshes in ``units``, the SVG and
+        DXF drawn for ``cutter``, a :class:`~holofold.geometry.CutterOptions`); returns the
+        :class:`~holofold.geometry.FabricationSet` (files under stable keys with labels).
     evaluate_batch : callable(rows) -> list of dict, optional
         Simulates several rows with the same ``batch_key`` together (their Newton solves in
         lockstep); each output is the one ``evaluate`` gives the row alone. The runner uses it

@@ -818,17 +818,15 @@ def gripper_shape(row) -> CreasePattern:
     return gripper_pattern(int(round(row["Pattern"])), row["L1"], row["L2"], row["rate"]).pattern
 
 
-def write_gripper_files(row, folder, units: str = "mm") -> dict:
-    """FOLD, SVG (cut and score lines), STL/OBJ and the thick solid of the flat gripper
-    (:func:`~holofold.geometry.export_pattern_files`; meshes in ``units``). Returns label ->
-    path."""
-    from holofold.geometry import export_pattern_files  # trimesh: only for files
+def write_gripper_files(row, folder, units: str = "mm", cutter=None):
+    """The flat gripper's fabrication set (:func:`~holofold.geometry.write_fabrication_set`):
+    FOLD, SVG and DXF for ``cutter``, STL/OBJ and the thick solid (meshes in ``units``)."""
+    from holofold.geometry import write_fabrication_set  # trimesh: only for files
 
-    paths = export_pattern_files(
-        gripper_shape(row), folder, thickness=float(row["tpanel"]), crease_width=float(row["W"]),
-        units=units,
+    return write_fabrication_set(
+        gripper_shape(row), folder, panel_thickness=float(row["tpanel"]),
+        crease_width=float(row["W"]), units=units, cutter=cutter,
     )  # fmt: skip
-    return {p.name: p for p in paths}
 
 
 SCENARIO = Scenario(

@@ -497,28 +497,26 @@ def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreaseP
 
 
 def write_sheet_files(
-    setting: SheetSetting, row, folder, ext: float | None = None, units: str = "mm"
-) -> dict:
-    """FOLD, SVG (cut and score lines), STL/OBJ of the sheet folded as :func:`sheet_shape`, its
-    thick solid and printable part (:func:`~holofold.geometry.export_pattern_files`; meshes in
-    ``units``); if the thick panels overlap too much in that state, every file but the solids,
-    with a warning saying why.
-
-    Returns label -> path (the labels name the files).
+    setting: SheetSetting, row, folder, ext: float | None = None, units: str = "mm", cutter=None
+):
+    """The design's fabrication set (:func:`~holofold.geometry.write_fabrication_set`) for the
+    sheet folded as :func:`sheet_shape`: its printable part, FOLD, SVG and DXF for ``cutter``,
+    STL/OBJ and the thick solid (meshes in ``units``); if the thick panels overlap too much in
+    that state, every file but the solids, with a note saying why.
     """
-    from holofold.geometry import export_pattern_files  # trimesh: only for files
+    from holofold.geometry import FabricationSet, write_fabrication_set  # trimesh: only for files
 
     shape = sheet_shape(setting, row, ext)
     W = float(row["W"])
     try:
-        paths = export_pattern_files(
-            shape, folder, thickness=float(row["tpanel"]), crease_width=W,
-            crease_thickness=float(row["tcrease"]), units=units,
+        return write_fabrication_set(
+            shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
+            crease_thickness=float(row["tcrease"]), units=units, cutter=cutter,
         )  # fmt: skip
     except DegenerateGeometryError as exc:
         warnings.warn(f"no thick.stl: {exc}", stacklevel=2)
-        paths = export_pattern_files(shape, folder, crease_width=W, units=units)
-    return {p.name: p for p in paths}
+        got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
+        return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
 
 
 def sheet_scenario(

@@ -437,35 +437,23 @@ def _fit(setting: StripSetting, row):
     )
 
 
-def write_strip_files(setting: StripSetting, row, folder, units: str = "mm") -> dict:
-    """The design's fabrication files: FOLD, SVG (cut and score layers), STL/OBJ of the folded
-    strip, its thick panels, and the printable part (flat panels of ``tpanel`` joined by hinge
-    strips of ``tcrease`` and width ``W``) flat and folded. Meshes in ``units``.
-
-    Returns label -> path (the labels name the formats and units).
+def write_strip_files(setting: StripSetting, row, folder, units: str = "mm", cutter=None):
+    """The design's fabrication set (:func:`~holofold.fitting.write_strip_set`): the printable
+    part (flat panels of ``tpanel`` joined by hinge strips of ``tcrease`` and width ``W``) flat and
+    folded, FOLD, SVG and DXF for ``cutter`` (a :class:`~holofold.geometry.CutterOptions`), STL/OBJ
+    of the folded strip and its thick panels. Meshes in ``units``.
     """
-    from holofold.fitting import export_strip_files  # trimesh: only for files
+    from holofold.fitting import write_strip_set  # trimesh: only for files
 
-    paths = export_strip_files(
+    return write_strip_set(
         _fit(setting, row),
         folder,
         panel_thickness=float(row["tpanel"]),
         crease_width=float(row["W"]),
         crease_thickness=float(row["tcrease"]),
         units=units,
+        cutter=cutter,
     )
-    labels = {
-        "printable.stl": f"STL to print: the flat part, panels joined by hinge strips ({units})",
-        "printable_folded.stl": f"STL of the printable part folded, hinges bent ({units})",
-        "strip.fold": "FOLD crease pattern (flat layout and folded state, m)",
-        "strip.svg": "SVG of the flat layout: cut and score layers (mm)",
-        "strip.stl": f"STL of the folded strip ({units})",
-        "strip.obj": f"OBJ of the folded strip ({units})",
-        "strip_solid.stl": f"STL of the folded thick panels, loose ({units})",
-    }
-    order = {name: i for i, name in enumerate(labels)}
-    paths = sorted(paths, key=lambda p: order.get(p.name, len(order)))
-    return {labels.get(p.name, p.name): p for p in paths}
 
 
 def strip_scenario(

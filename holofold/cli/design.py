@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from holofold.cli._fabrication import add_cutter_arguments, cutter_options
+
 __all__ = ["register", "run"]
 
 
@@ -44,16 +46,18 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="length unit of the STL/OBJ files (default mm, as slicers read them)",
     )  # fmt: skip
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    add_cutter_arguments(p)
     return p
 
 
 def run(args) -> int:
     from holofold.design import run_design
 
+    cutter = cutter_options(args)
     run_design(
         args.scenario, args.target, args.output, samples=args.samples, rounds=args.rounds,
         refine=args.refine, verify=args.verify, top=args.top, db=args.db, seed=args.seed,
         workers=args.workers, progress=False if args.no_progress else None, mesh_units=args.units,
-        say=lambda text: print(text, flush=True),
+        cutter=cutter, say=lambda text: print(text, flush=True),
     )  # fmt: skip
     return 0

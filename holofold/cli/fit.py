@@ -32,6 +32,7 @@ import argparse
 import math
 from pathlib import Path
 
+from holofold.cli._fabrication import add_cutter_arguments, cutter_options
 from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
 
@@ -111,6 +112,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
+    add_cutter_arguments(p)
     return p
 
 
@@ -207,6 +209,7 @@ def run(args) -> int:
     )
 
     opts = _validate(args)
+    cutter = cutter_options(args)
     scaled = args.curve_scale != 1.0
     curve = load_curve(args.curve, units=args.curve_units, check_size=not scaled)
     if scaled:
@@ -242,9 +245,11 @@ def run(args) -> int:
         crease_thickness=args.crease_thickness if args.printable else None,
         candidates=table,
         units=args.units,
+        cutter=cutter,
     )
     units = {"lengths": "m", "errors": "m", "warp": "relative (1 = 100 %)",
-             "mesh files": args.units, "strip.fold": "m", "strip.svg": "mm"}  # fmt: skip
+             "mesh files": args.units, "strip.fold": "m", "strip.svg": "mm",
+             "strip.dxf": "mm"}  # fmt: skip
     summary = {**fit.parameters, **fit.errors, "units": units, "files": [str(w) for w in written]}
     warp = fit.errors["warp_max"]
     limit = f" (limit {100 * args.max_warp:.3g} %)" if args.auto else ""

@@ -9,8 +9,9 @@ Examples::
     holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --size 0.1 --printable \
         --panel-thickness 2e-3 --crease-thickness 0.6e-3 --crease-width 2e-3 -o out/
 
-Writes ``pattern.fold`` (flat crease pattern + folded frame, m), ``pattern.svg`` (cut/score
-layers, mm), ``folded.stl`` and ``folded.obj`` (folded surface) and, with ``--thickness``,
+Writes ``pattern.fold`` (flat crease pattern + folded frame, m), ``pattern.svg`` and
+``pattern.dxf`` (the flat pattern for ``--profile``, mm), ``folded.stl`` and ``folded.obj``
+(folded surface) and, with ``--thickness``,
 ``thick.stl`` (the folded panels with hinge gaps, loose bodies) and, with ``--printable``,
 ``printable.stl``: the flat part to print and then fold, panels joined by hinge strips of
 ``--crease-thickness`` and ``--crease-width``. Meshes in ``--units`` (default mm, what slicers
@@ -21,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 import math
+
+from holofold.cli._fabrication import add_cutter_arguments, cutter_options
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -58,6 +61,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
+    add_cutter_arguments(p)
     return p
 
 
@@ -97,6 +101,7 @@ def run(args) -> int:
 
     from holofold.geometry import ParameterError, check_range, export_pattern_files
 
+    cutter = cutter_options(args)
     pattern = _build(args)
     check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:
@@ -118,6 +123,7 @@ def run(args) -> int:
         crease_width=args.crease_width,
         crease_thickness=args.crease_thickness if args.printable else None,
         units=args.units,
+        cutter=cutter,
     )
     ext = np.ptp(pattern.coords, axis=0)
     print(

@@ -1,0 +1,101 @@
+"""DXF crease patterns with named layers, for CAD and laser software (written with ezdxf).
+
+The flat layout in millimetres (``$INSUNITS`` = 4, y up as the pattern has it), one ``LINE``
+per drawn segment on the layer of its role (:data:`DXF_LAYERS`): ``BOUNDARY``, ``CUT``,
+``SCORE_M`` (mountains), ``SCORE_V`` (valleys), ``SCORE_F`` (flat creases), ``SCORE_U``
+(unassigned), ``REGISTRATION``. Each layer has the profile's colour (as a true colour and the
+nearest AutoCAD colour index, which laser software maps by) and a lineweight of the profile's
+stroke width. Creases are drawn as the cutter profile says
+(:func:`~holofold.geometry.cutter.cutter_drawing`): whole lines, vertex to vertex, with the
+``origami-simulator`` profile (a reader rebuilds the crease graph from them), dashes with gaps
+at the vertices with ``laser``. Every ``LINE`` carries no text; the fold angle of a crease is
+not in a DXF (use the FOLD file).
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from holofold.geometry.cutter import (
+    DEFAULT_PROFILE,
+    ROLES,
+    CutterProfile,
+    cutter_drawing,
+    get_profile,
+    hole_points,
+)
+from holofold.geometry.pattern import CreasePattern
+
+__all__ = ["DXF_LAYERS", "export_dxf"]
+
+#: role -> DXF layer name (readers map these back to FOLD assignments B, C, M, V, F, U)
+DXF_LAYERS = {
+    "boundary": "BOUNDARY",
+    "cut": "CUT",
+    "mountain": "SCORE_M",
+    "valley": "SCORE_V",
+    "flat": "SCORE_F",
+    "unassigned": "SCORE_U",
+    "registration": "REGISTRATION",
+}
+
+# AutoCAD colour index of the pure colours the profiles use
+_ACI = {
+    (255, 0, 0): 1,
+    (255, 255, 0): 2,
+    (0, 255, 0): 3,
+    (0, 255, 255): 4,
+    (0, 0, 255): 5,
+    (255, 0, 255): 6,
+    (0, 0, 0): 7,  # black / white by background
+    (255, 255, 255): 7,
+}
+# DXF lineweights, 1/100 mm
+_LINEWEIGHTS = (0, 5, 9, 13, 15, 18, 20, 25, 30, 35, 40, 50, 53, 60, 70, 80, 90, 100)
+
+
+def _rgb(colour: str) -> tuple[int, int, int]:
+    c = colour.lstrip("#")
+    return int(c[0:2], 16), int(c[2:4], 16), int(c[4:6], 16)
+
+
+def export_dxf(
+    pattern: CreasePattern,
+    *,
+    profile: str | CutterProfile = DEFAULT_PROFILE,
+    dash: float | None = None,
+    gap: float | None = None,
+    vertex_gap: float | None = None,
+    margin_mm: float = 5.0,
+) -> str:
+    """DXF text (R2010) of the flat crease pattern for a cutter ``profile``, mm (see module)."""
+    import ezdxf
+
+    prof = get_profile(profile)
+    draw = cutter_drawing(
+        pattern, prof, dash=dash, gap=gap, vertex_gap=vertex_gap, margin=margin_mm
+    )
+    doc = ezdxf.new("R2010", units=4)  # 4: millimetres
+    doc.header["$MEASUREMENT"] = 1  # metric
+    msp = doc.modelspace()
+    for role in ROLES:
+        st = prof.strokes[role]
+        rgb = _rgb(st.colour)
+        lw = min(_LINEWEIGHTS, key=lambda w: abs(w - 100 * st.width))
+        layer = doc.layers.add(DXF_LAYERS[role], color=_ACI.get(rgb, 7))
+        layer.rgb = rgb
+        layer.dxf.lineweight = lw
+    flip = np.array([1.0, -1.0])
+    shift = np.array([0.0, draw.height])
+    for role, segs in draw.lines.items():
+        name = DXF_LAYERS[role]
+        for a, b in segs * flip + shift:
+            msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": name})
+    for c in draw.holes:
+        pts = hole_points(c, draw.hole_radius) * flip + shift
+        msp.add_lwpolyline(pts[:-1].tolist(), close=True, dxfattribs={"layer": "REGISTRATION"})
+    stream = io.StringIO()
+    doc.write(stream)
+    return stream.getvalue()
