@@ -240,3 +240,20 @@ def test_laser_svg_renders_with_librsvg(which, request, tmp_path):
     back.write_text(export_svg(pattern, profile="laser", side="back"))
     img = _render(back, tmp_path / "b.png", dpi)
     assert tinted(img[..., 1], img[..., 0], img[..., 2]) > 100
+
+
+def test_dxf_round_trip_through_the_reader(miura, tmp_path):
+    """The origami-simulator profile's DXF (whole creases) reads back with holofold's DXF reader
+    to the same pattern: vertices (mm -> m, to 1e-9 m), edges and assignments."""
+    from holofold.geometry.readers import read_pattern
+
+    back = read_pattern(export(miura, tmp_path / "p.dxf"))
+    assert (back.n_vertices, back.n_edges, back.n_faces) == (25, 40, 16)
+    # the drawing sits on the page with a margin: compare after removing the offset
+    a = miura.flat - miura.flat.min(axis=0)
+    b = back.flat - back.flat.min(axis=0)
+    order_a = np.lexsort(np.round(a, 6).T)
+    order_b = np.lexsort(np.round(b, 6).T)
+    np.testing.assert_allclose(b[order_b], a[order_a], atol=1e-9)
+    for code in "MVB":
+        assert (back.assignment == code).sum() == (miura.assignment == code).sum()
