@@ -156,8 +156,10 @@ def read_fold_pattern(path, *, frame: int | None = None, unit: float | None = No
                 "every fold angle lies within +-pi and some equal pi: they look like radians, "
                 "but FOLD angles are degrees (read as degrees)"
             )
-    elif "edges_assignment" in fr:
+    elif isinstance(fr.get("edges_assignment"), list):
         notes.append("no edges_foldAngle: mountains and valleys fold fully (-+180 degrees)")
+        full = {"M": -180.0, "V": 180.0}
+        fr["edges_foldAngle"] = [full.get(a, 0.0) for a in fr["edges_assignment"]]
     # units
     fu = fr.get("frame_unit", d.get("frame_unit"))
     if unit is not None:

@@ -12,9 +12,10 @@ take it.
 What each assignment becomes (FOLD codes):
 
 * ``M``, ``V``: driven creases, rest angle ``pi + f phi`` (``phi`` the target in radians,
-  valley > 0). A target of 0 on an M or V crease means "fold fully": -180 or +180 degrees, the
-  convention of Origami Simulator and of holofold's flat sheets. Targets are capped at
-  :data:`MAX_FOLD_DEG` (the dihedral angle of a spring wraps at +-180 degrees).
+  valley > 0), as Origami Simulator drives them: a target of 0 (an SVG line of opacity 0)
+  keeps the crease flat. Targets are capped at :data:`MAX_FOLD_DEG` (the dihedral angle of a
+  spring wraps at +-180 degrees). A flat sheet whose M/V is known but not its angles needs
+  ``target`` (for instance -+180).
 * ``F``, ``J``: facets (Origami Simulator's yellow lines, triangulation edges): springs of the
   panel's thickness over the crease width, kept flat.
 * ``U`` and any other interior edge: passive creases of the crease section, kept flat (no
@@ -26,8 +27,10 @@ fixed, which removes the rigid-body motion and nothing else.
 The result (:class:`FoldResult`) keeps the path (the vertex coordinates after every step), the
 fraction reached with every step converged, the fold progress (how far the driven creases
 actually turned, length-weighted, against their targets) and a one-line verdict: ``folds
-rigidly``, ``does not fold rigidly`` (panels take more than :data:`RIGID_PANEL_SHARE` of the
-energy, or driven creases turn less than :data:`STUCK_RATIO` of their actuated target),
+rigidly``, ``does not fold rigidly`` (a panel bends by more than :data:`RIGID_BEND_DEG` or
+stretches by more than :data:`RIGID_STRAIN`), ``folds off target`` (panels stay flat but
+driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the targets are
+not those of a rigid folding),
 ``bifurcation at flat`` (driven creases folded the wrong way: the solve left the flat
 state on another branch) or ``stalls`` (a step would not converge).
 """
@@ -54,14 +57,17 @@ __all__ = [
     "crease_classes",
     "default_supports",
     "MAX_FOLD_DEG",
-    "RIGID_PANEL_SHARE",
+    "RIGID_BEND_DEG",
+    "RIGID_STRAIN",
     "MODELS",
 ]
 
 #: the largest driven fold angle, degrees: a spring's dihedral angle wraps at +-180
 MAX_FOLD_DEG = 179.0
-#: a fold whose panels store more than this share of the energy does not fold rigidly
-RIGID_PANEL_SHARE = 0.10
+#: a fold that bends a panel by more than this (degrees) or stretches it by more than
+#: :data:`RIGID_STRAIN` does not fold rigidly
+RIGID_BEND_DEG = 3.0
+RIGID_STRAIN = 1e-3
 #: a driven crease counts as folded the wrong way beyond this angle of the wrong sign, degrees
 WRONG_WAY_DEG = 10.0
 #: the bar-and-hinge models a pattern can be folded with
@@ -87,8 +93,8 @@ def crease_classes(pattern: CreasePattern) -> np.ndarray:
 def fold_targets(pattern: CreasePattern, target=None) -> np.ndarray:
     """(ne,) float: the full-fold target of every edge, degrees (FOLD sign: valley > 0).
 
-    ``target`` (ne,) degrees, default ``pattern.fold_angle``; M/V creases with target 0 get
-    -180/+180; capped at +-:data:`MAX_FOLD_DEG`; 0 for every edge that is not driven.
+    ``target`` (ne,) degrees, default ``pattern.fold_angle``; capped at +-:data:`MAX_FOLD_DEG`;
+    0 for every edge that is not driven (not M or V).
     """
     t = pattern.fold_angle if target is None else np.asarray(target, float)
     if t.shape != (pattern.n_edges,) or not np.isfinite(t).all():
@@ -96,11 +102,7 @@ def fold_targets(pattern: CreasePattern, target=None) -> np.ndarray:
             f"target must be {pattern.n_edges} finite fold angles (degrees), got shape {t.shape}"
         )
     cls = crease_classes(pattern)
-    a = pattern.assignment
-    full = np.where(a == "M", -180.0, 180.0)
-    t = np.where((cls == DRIVEN) & (t == 0.0), full, t)
-    t = np.where(cls == DRIVEN, np.clip(t, -MAX_FOLD_DEG, MAX_FOLD_DEG), 0.0)
-    return t
+    return np.where(cls == DRIVEN, np.clip(t, -MAX_FOLD_DEG, MAX_FOLD_DEG), 0.0)
 
 
 def _components(pattern: CreasePattern) -> np.ndarray:
@@ -169,7 +171,8 @@ class FoldResult:
     status : Status
         Converged (every step met the tolerance up to ``requested``) or not converged, why.
     verdict : str
-        ``folds rigidly``, ``does not fold rigidly``, ``bifurcation at flat`` or ``stalls``.
+        ``folds rigidly``, ``folds off target``, ``does not fold rigidly``, ``bifurcation at
+        flat`` or ``stalls``.
     note : str
         One sentence behind the verdict (numbers).
     energy : ModelEnergy
@@ -178,6 +181,9 @@ class FoldResult:
         Driven creases folded against their assignment in the last state.
     halvings : int
         Steps retried at a smaller size.
+    snaps : (n,) float
+        Fractions at which no equilibrium lay near the last one and the sheet snapped to the
+        energy minimum beyond (a limit point of the rest-angle path).
     """
 
     pattern: CreasePattern
@@ -195,6 +201,7 @@ class FoldResult:
     energy: ModelEnergy
     wrong_way: np.ndarray = field(default_factory=lambda: np.zeros(0, np.intp))
     halvings: int = 0
+    snaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def reached(self) -> float:
@@ -361,6 +368,7 @@ def fold_pattern(
     h0 = fraction / n_steps
     done, h, halvings = 0.0, h0, 0
     fr, Us = [0.0], [U.copy()]
+    snaps: list[float] = []
     stalled = ""
     while done < fraction - 1e-12:
         nxt = done + h
@@ -378,6 +386,17 @@ def fold_pattern(
             h = min(h0, 2.0 * h)
             continue
         if h <= h0 / 2**_MAX_HALVINGS:
+            # no equilibrium near the last one: a limit point; the sheet snaps to another
+            # equilibrium, found by minimising the energy (Levenberg-Marquardt)
+            relaxed = _relax(asm, U, rest(nxt), tol)
+            if relaxed is not None:
+                U = relaxed
+                done = nxt
+                fr.append(done)
+                Us.append(U.copy())
+                snaps.append(done)
+                h = h0
+                continue
             why = "; ".join(res.status.reasons) or "non-finite displacement"
             stalled = f"step {100 * done:.1f} -> {100 * nxt:.1f} % does not converge ({why})"
             break
@@ -397,6 +416,8 @@ def fold_pattern(
     stuck = np.flatnonzero(driven & (ratio < STUCK_RATIO * done)) if done > 0 else wrong[:0]
     e_flat = asm.internal_force(np.zeros((nn, 3)), final_rest)[0]  # held flat: the reference
     share = energy.panel_share if energy.total > 1e-9 * e_flat else 0.0
+    bend = float(np.degrees(energy.panel_bend.max(initial=0.0)))
+    strain = float(energy.panel_strain.max(initial=0.0))
     if stalled:
         verdict = "stalls"
         note = stalled
@@ -409,32 +430,76 @@ def fold_pattern(
                 f"{wrong.size} of {int(driven.sum())} driven creases folded against their "
                 f"assignment (first: edge {int(wrong[0])})"
             )
-        elif stuck.size:
+        elif bend > RIGID_BEND_DEG or strain > RIGID_STRAIN:
             verdict = "does not fold rigidly"
+            p = int(np.argmax(energy.panel_bend))
             note = (
-                f"{stuck.size} of {int(driven.sum())} driven creases turn less than "
-                f"{100 * STUCK_RATIO:.0f} % of their target (first: edge {int(stuck[0])}); "
-                f"panels store {100 * share:.0f} % of the energy"
+                f"panels bend up to {bend:.1f} deg (panel {p}) and stretch up to {strain:.2g}; "
+                f"they store {100 * share:.0f} % of the energy"
             )
-        elif share > RIGID_PANEL_SHARE:
-            verdict = "does not fold rigidly"
+            if stuck.size:
+                note += f"; {stuck.size} of {int(driven.sum())} driven creases barely turn"
+        elif stuck.size:
+            verdict = "folds off target"
             note = (
-                f"panels store {100 * share:.0f} % of the energy; largest panel strain "
-                f"{energy.panel_strain.max(initial=0.0):.2g}"
+                f"panels stay flat (bend at most {bend:.1f} deg) but {stuck.size} of "
+                f"{int(driven.sum())} driven creases turn less than {100 * STUCK_RATIO:.0f} % "
+                f"of their target (first: edge {int(stuck[0])}): the targets are not those of "
+                "a rigid folding"
             )
         else:
             verdict = "folds rigidly"
             if energy.total <= 1e-9 * e_flat:
                 note = "the folded state is stress free (the targets are compatible)"
             else:
-                note = f"panels store {100 * share:.1f} % of the energy"
+                note = f"panels bend at most {bend:.2f} deg, stretch at most {strain:.1g}"
     if stalled and wrong.size:
         note += f"; {wrong.size} driven creases folded against their assignment"
+    if snaps:
+        where = ", ".join(f"{100 * x:.1f}" for x in snaps[:5])
+        note += f"; snaps at {where} % (no nearby equilibrium: the energy minimum beyond)"
     return FoldResult(
         pattern=base, structure=structure, target=tgt, requested=fraction, fractions=fractions,
         U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
         verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
+        snaps=np.array(snaps),
     )  # fmt: skip
+
+
+def _relax(asm, U, rest, tol, max_iter: int = 400):
+    """The equilibrium reached from ``U`` by minimising the energy at rest angles ``rest``
+    (Levenberg-Marquardt: (K + mu D) dU = r, mu adapted to the energy decrease); None if it
+    does not reach the residual ``tol``."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    free = asm.free_dofs
+    U = U.copy().ravel()
+    E, f, K = asm.evaluate_reduced(U, rest, dense=False)
+    r = -f[free]
+    D = np.maximum(np.abs(K.diagonal()), 1e-12 * np.abs(K.diagonal()).max(initial=1.0))
+    mu = 1e-4
+    for _ in range(max_iter):
+        if math.sqrt(r @ r) <= tol:
+            return U.reshape(-1, 3)
+        try:
+            d = splu((K + sp.diags(mu * D)).tocsc()).solve(r)
+        except RuntimeError:  # singular: damp more
+            mu *= 10.0
+            continue
+        trial = U.copy()
+        trial[free] += d
+        E_t = asm.internal_force(trial, rest)[0]
+        if np.isfinite(E_t) and E_t < E:
+            U = trial
+            E, f, K = asm.evaluate_reduced(U, rest, dense=False)
+            r = -f[free]
+            mu = max(mu / 3.0, 1e-12)
+        else:
+            mu *= 4.0
+            if mu > 1e12:
+                return None
+    return None
 
 
 def _face_edges(pattern: CreasePattern) -> np.ndarray:

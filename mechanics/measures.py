@@ -7,6 +7,7 @@ largest bar strain of each panel::
     panel_energy   (nf,) J   the panel's bars (a bar on an edge shared by two panels split in
                              half) and its bending springs
     panel_strain   (nf,) -   largest |Green-Lagrange strain| of the panel's bars
+    panel_bend     (nf,) rad largest turn of the panel's bending springs from their rest angle
     crease_energy  (ne,) J   per pattern edge: its hinge (concentrated) or its strip's bars and
                              springs (compliant); 0 for edges that are not creases
 
@@ -38,6 +39,9 @@ class ModelEnergy:
         J.
     panel_strain : (nf,) float
         Largest |strain| of each panel's bars (dimensionless).
+    panel_bend : (nf,) float
+        Largest turn of each panel's bending springs away from their rest angle, rad: how far
+        the panel is from flat (0 for a rigid panel, whatever the stiffness).
     crease_energy : (ne,) float
         J, per pattern edge (0 where the edge is not a crease).
     total : float
@@ -49,6 +53,7 @@ class ModelEnergy:
     panel_strain: np.ndarray
     crease_energy: np.ndarray
     total: float
+    panel_bend: np.ndarray | None = None
 
     @property
     def panel_share(self) -> float:
@@ -135,6 +140,15 @@ def model_energy(
         owner = np.where(sk[order][pos] == hk, sp_owner[order][pos], -1)
         ok = owner >= 0
         np.add.at(panel_energy, owner[ok], es[is_panel][ok])
+        from holofold.mechanics.springs import dihedral_angle
+
+        rest = structure.spring_rest if spring_rest is None else np.asarray(spring_rest, float)
+        theta = dihedral_angle(structure.nodes + U, structure.springs[is_panel])
+        turn = np.abs(np.angle(np.exp(1j * (theta - rest[is_panel]))))  # wrapped to [0, pi]
+        panel_bend = np.zeros(nf)
+        np.maximum.at(panel_bend, owner[ok], turn[ok])
+    else:
+        panel_bend = np.zeros(nf)
     crease_spring = ~is_panel & (structure.spring_crease >= 0)
     np.add.at(crease_energy, structure.spring_crease[crease_spring], es[crease_spring])
     return ModelEnergy(
@@ -142,4 +156,5 @@ def model_energy(
         panel_strain=panel_strain,
         crease_energy=crease_energy,
         total=float(eb.sum() + es.sum()),
+        panel_bend=panel_bend,
     )
