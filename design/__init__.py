@@ -40,8 +40,22 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "plot_folded_design",
             "save_figure",
         ],
-        "rulefile": ["rules_to_records", "write_rules", "read_rules", "RulesFileError"],
-        "rules": ["ForestRuleMiner", "FewRulesWarning", "format_rule"],
+        "rulefile": [
+            "mined_rules",
+            "rules_to_records",
+            "write_rules",
+            "read_rules",
+            "RulesFileError",
+        ],
+        "rules": [
+            "ForestRuleMiner",
+            "FewRulesWarning",
+            "Rule",
+            "Condition",
+            "Score",
+            "Estimate",
+            "RuleError",
+        ],
         "runner": [
             "validate_designs",
             "evaluate_designs",
@@ -88,6 +102,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "write_verification",
             "Verification",
             "rule_mask",
+            "rule_ranges",
+            "as_rule",
         ],
     },
 )

@@ -33,15 +33,15 @@ import pandas as pd
 from holofold.design.folder_lock import locks_folder
 from holofold.design.mining import mine_rules
 from holofold.design.row_status import converged_rows, failed_rows
-from holofold.design.rulefile import rules_to_records, write_rules
-from holofold.design.rules import FewRulesWarning
+from holofold.design.rulefile import mined_rules, write_rules
+from holofold.design.rules import Condition, FewRulesWarning, Rule
 from holofold.design.runner import check_workers
 from holofold.design.sampling import MAX_SAMPLES, sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.store import build_database, load_database
 from holofold.design.tables import ColumnRoles, write_table
 from holofold.design.targets import parse_target
-from holofold.design.verify import Verification, rule_mask, rule_ranges
+from holofold.design.verify import Verification, as_rule, rule_ranges
 from holofold.geometry.outputs import write_json
 from holofold.geometry.units import length_factor
 
@@ -81,14 +81,15 @@ class DesignOutcome:
 # ---------------------------------------------------------------------- sampling
 def refine_designs(
     scenario: Scenario,
-    rules: Sequence[Mapping],
+    rules: Sequence[Rule | Mapping],
     n: int,
     *,
     seed: int,
     start: int = 0,
     widen: float = 0.25,
 ) -> pd.DataFrame:
-    """``n`` new designs inside and around the boxes of ``rules`` (shared equally).
+    """``n`` new designs inside and around the boxes of ``rules`` (:class:`Rule` records or
+    their JSON form; shared equally).
 
     Half of each rule's designs lie inside its box, half in the box widened by ``widen`` of
     each feature's range on both sides (clipped to the scenario's range), so the database also
@@ -99,7 +100,7 @@ def refine_designs(
     k = len(rules)
     counts = [n // k + (1 if i < n % k else 0) for i in range(k)]
     for i, (rule, m) in enumerate(zip(rules, counts, strict=True)):
-        inside = rule_ranges(scenario, rule["bounds"])
+        inside = rule_ranges(scenario, rule)
         wide = {}
         for name, r in inside.items():
             c = cols[name]
@@ -121,9 +122,9 @@ def refine_designs(
 
 # ---------------------------------------------------------------------- choosing
 def choose_design(
-    table: pd.DataFrame, target, bounds: Mapping | None
+    table: pd.DataFrame, target, rule: Rule | Mapping | None
 ) -> tuple[int | None, dict, str]:
-    """The row of ``table`` to build: inside ``bounds``, meeting ``target``, largest margin.
+    """The row of ``table`` to build: inside ``rule``, meeting ``target``, largest margin.
 
     Returns (index label or None, per-condition margins of that row, how it was chosen).
     Converged rows are preferred; without one inside the box, every row meeting the target
@@ -133,7 +134,7 @@ def choose_design(
     conv = converged_rows(table)
     meets = np.zeros(len(table), bool)
     meets[ok] = target.evaluate(table.loc[ok])
-    inside = rule_mask(table, bounds) if bounds is not None else np.ones(len(table), bool)
+    inside = as_rule(rule).mask(table) if rule is not None else np.ones(len(table), bool)
     how = "inside the best verified rule"
     for pool, text in (
         (inside & meets & conv, how),
@@ -210,45 +211,42 @@ def _simulate(scenario, designs, folder, workers, progress) -> pd.DataFrame:
     )
 
 
-def _verify(scenario, records, target, n, folder, seed, workers, progress):
+def _verify(scenario, rules, target, n, folder, seed, workers, progress):
     out = []
-    for i, r in enumerate(records, start=1):
-        designs = sample_designs(
-            scenario, n, seed=seed + i, ranges=rule_ranges(scenario, r["bounds"])
-        )
+    for i, r in enumerate(rules, start=1):
+        designs = sample_designs(scenario, n, seed=seed + i, ranges=rule_ranges(scenario, r))
         res = _simulate(scenario, designs, folder / f"rule{i}", workers, progress)
         out.append(Verification.of(res, target))
     return out
 
 
-def _box_of(sc: Scenario, hits: pd.DataFrame, roles: ColumnRoles) -> dict:
+def _box_of(sc: Scenario, hits: pd.DataFrame, roles: ColumnRoles) -> Rule:
     """A pseudo-rule: the box spanned by the designs that meet the target (to refine around)."""
-    bounds: dict = {}
+    conds = []
     for name in roles.features:
         col = hits[name].to_numpy(dtype=float)
         if name in roles.categorical:
-            bounds[name] = {"in": sorted(set(col.tolist()))}
-        else:
-            bounds[name] = {"gt": float(np.nextafter(col.min(), -np.inf)), "le": float(col.max())}
-    return {"rank": 0, "rule": f"the box of the {len(hits)} designs meeting the target",
-            "bounds": bounds}  # fmt: skip
+            conds.append(Condition(name, levels=tuple(col.tolist())))
+        elif col.max() > col.min():
+            conds.append(Condition(name, gt=float(np.nextafter(col.min(), -np.inf)),
+                                   le=float(col.max())))  # fmt: skip
+    return Rule(tuple(conds), rank=0)
 
 
-def _rule_entry(rec: Mapping, v: Verification | None) -> dict:
-    e = {
-        "rank": rec["rank"],
-        "rule": rec["rule"],
-        "bounds": rec["bounds"],
-        "train_precision": rec["train"]["precision"],
-        "test_precision": rec.get("test", {}).get("precision"),
-        "test_support": rec.get("test", {}).get("support"),
+def _rule_entry(rule: Rule, v: Verification | None, columns: Mapping) -> dict:
+    rec = rule.to_json(columns)
+    e = {k: rec[k] for k in ("rank", "rule", "bounds", "display")}
+    e |= {
+        "train_precision": None if rule.train is None else rule.train.precision,
+        "test_precision": None if rule.test is None else rule.test.precision,
+        "test_support": None if rule.test is None else rule.test.support,
     }
-    est = rec.get("estimate")
-    if isinstance(est, Mapping):
+    if rule.estimate is not None:
+        est = rec["estimate"]
         e |= {
-            "estimate": est.get("precision"),
-            "estimate_95ci": est.get("interval"),
-            "estimate_rows": est.get("rows"),
+            "estimate": est["precision"],
+            "estimate_95ci": est["interval"],
+            "estimate_rows": est["rows"],
         }
     if v is not None:
         s = v.summary()
@@ -357,6 +355,7 @@ def run_design(
     out = Path(folder)
     dbf = Path(db) if db is not None else out / "database"
     roles = _roles(sc)
+    columns = sc.columns
     if not roles.features:
         raise ValueError(f"scenario {sc.name!r} varies no feature: give ranges in [features]")
     out.mkdir(parents=True, exist_ok=True)
@@ -398,10 +397,10 @@ def run_design(
             warnings.simplefilter("ignore", FewRulesWarning)
             mined = mine_rules(table, tgt, roles=roles, seed=seed, n_rules=top, max_overlap=0.5,
                                source=str(dbf))  # fmt: skip
-        records = rules_to_records(mined.miner, mined.test_scores)[:top]
+        records = mined_rules(mined.miner, mined.test_scores)[:top]
         if records:
             rdir.mkdir(parents=True, exist_ok=True)
-            write_rules(rdir / "rules.json", records)
+            write_rules(rdir / "rules.json", records, columns)
         times["mine"] += time.perf_counter() - t0
         if not records:
             hits = int(mined.meets.sum())
@@ -424,7 +423,7 @@ def run_design(
         checks = _verify(sc, records, tgt, verify, rdir / "verify", seed + 100 * r, workers,
                          progress)  # fmt: skip
         times["verify"] += time.perf_counter() - t0
-        entries = [_rule_entry(rec, v) for rec, v in zip(records, checks, strict=True)]
+        entries = [_rule_entry(rec, v, columns) for rec, v in zip(records, checks, strict=True)]
         for e in entries:
             est, test = _fmt(e.get("estimate")), _fmt(e["test_precision"])
             ver = _fmt(e.get("verified_precision"))
@@ -443,7 +442,7 @@ def run_design(
     t0 = time.perf_counter()
     say("[choose] the design with the largest worst-case margin inside the best rule")
     rule = history[-1]["rules"][best]
-    label, margins, how = choose_design(table, tgt, rule["bounds"])
+    label, margins, how = choose_design(table, tgt, history[-1]["records"][best])
     if label is None:
         raise ValueError(f"no simulated design meets {str(tgt)!r}; try more samples or rounds")
     row = table.loc[label]
@@ -493,8 +492,8 @@ def run_design(
         write_report_page(out, summary)
     _check_own_summary(out, summary)
     vp = rule.get("verified_precision")
-    say(f"chosen: {', '.join(f'{k} = {v:.4g}' for k, v in features.items())}\n"
-        f"  {', '.join(f'{k} = {performance[k]:.4g} {units[k]}' for k in tgt.columns)}; "
+    say(f"chosen: {', '.join(f'{k} = {_shown(columns, k, v)}' for k, v in features.items())}\n"
+        f"  {', '.join(f'{k} = {_shown(columns, k, performance[k])}' for k in tgt.columns)}; "
         f"worst margin {summary['worst_margin']:.3g}; rule verified precision "
         f"{'n/a' if vp is None else f'{vp:.2f}'}; files in {out}/")  # fmt: skip
     return DesignOutcome(summary, table, out)
@@ -510,6 +509,11 @@ def _check_own_summary(out: Path, summary: dict) -> None:
         raise ValueError(f"{out}/design.json cannot be read back ({exc})") from None
     if stored != json.loads(json.dumps(summary)):
         raise ValueError(f"{out}/design.json is not this run's: another run wrote the folder")
+
+
+def _shown(columns: Mapping, name: str, value) -> str:
+    """A value of the chosen design in its column's display unit (4 digits), or n/a."""
+    return "n/a" if value is None else columns[name].format(value, 4)
 
 
 def _scenario_summary(sc: Scenario) -> dict:
@@ -560,8 +564,7 @@ def _write_files(
         save_figure(fig, out / "design.png")
         images["design"] = "design.png"
     X = mined.table[list(mined.features)]
-    units = {c.name: c.unit for c in (*sc.features, *sc.performance)}
-    fig = plot_rule_boxes(mined.miner, X, rule["rank"] - 1, units=units)
+    fig = plot_rule_boxes(mined.miner, X, rule["rank"] - 1, columns=sc.columns)
     fig.tight_layout()  # long feature names stay inside the picture
     save_figure(fig, out / "rule.png")
     images["rule"] = "rule.png"
@@ -572,6 +575,7 @@ def _write_files(
         x = next((k for k in rule["bounds"] if k not in sc.categorical), mined.features[0])
         y = cols[0]
     ok = table.loc[~failed_rows(table)]
-    save_figure(plot_target_scatter(ok, tgt, x, y, chosen=row, units=units), out / "scatter.png")
+    fig = plot_target_scatter(ok, tgt, x, y, chosen=row, columns=sc.columns)
+    save_figure(fig, out / "scatter.png")
     images["scatter"] = "scatter.png"
     return files, images

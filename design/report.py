@@ -15,7 +15,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from holofold.design.rules import ForestRuleMiner, format_rule, level_value
+from holofold.design.rulefile import mined_rules
+from holofold.design.rules import ForestRuleMiner, level_value
+from holofold.design.scenarios.base import format_value
 from holofold.design.targets import Target, parse_target
 from holofold.geometry.outputs import atomic_write
 
@@ -43,20 +45,14 @@ def rules_frame(miner: ForestRuleMiner, test: pd.DataFrame | None = None) -> pd.
     return frame
 
 
-def _categorical_names(miner: ForestRuleMiner) -> set:
-    enc = miner._encoding
-    return {n for n, c in zip(enc.names, enc.categorical, strict=True) if c}
-
-
 def rules_to_text(
     miner: ForestRuleMiner,
     test: pd.DataFrame | None = None,
     *,
-    scale: dict | None = None,
-    units: dict | None = None,
-    digits: int = 4,
+    columns: Mapping | None = None,
+    digits: int = 3,
 ) -> str:
-    """Human-readable list of the kept rules with their metrics.
+    """Human-readable list of the kept rules with their metrics, in display units.
 
     Parameters
     ----------
@@ -64,55 +60,49 @@ def rules_to_text(
     test : DataFrame, optional
         Held-out metrics per rule (``evaluation.rule_scores``: ``precision``, ``recall``,
         ``support``, ``true_positives``); its rows also join the estimate's evidence.
-    scale, units : dict, optional
-        Display factor and unit per feature, e.g. ``{"W": 1e3}``, ``{"W": "mm"}``.
-    digits : int, default=4
+    columns : mapping, optional
+        Name -> :class:`~holofold.design.scenarios.Column` (``tables.table_columns``): the
+        thresholds are shown in each column's display unit (``tcrease <= 0.779 mm``); features
+        without one read as bare SI numbers.
+    digits : int, default=3
+        Significant digits of the thresholds (the rules files keep them exactly).
     """
-    rules = miner.rules_
-    if not len(rules):
+    if not len(miner.rules_):
         return (
             f"no rule reaches precision >= {miner.precision_min} with support >= "
             f"{miner.min_support} ({miner.n_candidates_} candidate boxes)"
         )
-    oob = rules["estimate_support"].to_numpy()
-    est = miner.rule_estimates(None if test is None else test.reset_index(drop=True))
     lines = []
-    for i, row in rules.iterrows():
-        text = format_rule(
-            miner.rule_bounds(i),
-            miner.feature_names_,
-            categorical=_categorical_names(miner),
-            digits=digits,
-            scale=scale,
-            units=units,
-        )
-        lines.append(f"rule {i + 1}: {text}")
-        e = est.iloc[i]
-        held = int(e["estimate_support"] - oob[i])
-        rows = f"{int(oob[i])} out-of-bag" + (f" + {held} held-out" if test is not None else "")
-        lines.append(
-            f"    estimate: precision {e['estimate']:.3f} (95 % interval "
-            f"{e['estimate_low']:.3f}-{e['estimate_high']:.3f}; from {rows} rows)"
+    for r in mined_rules(miner, test):
+        e = r.estimate
+        lines.append(f"rule {r.rank}: {r.text(columns, digits)}")
+        rows = f"{e.out_of_bag_rows} out-of-bag" + (
+            f" + {e.held_out_rows} held-out" if test is not None else ""
         )
         lines.append(
-            f"    train:    precision {row['precision']:.3f}  recall {row['recall']:.3f}  "
-            f"support {int(row['support'])}"
+            f"    estimate: precision {e.precision:.3f} (95 % interval "
+            f"{e.low:.3f}-{e.high:.3f}; from {rows} rows)"
         )
-        if test is not None:
-            t = test.iloc[i]
+        t = r.train
+        lines.append(
+            f"    train:    precision {t.precision:.3f}  recall {t.recall:.3f}  support {t.support}"
+        )
+        if r.test is not None:
+            t = r.test
             lines.append(
-                f"    held-out: precision {t['precision']:.3f}  recall {t['recall']:.3f}  "
-                f"support {int(t['support'])}"
+                f"    held-out: precision {t.precision:.3f}  recall {t.recall:.3f}  "
+                f"support {t.support}"
             )
-    if len(rules) < miner.n_rules:
-        lines.append(f"(only {len(rules)} of the {miner.n_rules} requested rules survived)")
+    if len(miner.rules_) < miner.n_rules:
+        lines.append(f"(only {len(miner.rules_)} of the {miner.n_rules} requested rules survived)")
     return "\n".join(lines)
 
 
-def mining_summary(mined, source: str) -> str:
+def mining_summary(mined, source: str, columns: Mapping | None = None) -> str:
     """What ``holofold mine`` prints: the table, target, features, split and the rules.
 
-    ``mined``: a :class:`~holofold.design.mining.MinedRules`; ``source``: the table's name.
+    ``mined``: a :class:`~holofold.design.mining.MinedRules`; ``source``: the table's name;
+    ``columns``: name -> Column for display units (:func:`rules_to_text`).
     """
     m, h = mined.miner, mined.holdout
     y = mined.meets
@@ -136,7 +126,7 @@ def mining_summary(mined, source: str) -> str:
             + (", ".join(free) if free else "(it depends on every feature)")
             + " (held-out permutation test of the forest, 5 %)"
         )
-    lines.append(rules_to_text(m, mined.test_scores))
+    lines.append(rules_to_text(m, mined.test_scores, columns=columns))
     return "\n".join(lines)
 
 
@@ -157,14 +147,22 @@ def _frame(X, names) -> pd.DataFrame:
     return X if isinstance(X, pd.DataFrame) else pd.DataFrame(np.asarray(X), columns=names)
 
 
+def _scale(columns: Mapping | None, name: str) -> tuple[float, str]:
+    """(display factor, display unit) of a column, (1, "") without one."""
+    c = (columns or {}).get(name)
+    if c is None:
+        return 1.0, ""
+    unit = c.display_unit
+    return c.display_factor, "" if unit in ("", "-") else unit
+
+
 def plot_rule_boxes(
     miner: ForestRuleMiner,
     X,
     rule: int = 0,
     *,
     ax=None,
-    scale: dict | None = None,
-    units: dict | None = None,
+    columns: Mapping | None = None,
 ):
     """Box chart of one rule (Fig. 2F): per feature its full data range, the rule range shaded.
 
@@ -175,6 +173,8 @@ def plot_rule_boxes(
         Data giving each feature's full range (e.g. the whole database).
     rule : int, default=0
     ax : matplotlib Axes, optional
+    columns : mapping, optional
+        Name -> Column: ranges and thresholds are labelled in each column's display unit.
 
     Returns
     -------
@@ -183,8 +183,6 @@ def plot_rule_boxes(
     plt = _pyplot()
     names = miner.feature_names_
     df = _frame(X, names)
-    scale = scale or {}
-    units = units or {}
     bounds = miner.rule_bounds(rule)
     if ax is None:
         fig, ax = plt.subplots(figsize=(6, 0.5 + 0.45 * len(names)))
@@ -193,7 +191,6 @@ def plot_rule_boxes(
     for k, (name, b) in enumerate(zip(names, bounds, strict=True)):
         yk = len(names) - 1 - k
         ax.barh(yk, 1.0, left=0.0, height=0.5, color="0.88", edgecolor="0.5")
-        s = scale.get(name, 1.0)
         if miner._encoding.categorical[k]:
             lv = miner._encoding.levels[k]
             allowed = set(lv.tolist()) if b is None else set(b)
@@ -204,29 +201,31 @@ def plot_rule_boxes(
                 label = str(level_value(v))
                 ax.text((i + 0.5) * w, yk, label, ha="center", va="center", fontsize=7)
             continue
+        s, u = _scale(columns, name)
         col = df[name].to_numpy(dtype=float)
         lo, hi = float(np.min(col)), float(np.max(col))
         span = hi - lo if hi > lo else 1.0
         a = 0.0 if not math.isfinite(b[0]) else np.clip((b[0] - lo) / span, 0, 1)
         c = 1.0 if not math.isfinite(b[1]) else np.clip((b[1] - lo) / span, 0, 1)
         ax.barh(yk, c - a, left=a, height=0.5, color="tab:blue", alpha=0.7)
-        u = units.get(name, "")
-        # the rule's thresholds, in the feature's unit, on the shaded bar
+        # the rule's thresholds, in the feature's display unit, on the shaded bar
         if b is not None and math.isfinite(b[0]):
-            ax.text(a, yk + 0.3, f"> {b[0] * s:.4g}", ha="left", va="bottom", fontsize=6.5,
-                    color="tab:blue")  # fmt: skip
+            ax.text(a, yk + 0.3, f"> {format_value(b[0] * s)}", ha="left", va="bottom",
+                    fontsize=6.5, color="tab:blue")  # fmt: skip
         if b is not None and math.isfinite(b[1]):
-            ax.text(c, yk + 0.3, f"<= {b[1] * s:.4g}", ha="right", va="bottom", fontsize=6.5,
-                    color="tab:blue")  # fmt: skip
-        ax.text(-0.02, yk, f"{lo * s:.3g}", ha="right", va="center", fontsize=7)
-        ax.text(1.02, yk, f"{hi * s:.3g} {u}".rstrip(), ha="left", va="center", fontsize=7)
+            ax.text(c, yk + 0.3, f"<= {format_value(b[1] * s)}", ha="right", va="bottom",
+                    fontsize=6.5, color="tab:blue")  # fmt: skip
+        ax.text(-0.02, yk, format_value(lo * s), ha="right", va="center", fontsize=7)
+        ax.text(1.02, yk, f"{format_value(hi * s)} {u}".rstrip(), ha="left", va="center",
+                fontsize=7)  # fmt: skip
     ax.set_yticks(range(len(names)))
     ax.set_yticklabels(list(reversed(names)))
     ax.set_xlim(-0.25, 1.3)
     ax.set_xticks([])
     row = miner.rules_.iloc[rule]
     ax.set_title(
-        f"rule {rule + 1}: precision {row['precision']:.2f}, support {int(row['support'])}",
+        f"rule {rule + 1}: training precision {row['precision']:.2f}, "
+        f"support {int(row['support'])}",
         fontsize=9,
     )
     return fig
@@ -265,7 +264,7 @@ def plot_rules(miner: ForestRuleMiner, X, path=None, **kw):
 
 
 def plot_rule_scatter(
-    miner: ForestRuleMiner, X, y, features, rule: int = 0, *, ax=None, scale=None
+    miner: ForestRuleMiner, X, y, features, rule: int = 0, *, ax=None, columns=None
 ):
     """Scatter of two features (Fig. 3E): target rows vs others, rows inside the rule marked.
 
@@ -275,6 +274,8 @@ def plot_rule_scatter(
     X : DataFrame or array, y : array of labels
     features : (str, str)
     rule : int, default=0
+    columns : mapping, optional
+        Name -> Column: axes in each column's display unit.
 
     Returns
     -------
@@ -287,11 +288,11 @@ def plot_rule_scatter(
         if f not in names:
             raise ValueError(f"feature {f!r} is not one of {', '.join(names)}")
     df = _frame(X, names)
-    scale = scale or {}
+    (sx, ux), (sy, uy) = _scale(columns, fx), _scale(columns, fy)
     pos = np.asarray(y) == miner.classes_[1]
     inside = miner.rule_matches(df)[rule]
-    xs = df[fx].to_numpy(dtype=float) * scale.get(fx, 1.0)
-    ys = df[fy].to_numpy(dtype=float) * scale.get(fy, 1.0)
+    xs = df[fx].to_numpy(dtype=float) * sx
+    ys = df[fy].to_numpy(dtype=float) * sy
     if ax is None:
         fig, ax = plt.subplots(figsize=(5, 4))
     else:
@@ -313,9 +314,9 @@ def plot_rule_scatter(
             continue
         for v in b:
             if math.isfinite(v):
-                setter(v * scale.get(f, 1.0), color="tab:blue", ls="--", lw=1)
-    ax.set_xlabel(fx)
-    ax.set_ylabel(fy)
+                setter(v * _scale(columns, f)[0], color="tab:blue", ls="--", lw=1)
+    ax.set_xlabel(f"{fx} [{ux}]" if ux else fx)
+    ax.set_ylabel(f"{fy} [{uy}]" if uy else fy)
     ax.legend(fontsize=7, loc="best")
     return fig
 
@@ -384,6 +385,7 @@ def plot_target_scatter(
     *,
     chosen: Mapping | None = None,
     units: Mapping | None = None,
+    columns: Mapping | None = None,
     ax=None,
 ):
     """Scatter of a database in the (x, y) plane: rows meeting the target coloured, others grey.
@@ -401,6 +403,9 @@ def plot_target_scatter(
         The chosen design (values of at least ``x`` and ``y``), drawn as a large star.
     units : mapping, optional
         Unit per column for the axis labels, e.g. ``{"offset": "m"}``.
+    columns : mapping, optional
+        Name -> Column: the axes (and thresholds, chosen design) in each column's display unit
+        and labelled with it (instead of ``units``).
     ax : matplotlib Axes, optional
 
     Returns
@@ -416,10 +421,13 @@ def plot_target_scatter(
     for c in (x, y):
         if c not in table.columns:
             raise ValueError(f"column {c!r} is not in the table ({', '.join(map(str, table))})")
-    units = units or {}
+    units = dict(units or {})
+    (sx, ux), (sy, uy) = _scale(columns, x), _scale(columns, y)
+    if columns:
+        units.update({x: ux, y: uy})
     meets = target.evaluate(table)
-    xs = table[x].to_numpy(dtype=float)
-    ys = table[y].to_numpy(dtype=float)
+    xs = table[x].to_numpy(dtype=float) * sx
+    ys = table[y].to_numpy(dtype=float) * sy
     ok = np.isfinite(xs) & np.isfinite(ys)
     hit, miss = ok & meets, ok & ~meets
     if ax is None:
@@ -430,8 +438,8 @@ def plot_target_scatter(
     ax.scatter(xs[hit], ys[hit], s=14, c="tab:red", lw=0, label=f"meets the target ({hit.sum()})")
     if chosen is not None:
         ax.scatter(
-            [float(chosen[x])],
-            [float(chosen[y])],
+            [float(chosen[x]) * sx],
+            [float(chosen[y]) * sy],
             s=260,
             marker="*",
             c="gold",
@@ -442,9 +450,9 @@ def plot_target_scatter(
         )
     for col, value in _target_thresholds(target):
         if col == x:
-            ax.axvline(value, color="tab:red", ls="--", lw=1)
+            ax.axvline(value * sx, color="tab:red", ls="--", lw=1)
         if col == y:
-            ax.axhline(value, color="tab:red", ls="--", lw=1)
+            ax.axhline(value * sy, color="tab:red", ls="--", lw=1)
     for values, set_scale in ((xs[ok], ax.set_xscale), (ys[ok], ax.set_yscale)):
         if values.size and values.min() > 0 and values.max() / values.min() > 100:
             set_scale("log")

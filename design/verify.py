@@ -19,6 +19,7 @@ import pandas as pd
 
 from holofold.design.row_limits import check_on_invalid, resolve_row_timeout
 from holofold.design.row_status import failed_rows
+from holofold.design.rules.record import Rule
 from holofold.design.runner import dask_scheduler, evaluate_designs
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
@@ -27,6 +28,7 @@ from holofold.design.targets import parse_target
 from holofold.geometry.outputs import write_json
 
 __all__ = [
+    "as_rule",
     "rule_ranges",
     "rule_mask",
     "verify_rule",
@@ -36,24 +38,34 @@ __all__ = [
 ]
 
 
-def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
-    """Sampling ranges of the box ``bounds`` (the ``bounds`` of a mined rule's JSON record).
+def as_rule(rule: Rule | Mapping) -> Rule:
+    """``rule`` as a :class:`Rule`: a Rule as it is; a rule record (with ``bounds``) or a mapping
+    feature -> bound, checked once (:meth:`Rule.from_json`); a ValueError names the problem."""
+    if isinstance(rule, Rule):
+        return rule
+    if isinstance(rule, Mapping) and "bounds" in rule:
+        return Rule.from_json(rule)
+    return Rule.from_bounds(rule)
 
-    Continuous features: ``{"gt": a, "le": b}`` (null for an open side) intersected with the
-    scenario's range; categorical: ``{"in": [levels]}``.
+
+def rule_ranges(scenario: Scenario, rule: Rule | Mapping) -> dict:
+    """Sampling ranges of a rule's box (a :class:`Rule`, or its ``bounds`` mapping).
+
+    Continuous features: the interval ``(gt, le]`` intersected with the scenario's range;
+    categorical: the allowed levels (an interval over a categorical feature: the levels in it).
     """
+    rule = as_rule(rule)
     cols = {c.name: c for c in scenario.features}
     out: dict = {}
-    if not isinstance(bounds, Mapping):
-        raise ValueError(f"a rule's bounds must be a mapping feature -> box, got {bounds!r:.60}")
-    for name, b in bounds.items():
+    for cond in rule.conditions:
+        name = cond.feature
         if name not in cols:
             raise ValueError(f"rule constrains {name!r}, which is not a feature of {scenario.name}")
         c = cols[name]
-        levels, lo, hi = _check_bound(name, b)
-        if levels is not None:
-            out[name] = levels
+        if cond.levels is not None:
+            out[name] = list(cond.levels)
             continue
+        lo, hi = cond.gt, cond.le
         if c.choices:  # an interval over a categorical feature: the levels inside it
             inside = [v for v in c.choices if (lo is None or v > lo) and (hi is None or v <= hi)]
             if not inside:
@@ -64,49 +76,16 @@ def rule_ranges(scenario: Scenario, bounds: Mapping[str, Mapping]) -> dict:
         hi = c.high if hi is None else min(hi, c.high)
         if not lo <= hi:
             raise ValueError(
-                f"rule range of {name} ({b.get('gt')}, {b.get('le')}] lies outside the "
+                f"rule range of {name} ({cond.gt}, {cond.le}] lies outside the "
                 f"scenario's range [{c.low}, {c.high}]"
             )
         out[name] = (lo, hi)
     return out
 
 
-def _number(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and not math.isnan(v)
-
-
-def _check_bound(name: str, b) -> tuple[list | None, float | None, float | None]:
-    """(levels, low, high) of one feature's box; one clear line for a malformed one."""
-    shape = '{"gt": number or null, "le": number or null} or {"in": [numbers]}'
-    if not isinstance(b, Mapping) or not b or set(b) - {"gt", "le", "in"}:
-        raise ValueError(f"bounds of {name} = {b!r:.60} must be {shape}")
-    if "in" in b:
-        v = b["in"]
-        if set(b) != {"in"} or not isinstance(v, list) or not v or not all(map(_number, v)):
-            raise ValueError(f"bounds of {name}: 'in' = {v!r:.60} must be a list of numbers")
-        return [float(x) for x in v], None, None
-    lo, hi = b.get("gt"), b.get("le")
-    for key, v in (("gt", lo), ("le", hi)):
-        if v is not None and not _number(v):
-            raise ValueError(f"bounds of {name}: {key!r} = {v!r:.60} must be a number or null")
-    lo = None if lo is None or lo == -math.inf else float(lo)
-    hi = None if hi is None or hi == math.inf else float(hi)
-    return None, lo, hi
-
-
-def rule_mask(table: pd.DataFrame, bounds: Mapping[str, Mapping]) -> np.ndarray:
-    """(n,) bool: the rows of ``table`` inside the box ``bounds`` (a rule record's)."""
-    inside = np.ones(len(table), bool)
-    for name, b in bounds.items():
-        col = table[name].to_numpy(dtype=float)
-        if "in" in b:
-            inside &= np.isin(col, np.asarray(b["in"], dtype=float))
-            continue
-        if b.get("gt") is not None:
-            inside &= col > float(b["gt"])
-        if b.get("le") is not None:
-            inside &= col <= float(b["le"])
-    return inside
+def rule_mask(table: pd.DataFrame, rule: Rule | Mapping) -> np.ndarray:
+    """(n,) bool: the rows of ``table`` inside ``rule`` (:meth:`Rule.mask`)."""
+    return as_rule(rule).mask(table)
 
 
 @dataclass(frozen=True)
@@ -174,7 +153,7 @@ class Verification:
 
 def verify_rule(
     scenario: Scenario | str,
-    bounds: Mapping[str, Mapping],
+    rule: Rule | Mapping,
     target: str,
     n: int = 50,
     *,
@@ -185,7 +164,7 @@ def verify_rule(
     on_invalid: str = "skip",
     row_timeout: float | str | None = None,
 ) -> Verification:
-    """Simulate ``n`` fresh designs inside a rule and count those meeting ``target``.
+    """Simulate ``n`` fresh designs inside ``rule`` and count those meeting ``target``.
 
     ``workers``, ``progress``, ``scheduler`` (a Dask scheduler address or ``"local"``),
     ``on_invalid`` and ``row_timeout`` are passed to
@@ -196,7 +175,7 @@ def verify_rule(
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     tgt = parse_target(target, scenario.performance_names)
-    designs = sample_designs(scenario, n, seed=seed, ranges=rule_ranges(scenario, bounds))
+    designs = sample_designs(scenario, n, seed=seed, ranges=rule_ranges(scenario, rule))
     res = evaluate_designs(
         scenario, designs, workers=workers, progress=progress, scheduler=scheduler,
         on_invalid=on_invalid, row_timeout=row_timeout,
@@ -206,7 +185,7 @@ def verify_rule(
 
 def verify_rules(
     scenario: Scenario | str,
-    rules: Sequence[Mapping],
+    rules: Sequence[Rule | Mapping],
     target: str,
     n: int = 50,
     *,
@@ -217,7 +196,7 @@ def verify_rules(
     on_invalid: str = "skip",
     row_timeout: float | str | None = None,
 ) -> list[Verification]:
-    """:func:`verify_rule` for each rule record (``bounds`` as in a rules file), in order.
+    """:func:`verify_rule` for each rule (a :class:`Rule` or its record), in order.
 
     Every rule is checked against the scenario before anything is simulated; rule ``i``
     (1-based) samples with seed ``seed + i``. A local Dask cluster (``scheduler="local"``) is
@@ -230,14 +209,15 @@ def verify_rules(
     resolve_row_timeout(scenario.row_timeout, row_timeout)
     if int(n) < 1:
         raise ValueError(f"n = {n} designs per rule must be >= 1")
+    rules = [as_rule(r) for r in rules]
     for r in rules:
-        rule_ranges(scenario, r["bounds"])
+        rule_ranges(scenario, r)
     cluster = dask_scheduler(scheduler, workers) if scheduler else nullcontext()
     with cluster as address:
         return [
             verify_rule(
                 scenario,
-                r["bounds"],
+                r,
                 target,
                 n,
                 seed=seed + i,
@@ -251,14 +231,17 @@ def verify_rules(
         ]
 
 
-def write_verification(folder, rules: Sequence[Mapping], results: Sequence[Verification]):
-    """``verify.json`` (one record per rule: rank, rule, bounds and the summary) and
-    ``verify_rule{i}.csv`` (the simulated designs) in ``folder``; returns the records."""
+def write_verification(folder, rules: Sequence[Rule | Mapping], results: Sequence[Verification],
+                       columns: Mapping | None = None):  # fmt: skip
+    """``verify.json`` (one record per rule: its JSON form, :meth:`Rule.to_json` with ``columns``
+    for display units, and the summary) and ``verify_rule{i}.csv`` (the simulated designs) in
+    ``folder``; returns the records."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     report = []
     for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
-        report.append({"rank": i, "rule": r.get("rule"), "bounds": r["bounds"], **v.summary()})
+        rec = as_rule(r).with_rank(i).to_json(columns)
+        report.append({k: rec[k] for k in ("rank", "rule", "bounds", "display")} | v.summary())
         write_table(v.designs, folder / f"verify_rule{i}.csv")
     write_json(folder / "verify.json", report)
     return report

@@ -35,8 +35,8 @@ from holofold.design import (
     column_roles,
     generate_database,
     mine_rules,
+    mined_rules,
     parse_target,
-    rules_to_records,
     strip_scenario,
     verify_rules,
 )
@@ -88,13 +88,14 @@ def main(folder="my-arch", samples=400, verify=30, workers=2) -> dict:
 
     roles = column_roles(db.columns, out / "database" / "database.parquet")
     mined = mine_rules(db, target, roles=roles, seed=0, max_overlap=0.5)
-    rules = rules_to_records(mined.miner, mined.test_scores)
+    rules = mined_rules(mined.miner, mined.test_scores)  # Rule records, best first
     if not rules:
         raise SystemExit(f"no rule found for {TARGET}; try more samples")
 
     checks = verify_rules(scenario, rules, TARGET, verify, seed=1, workers=workers)
+    cols = scenario.columns  # units, and the units people read (mm, deg)
     for r, v in zip(rules, checks, strict=True):
-        print(f"rule {r['rank']}: {r['rule']}\n  test precision {r['test']['precision']:.2f}, "
+        print(f"rule {r.rank}: {r.text(cols)}\n  test precision {r.test.precision:.2f}, "
               f"{v.describe()}")  # fmt: skip
     best = max(range(len(rules)), key=lambda i: (checks[i].precision, checks[i].interval[0]))
 
@@ -102,15 +103,16 @@ def main(folder="my-arch", samples=400, verify=30, workers=2) -> dict:
     import pandas as pd
 
     table = pd.concat([db, *(v.designs for v in checks)], ignore_index=True)
-    label, margins, how = choose_design(table, target, rules[best]["bounds"])
+    label, margins, how = choose_design(table, target, rules[best])
     design = {c: float(table.loc[label, c]) for c in scenario.feature_names}
     performance = {c: float(table.loc[label, c]) for c in scenario.performance_names}
-    print(f"chosen {how}: " + ", ".join(f"{k} = {v:.4g}" for k, v in design.items()))
-    print("  " + ", ".join(f"{k} = {v:.4g}" for k, v in performance.items()))
+    print(f"chosen {how}: " + ", ".join(f"{k} = {cols[k].format(v)}" for k, v in design.items()))
+    print("  " + ", ".join(f"{k} = {cols[k].format(v)}" for k, v in performance.items()))
     print("  margins: " + ", ".join(f"{k}: {v:+.2f}" for k, v in margins.items()))
 
     files = scenario.write_files(design, out / "files")
-    summary = {"features": design, "performance": performance, "rule": rules[best],
+    summary = {"features": design, "performance": performance,
+               "rule": rules[best].to_json(cols),
                "verified_precision": checks[best].precision, "margins": margins,
                "scenario": scenario.name, "files": files.record(out)}  # fmt: skip
     write_json(out / "design.json", summary)

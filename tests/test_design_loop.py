@@ -311,13 +311,14 @@ def test_a_rare_target_is_refined_around_its_hits_before_any_rule_exists(tmp_pat
 
 
 def test_the_rule_box_chart_shows_the_rules_thresholds():
-    from holofold.design import ForestRuleMiner, plot_rule_boxes
+    from holofold.design import Column, ForestRuleMiner, plot_rule_boxes
 
     rng = np.random.default_rng(0)
     X = pd.DataFrame({"a": rng.uniform(0, 1, 400), "b": rng.uniform(0, 1, 400)})
     y = (X["a"] > 0.6).to_numpy()
     miner = ForestRuleMiner(n_estimators=20, random_state=0).fit(X, y)
-    fig = plot_rule_boxes(miner, X, 0, units={"a": "m", "b": "m"})
+    mm = {n: Column(n, "m", display="mm") for n in "ab"}
+    fig = plot_rule_boxes(miner, X, 0, columns=mm)
     texts = [t.get_text() for t in fig.axes[0].texts]
-    lo = miner.rule_bounds(0)[0][0]
-    assert f"> {lo:.4g}" in texts and any(t.endswith(" m") for t in texts)
+    lo = miner.rule_bounds(0)[0][0]  # in m: shown in mm, 3 digits
+    assert f"> {float(f'{lo * 1e3:.3g}'):g}" in texts and any(t.endswith(" mm") for t in texts)

@@ -20,6 +20,7 @@ from holofold.design.report import (
 )
 from holofold.design.report_page import report_page_html, write_report_page
 from holofold.design.rules import ForestRuleMiner
+from holofold.design.scenarios import Column
 from holofold.design.targets import parse_target
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -460,7 +461,8 @@ def _real_pictures(folder):
     y = parse_target("offset < 0.2 & m >= 12", X.columns).evaluate(X)
     miner = ForestRuleMiner(n_estimators=10, min_support=5, random_state=0)
     miner.fit(X, y)
-    save_figure(plot_rule_boxes(miner, X, 0, units={"offset": "m"}), folder / "rule.png")
+    offset = {"offset": Column("offset", "m", display="m")}
+    save_figure(plot_rule_boxes(miner, X, 0, columns=offset), folder / "rule.png")
 
 
 @pytest.mark.slow

@@ -26,6 +26,7 @@ from holofold.design.report import (
 )
 from holofold.design.rulefile import rules_to_json
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.scenarios import Column
 from holofold.design.tables import PUBLISHED, column_roles, read_table
 from holofold.design.targets import parse_target
 
@@ -166,7 +167,8 @@ def test_reports_and_plots(data3, tmp_path):
     )
     m = res.miner
     test = rule_scores(m, X.iloc[res.test_index], y[res.test_index])
-    text = rules_to_text(m, test, scale={"tcrease": 1e3}, units={"tcrease": "mm"})
+    mm = {n: Column(n, "m", display="mm") for n in D3_FEATURES if n != "m"}
+    text = rules_to_text(m, test, columns=mm)
     assert text.count("rule ") == len(m.rules_) and "held-out: precision" in text
     assert text.count("estimate: precision") == len(m.rules_)
     assert " mm" in text and "m >= 0.5" not in text

@@ -9,14 +9,9 @@ import pytest
 
 from holofold.design.evaluation import feature_dependence, holdout, rule_scores
 from holofold.design.mining import mine_rules
-from holofold.design.rules import (
-    SELECTION_PARAMS,
-    FewRulesWarning,
-    ForestRuleMiner,
-    _drop_idle_conditions,
-    _posterior,
-    boxes_contain,
-)
+from holofold.design.rules import SELECTION_PARAMS, FewRulesWarning, ForestRuleMiner, boxes_contain
+from holofold.design.rules.boxes import drop_idle_conditions
+from holofold.design.rules.statistics import posterior
 
 
 def _noisy(n, seed):
@@ -48,10 +43,10 @@ def test_estimate_predicts_precision_on_fresh_rows_where_training_precision_does
 
 
 def test_posterior_and_rule_estimates_with_held_out_rows():
-    mean, lo, hi, lcb = _posterior(np.array([8.0]), np.array([10.0]), 0.5, 4.0)
+    mean, lo, hi, lcb = posterior(np.array([8.0]), np.array([10.0]), 0.5, 4.0)
     assert mean[0] == pytest.approx((8 + 2) / (10 + 4))
     assert lo[0] < lcb[0] < mean[0] < hi[0]
-    mean0, lo0, hi0, _ = _posterior(np.array([0.0]), np.array([0.0]), 0.7, 0.0)
+    mean0, lo0, hi0, _ = posterior(np.array([0.0]), np.array([0.0]), 0.7, 0.0)
     assert mean0[0] == 0.7 and lo0[0] < 0.05 and hi0[0] > 0.95  # no rows: Jeffreys interval
     X, y = _noisy(800, 1)
     m = ForestRuleMiner(n_estimators=30, random_state=0).fit(X, y)
@@ -127,7 +122,7 @@ def test_a_condition_no_row_depends_on_is_dropped():
     Z[Z[:, 0] <= 0.3, 1] *= 0.5
     lower = np.array([[-np.inf, 0.1]])
     upper = np.array([[0.3, 0.8]])
-    lo, up = _drop_idle_conditions(lower, upper, Z)
+    lo, up = drop_idle_conditions(lower, upper, Z)
     np.testing.assert_array_equal(lo, [[-np.inf, 0.1]])
     np.testing.assert_array_equal(up, [[0.3, np.inf]])
     np.testing.assert_array_equal(boxes_contain(lo, up, Z), boxes_contain(lower, upper, Z))

@@ -79,9 +79,9 @@ def test_verify_rules_checks_every_rule_first_and_writes_strict_json(tmp_path):
 
 @pytest.mark.parametrize(
     "bounds, match",
-    [([1, 2], "must be a mapping"), ({"offset": [0.1, 0.2]}, "bounds of offset"),
-     ({"offset": None}, "bounds of offset"), ({"offset": "wide"}, "bounds of offset"),
-     ({"m": {"in": 8}}, "'in' = 8 must be a list"), ({"m": {"in": ["8"]}}, "list of numbers"),
+    [([1, 2], "must be a mapping"), ({"offset": [0.1, 0.2]}, "bounds of 'offset'"),
+     ({"offset": None}, "bounds of 'offset'"), ({"offset": "wide"}, "bounds of 'offset'"),
+     ({"m": {"in": 8}}, "'m': levels must be a list"), ({"m": {"in": ["8"]}}, "finite numbers"),
      ({"offset": {"gt": "0.1"}}, "'gt' = '0.1' must be a number"),
      ({"offset": {"le": True}}, "must be a number"), ({"offset": {"gt": 0.1, "lt": 1}}, "must be")],
 )  # fmt: skip

@@ -259,6 +259,11 @@ class Scenario:
         return self.evaluate.args[0]
 
     @property
+    def columns(self) -> dict[str, Column]:
+        """name -> :class:`Column` of every feature and performance column (units, display)."""
+        return {c.name: c for c in (*self.features, *self.performance)}
+
+    @property
     def feature_names(self) -> list[str]:
         return [c.name for c in self.features]
 

@@ -145,11 +145,12 @@ def run(args) -> int:
         FewRulesWarning,
         column_roles,
         mine_rules,
+        mined_rules,
         mining_summary,
         plot_rules,
         read_table,
-        rules_to_records,
         save_figure,
+        table_columns,
         write_rules,
     )
     from holofold.geometry import check_output_path
@@ -181,11 +182,12 @@ def run(args) -> int:
             )
         except ValueError as exc:
             raise _in_option_terms(exc) from None
-    print(mining_summary(mined, args.database))
+    columns = table_columns(table.columns, args.database)  # display units (mm, um, deg)
+    print(mining_summary(mined, args.database, columns))
     # the figure is drawn before any file is written: a failing plot leaves no JSON behind
-    fig = plot_path and plot_rules(mined.miner, mined.table[list(mined.features)])
+    fig = plot_path and plot_rules(mined.miner, mined.table[list(mined.features)], columns=columns)
     if json_path:
-        write_rules(json_path, rules_to_records(mined.miner, mined.test_scores))
+        write_rules(json_path, mined_rules(mined.miner, mined.test_scores), columns)
         print(f"wrote {json_path}")
     if plot_path:
         save_figure(fig, plot_path)

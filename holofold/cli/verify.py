@@ -42,7 +42,7 @@ def register(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     import json
 
-    from holofold.design import read_rules, verify_rules, write_verification
+    from holofold.design import load_scenario, read_rules, verify_rules, write_verification
 
     workers, scheduler = parallel_settings(args)
     on_invalid, row_timeout = row_settings(args)
@@ -55,39 +55,34 @@ def run(args) -> int:
             raise ValueError(f"--output {args.output!r} exists and is not a folder")
         check_output_folder(args.output, "--output")
     rules = read_rules(args.rules)[: args.top]
+    scenario = load_scenario(args.scenario)
     results = verify_rules(
-        args.scenario, rules, args.target, args.samples,
+        scenario, rules, args.target, args.samples,
         seed=args.seed, workers=workers, scheduler=scheduler,
         on_invalid=on_invalid, row_timeout=row_timeout,
     )  # fmt: skip
     for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
-        print(f"rule {i}: {r['rule']}\n  {v.describe()}")
+        print(f"rule {i}: {r.text(scenario.columns)}\n  {v.describe()}")
         shown = _shown(r)
         if shown:
             print(f"  {shown}")
     if args.output is not None:
-        write_verification(args.output, rules, results)
+        write_verification(args.output, rules, results, scenario.columns)
     print(json.dumps([{"rank": i, **{k: v.summary()[k] for k in ("precision", "simulated")}}
                       for i, v in enumerate(results, start=1)]))  # fmt: skip
     return 0
 
 
-def _number(x) -> bool:
-    return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)
-
-
-def _shown(rec: dict) -> str:
+def _shown(rule) -> str:
     """What `holofold mine` said of the rule (its estimate and held-out precision), if the
     rules file carries it: '' otherwise."""
     parts = []
-    est = rec.get("estimate")
-    if isinstance(est, dict) and _number(est.get("precision")):
-        text = f"estimate {est['precision']:.3f}"
-        ci = est.get("interval")
-        if isinstance(ci, list) and len(ci) == 2 and all(_number(c) for c in ci):
-            text += f" (95 % interval {ci[0]:.3f}-{ci[1]:.3f})"
+    e = rule.estimate
+    if e is not None:
+        text = f"estimate {e.precision:.3f}"
+        if math.isfinite(e.low) and math.isfinite(e.high):
+            text += f" (95 % interval {e.low:.3f}-{e.high:.3f})"
         parts.append(text)
-    test = rec.get("test")
-    if isinstance(test, dict) and _number(test.get("precision")):
-        parts.append(f"held-out precision {test['precision']:.3f}")
+    if rule.test is not None:
+        parts.append(f"held-out precision {rule.test.precision:.3f}")
     return "mined with: " + ", ".join(parts) if parts else ""

@@ -1,35 +1,10 @@
-"""Random-forest rule mining: human-readable design rules from a performance database.
-
-The method of Zhu & Filipov (2022), done exactly and fast:
-
-1. train a forest of decision trees (entropy, balanced classes, deep, lightly pruned), each on a
-   random subset of the training rows drawn *without* replacement;
-2. every leaf that predicts the target class is a candidate rule: an axis-aligned box with
-   scikit-learn's own semantics (``x <= t`` left, ``x > t`` right, X compared as float32), the
-   tightest bound per feature and side, any real threshold (0 included);
-3. identical boxes found by several trees are merged;
-4. each rule is scored on the training rows (precision, recall, support) -- or, optionally, on
-   the out-of-bag rows of the trees that found it -- filtered by ``precision_min`` and
-   ``min_support`` and ranked by F-beta (or by F-beta of a lower confidence bound of precision);
-5. the best ``n_rules`` that are not near-copies of a better one are kept; ``predict`` is
-   "inside any kept rule".
-
-holofold adds, chosen on a suite of 45 targets (``benchmarks/bench_rule_suite.py``): each kept
-rule's numeric bounds move in to its outermost target training rows (``tighten``), conditions
-that change none of its rows are dropped (``simplify``), and every rule carries an *estimate*
-of its precision on new designs with a 95 % interval: the out-of-bag rows of the trees that
-found it, shrunk by an empirical-Bayes prior fitted to all candidate leaves.
-
-Extraction is one top-down pass over the concatenated node arrays of all trees (a loop over
-depth levels, vectorised over all nodes of the forest); scoring uses each tree's ``apply`` and a
-``bincount`` over all (row, tree) pairs, which is exact because a leaf's region *is* its box.
-"""
+"""The estimator: :class:`ForestRuleMiner`, a scikit-learn classifier whose model is a few
+human-readable rules (see the package docstring for the method)."""
 
 from __future__ import annotations
 
 import logging
 import warnings
-from dataclasses import dataclass
 from numbers import Integral, Real
 
 import numpy as np
@@ -42,23 +17,33 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-__all__ = [
-    "ForestRuleMiner",
-    "FewRulesWarning",
-    "ForestArrays",
-    "stack_trees",
-    "forest_boxes",
-    "boxes_contain",
-    "format_rule",
-    "level_value",
-]
+from holofold.design.rules.boxes import (
+    boxes_contain,
+    drop_idle_conditions,
+    simplify_boxes,
+    tighten,
+)
+from holofold.design.rules.encoding import Encoding
+from holofold.design.rules.forest import forest_boxes, stack_trees
+from holofold.design.rules.statistics import (
+    box_counts,
+    box_stats,
+    fbeta,
+    finder_matrix,
+    fit_prior,
+    posterior,
+    wilson_lower,
+)
+from holofold.design.rules.text import box_text
+
+__all__ = ["ForestRuleMiner", "FewRulesWarning", "SELECTION_PARAMS"]
 
 logger = logging.getLogger(__name__)
 
 _MAX_SEED = np.iinfo(np.int32).max
-_LCB_Z = 1.6448536269514722  # one-sided 95 % normal quantile for the Wilson bound
+LCB_Z = 1.6448536269514722  # one-sided 95 % normal quantile for the Wilson bound
 #: column order of the statistics in ``rules_``
-_STAT_ORDER = (
+STAT_ORDER = (
     "precision", "recall", "support", "true_positives", "estimate", "estimate_low",
     "estimate_high", "estimate_support", "estimate_true_positives", "f_score", "score",
     "n_trees", "oob_precision", "oob_support",
@@ -74,538 +59,7 @@ class FewRulesWarning(UserWarning):
     """Fewer rules than requested passed the precision and support filters."""
 
 
-# ---------------------------------------------------------------------------------------------
-# plain-array kernels
-# ---------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ForestArrays:
-    """The node arrays of several fitted trees concatenated into one forest-wide numbering.
-
-    Attributes
-    ----------
-    offsets : ndarray of int, shape (n_trees + 1,)
-        Node ``i`` of tree ``k`` has global id ``offsets[k] + i``.
-    left, right : ndarray of int, shape (n_nodes,)
-        Global ids of the children, -1 at leaves.
-    feature : ndarray of int, shape (n_nodes,)
-        Split feature (undefined at leaves).
-    threshold : ndarray of float64, shape (n_nodes,)
-        Split threshold: left child ``x <= t``, right child ``x > t``.
-    positive : ndarray of bool, shape (n_nodes,)
-        The node predicts the target class.
-    tree_of : ndarray of int, shape (n_nodes,)
-        The tree each node belongs to.
-    """
-
-    offsets: np.ndarray
-    left: np.ndarray
-    right: np.ndarray
-    feature: np.ndarray
-    threshold: np.ndarray
-    positive: np.ndarray
-    tree_of: np.ndarray
-
-    @property
-    def is_leaf(self) -> np.ndarray:
-        return self.left < 0
-
-
-def stack_trees(trees, positive_label=1) -> ForestArrays:
-    """Concatenate the node arrays of fitted ``DecisionTreeClassifier`` objects."""
-    sizes = np.array([t.tree_.node_count for t in trees], dtype=np.intp)
-    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.intp)
-    left, right, feat, thr, pos = [], [], [], [], []
-    for k, t in enumerate(trees):
-        tr = t.tree_
-        off = offsets[k]
-        cl = tr.children_left.astype(np.intp)
-        cr = tr.children_right.astype(np.intp)
-        left.append(np.where(cl >= 0, cl + off, -1))
-        right.append(np.where(cr >= 0, cr + off, -1))
-        feat.append(tr.feature.astype(np.intp))
-        thr.append(tr.threshold)
-        pred = np.asarray(t.classes_)[np.argmax(tr.value[:, 0, :], axis=1)]
-        pos.append(pred == positive_label)
-    tree_of = np.repeat(np.arange(len(trees)), sizes)
-    return ForestArrays(
-        offsets,
-        np.concatenate(left),
-        np.concatenate(right),
-        np.concatenate(feat),
-        np.concatenate(thr).astype(np.float64),
-        np.concatenate(pos),
-        tree_of,
-    )
-
-
-def forest_boxes(forest: ForestArrays, n_features: int) -> tuple[np.ndarray, np.ndarray]:
-    """Box of every node: the tightest bounds along its root path.
-
-    One top-down pass over depth levels, vectorised over all nodes of all trees.
-
-    Parameters
-    ----------
-    forest : ForestArrays
-    n_features : int
-
-    Returns
-    -------
-    lower, upper : ndarray of float64, shape (n_nodes, n_features)
-        A row ``x`` (as float32) lies in node ``i`` iff ``lower[i] < x <= upper[i]`` on every
-        feature; unbounded sides are ``-inf`` / ``+inf``.
-    """
-    n = forest.left.shape[0]
-    lower = np.full((n, n_features), -np.inf)
-    upper = np.full((n, n_features), np.inf)
-    frontier = forest.offsets[:-1]
-    frontier = frontier[frontier < n]
-    while frontier.size:
-        inner = frontier[forest.left[frontier] >= 0]
-        if not inner.size:
-            break
-        lc, rc = forest.left[inner], forest.right[inner]
-        f, t = forest.feature[inner], forest.threshold[inner]
-        lower[lc] = lower[inner]
-        upper[lc] = upper[inner]
-        lower[rc] = lower[inner]
-        upper[rc] = upper[inner]
-        upper[lc, f] = np.minimum(upper[lc, f], t)
-        lower[rc, f] = np.maximum(lower[rc, f], t)
-        frontier = np.concatenate([lc, rc])
-    return lower, upper
-
-
-def boxes_contain(lower: np.ndarray, upper: np.ndarray, Z: np.ndarray) -> np.ndarray:
-    """Which rows lie in which boxes, with scikit-learn's float32 semantics.
-
-    Parameters
-    ----------
-    lower, upper : ndarray, shape (n_boxes, n_features)
-    Z : ndarray, shape (n_rows, n_features)
-
-    Returns
-    -------
-    ndarray of bool, shape (n_boxes, n_rows)
-    """
-    Zf = np.asarray(Z, dtype=np.float32).astype(np.float64)
-    out = np.ones((lower.shape[0], Zf.shape[0]), dtype=bool)
-    for r in range(lower.shape[0]):  # a handful of kept rules; features vectorised
-        cols = np.flatnonzero(np.isfinite(lower[r]) | np.isfinite(upper[r]))
-        if cols.size:
-            sub = Zf[:, cols]
-            out[r] = np.all((sub > lower[r, cols]) & (sub <= upper[r, cols]), axis=1)
-    return out
-
-
-def _wilson_lower(tp: np.ndarray, n: np.ndarray, z: float = _LCB_Z) -> np.ndarray:
-    n = np.asarray(n, dtype=float)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        p = np.where(n > 0, tp / n, 0.0)
-        denom = 1 + z * z / n
-        centre = p + z * z / (2 * n)
-        half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
-        lcb = (centre - half) / denom
-    return np.where(n > 0, np.clip(lcb, 0.0, 1.0), 0.0)
-
-
-def _fbeta(precision, recall, beta):
-    b2 = beta * beta
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f = (1 + b2) * precision * recall / (b2 * precision + recall)
-    return np.nan_to_num(f, nan=0.0)
-
-
-_MAX_PRIOR = 20.0  # cap of the empirical-Bayes prior strength, in rows (chosen on the suite)
-
-
-def _prior(strength, tp: np.ndarray, n: np.ndarray, base_rate: float) -> tuple[float, float]:
-    """Mean and strength (in rows) of the Beta prior of a rule's precision.
-
-    A number shrinks toward the base rate with that strength, None not at all; ``"auto"``
-    fits a beta-binomial to the candidates' out-of-bag counts by moments (empirical Bayes):
-    the prior mean is their pooled precision and the strength follows from how much their
-    precisions vary beyond binomial noise, at most 20 rows: with few candidates the moments
-    often show no spread beyond noise, and an unbounded prior would then ignore the rule's own
-    rows (on the target suite, 20 gave the smallest error against verified precision).
-    """
-    if strength is None:
-        return base_rate, 0.0
-    if strength != "auto":
-        return base_rate, float(strength)
-    ok = n > 0
-    if np.count_nonzero(ok) < 3:
-        return base_rate, 0.0
-    tp, n = tp[ok], n[ok]
-    mu = float(tp.sum() / n.sum())
-    if not 0 < mu < 1:
-        return mu, 0.0
-    inv = float(np.mean(1.0 / n))
-    s2 = float(np.mean((tp / n - mu) ** 2))
-    tau2 = (s2 - mu * (1 - mu) * inv) / max(1 - inv, 1e-9)  # variance of the true precisions
-    if tau2 <= 0:
-        return mu, _MAX_PRIOR
-    return mu, float(np.clip(mu * (1 - mu) / tau2 - 1, 0.0, _MAX_PRIOR))
-
-
-def _posterior(tp, n, mu: float, k: float):
-    """Posterior mean, 95 % interval and one-sided 95 % lower bound of precision.
-
-    Prior Beta(k mu, k (1 - mu)) on ``tp`` of ``n`` rows; the interval and bound are quantiles
-    of the posterior with Jeffreys' half counts added (so k = 0 gives Jeffreys' interval).
-    """
-    from scipy.special import betaincinv
-
-    tp = np.asarray(tp, dtype=float)
-    n = np.asarray(n, dtype=float)
-    a = tp + k * mu
-    b = n - tp + k * (1 - mu)
-    mean = np.where(a + b > 0, a / np.maximum(a + b, 1e-300), mu)
-    lo = betaincinv(a + 0.5, b + 0.5, 0.025)
-    hi = betaincinv(a + 0.5, b + 0.5, 0.975)
-    lcb = betaincinv(a + 0.5, b + 0.5, 0.05)
-    return mean, lo, hi, lcb
-
-
-def _box_counts(pair_box, pair_row, pair_bag, y_pos, m: int, n: int) -> dict:
-    """Rows and target rows per box from its (row, tree) pairs.
-
-    ``support`` / ``true_positives``: distinct rows in the box; ``estimate_*``: distinct rows
-    out of bag for at least one tree that found it; ``bag_*``: distinct rows in bag for at
-    least one of them; ``oob_*``: out-of-bag pairs (a row once per such tree).
-    """
-    out = {}
-    for name, sel in (("", None), ("estimate_", ~pair_bag), ("bag_", pair_bag)):
-        b, r = (pair_box, pair_row) if sel is None else (pair_box[sel], pair_row[sel])
-        codes = np.unique(b * n + r)
-        out[f"{name}support" if name else "support"] = np.bincount(codes // n, minlength=m).astype(
-            float
-        )
-        out[f"{name}true_positives" if name else "true_positives"] = np.bincount(
-            codes // n, weights=y_pos[codes % n], minlength=m
-        )
-    oob = ~pair_bag
-    out["oob_support"] = np.bincount(pair_box[oob], minlength=m).astype(float)
-    out["oob_true_positives"] = np.bincount(
-        pair_box[oob], weights=y_pos[pair_row[oob]], minlength=m
-    )
-    return out
-
-
-def _finder_matrix(inverse, tree_of_cand, m: int, T: int) -> np.ndarray:
-    """(m, T) 0/1: which trees found each distinct box."""
-    out = np.zeros((m, T))
-    out[inverse, tree_of_cand] = 1.0
-    return out
-
-
-def _box_stats(lower, upper, Z32, y_pos, oob_weight, bag_rows) -> dict:
-    """Training statistics of boxes that are not leaves (simplified or tightened ones).
-
-    ``oob_weight`` (n_boxes, n): for each row, the trees that found the box's leaf and did not
-    train on it; ``bag_rows`` (n_boxes, n): rows one of them trained on.
-    """
-    inside = boxes_contain(lower, upper, Z32)
-    pos = y_pos == 1
-    in_oob = inside * oob_weight
-    est_rows = in_oob > 0
-    sup = inside.sum(axis=1).astype(float)
-    tp = (inside & pos).sum(axis=1).astype(float)
-    n_pos = max(int(pos.sum()), 1)
-    return {
-        "precision": np.where(sup > 0, tp / np.maximum(sup, 1), 0.0),
-        "recall": tp / n_pos,
-        "support": sup,
-        "true_positives": tp,
-        "oob_precision": (in_oob @ y_pos) / np.maximum(in_oob.sum(axis=1), 1),
-        "oob_support": in_oob.sum(axis=1),
-        "estimate_true_positives": (est_rows @ y_pos).astype(float),
-        "estimate_support": est_rows.sum(axis=1).astype(float),
-        "bag_true_positives": ((inside & bag_rows) @ y_pos).astype(float),
-        "bag_support": (inside & bag_rows).sum(axis=1).astype(float),
-    }
-
-
-def _tighten(lower, upper, Z32, y_pos, numeric):
-    """Move each finite numeric bound of each box inward to its outermost target training row.
-
-    A leaf's bound lies halfway between two values of the rows its tree trained on, so the
-    slab between it and the last target row inside holds no target row: a region where the rule
-    is a guess. Categorical columns (``numeric`` False) keep their bounds; so does a side that
-    is open (no new condition is added).
-    """
-    Zf = np.asarray(Z32, dtype=np.float32)
-    inside = boxes_contain(lower, upper, Z32) & (y_pos == 1)
-    lower, upper = lower.copy(), upper.copy()
-    for i in range(lower.shape[0]):
-        z = Zf[inside[i]]
-        if not z.shape[0]:
-            continue
-        for c in np.flatnonzero(np.isfinite(lower[i]) & numeric):
-            below = float(np.nextafter(z[:, c].min(), np.float32(-np.inf)))  # x > below: x >= min
-            lower[i, c] = max(lower[i, c], below)
-        for c in np.flatnonzero(np.isfinite(upper[i]) & numeric):
-            upper[i, c] = min(upper[i, c], float(z[:, c].max()))
-    return lower, upper
-
-
-def _conditions(lower: np.ndarray, upper: np.ndarray, Zf: np.ndarray):
-    """Conditions of one box as (column, side) and the (n, n_cond) matrix of rows violating each."""
-    conds = [(c, 0) for c in np.flatnonzero(np.isfinite(lower))]
-    conds += [(c, 1) for c in np.flatnonzero(np.isfinite(upper))]
-    viol = np.empty((Zf.shape[0], len(conds)), dtype=bool)
-    for j, (c, side) in enumerate(conds):
-        viol[:, j] = Zf[:, c] <= lower[c] if side == 0 else Zf[:, c] > upper[c]
-    return conds, viol
-
-
-def _open(lower, upper, i: int, cond) -> None:
-    c, side = cond
-    if side == 0:
-        lower[i, c] = -np.inf
-    else:
-        upper[i, c] = np.inf
-
-
-def _simplify(lower, upper, Z32, y_pos, weight, prior, precision_min):
-    """Drop conditions that do not raise the out-of-bag precision estimate.
-
-    Greedy: repeatedly drop the condition whose removal gives the highest estimate, as long as
-    that estimate is not below the current one and the box's training precision stays at
-    least ``precision_min``. ``weight[i]`` (n,) marks the rows out of bag for a tree that
-    found box ``i``; the estimate is the posterior mean under ``prior`` on those rows.
-    """
-    mu, k = prior
-    Zf = np.asarray(Z32, dtype=np.float32).astype(np.float64)
-    pos = y_pos == 1
-    lower, upper = lower.copy(), upper.copy()
-    for i in range(lower.shape[0]):
-        conds, viol = _conditions(lower[i], upper[i], Zf)
-        if not conds:
-            continue
-        oob = weight[i] > 0
-        active = np.ones(len(conds), dtype=bool)
-        while active.any():
-            act = np.flatnonzero(active)
-            nv = viol[:, act].sum(axis=1)
-            inside = nv == 0
-            r1 = np.flatnonzero(nv == 1)
-            which = act[np.argmax(viol[r1][:, act], axis=1)]  # each row's one violation
-
-            size = len(conds)
-
-            def added(w, which=which, r1=r1, size=size):
-                return np.bincount(which, weights=w[r1], minlength=size)
-
-            n_o, tp_o = np.count_nonzero(inside & oob), np.count_nonzero(inside & oob & pos)
-            n_t, tp_t = np.count_nonzero(inside), np.count_nonzero(inside & pos)
-            new_n_o, new_tp_o = n_o + added(oob * 1.0), tp_o + added((oob & pos) * 1.0)
-            new_prec = (tp_t + added(pos * 1.0)) / (n_t + added(np.ones(len(pos))))
-            with np.errstate(invalid="ignore", divide="ignore"):
-                cur = (tp_o + k * mu) / (n_o + k) if n_o + k > 0 else mu
-                new = np.where(new_n_o + k > 0, (new_tp_o + k * mu) / (new_n_o + k), mu)
-            ok = active & (new_prec >= precision_min) & (new >= cur - 1e-12)
-            if not ok.any():
-                break
-            j = int(np.argmax(np.where(ok, new, -np.inf)))
-            active[j] = False
-            _open(lower, upper, i, conds[j])
-    return lower, upper
-
-
-def _drop_idle_conditions(lower, upper, Z32):
-    """Drop the conditions of each box that no training row depends on.
-
-    A condition is idle when no row violates it alone: without it the box holds the same
-    rows. Conditions are tried in column order and dropped one at a time.
-    """
-    Zf = np.asarray(Z32, dtype=np.float32).astype(np.float64)
-    lower, upper = lower.copy(), upper.copy()
-    for i in range(lower.shape[0]):
-        conds, viol = _conditions(lower[i], upper[i], Zf)
-        active = np.ones(len(conds), dtype=bool)
-        for j in range(len(conds)):
-            others = active.copy()
-            others[j] = False
-            if not np.any(viol[:, j] & ~viol[:, others].any(axis=1)):
-                active[j] = False
-                _open(lower, upper, i, conds[j])
-    return lower, upper
-
-
-# ---------------------------------------------------------------------------------------------
-# categorical encoding
-# ---------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class _Encoding:
-    """How original features map to the encoded columns the trees see."""
-
-    names: tuple  # original feature names
-    categorical: tuple  # bool per original feature
-    levels: tuple  # per original feature: ndarray of levels or None
-    columns: tuple  # per encoded column: (original index, level index or -1)
-    mode: str  # "onehot" or "ordinal"
-
-    @property
-    def n_encoded(self) -> int:
-        return len(self.columns)
-
-    def encode(self, X) -> np.ndarray:
-        n = X.shape[0]
-        Z = np.empty((n, self.n_encoded), dtype=np.float64)
-        codes = {}
-        for j, is_cat in enumerate(self.categorical):
-            if not is_cat:
-                continue
-            lv = self.levels[j]
-            col = X[:, j]
-            idx = np.searchsorted(lv, col) if lv.dtype != object else None
-            if idx is None:
-                lookup = {v: i for i, v in enumerate(lv)}
-                bad = [v for v in col if v not in lookup]
-                idx = np.array([lookup.get(v, -1) for v in col], dtype=np.intp)
-            else:
-                idx = np.clip(idx, 0, len(lv) - 1)
-                badmask = lv[idx] != col
-                bad = list(col[badmask])
-            if len(bad):
-                raise ValueError(
-                    f"categorical feature {self.names[j]!r} has level {_fmt_level(bad[0])} not "
-                    f"seen in fit; known levels: {', '.join(_fmt_level(v) for v in lv)}"
-                )
-            codes[j] = idx
-        for c, (j, li) in enumerate(self.columns):
-            if not self.categorical[j]:
-                Z[:, c] = X[:, j]
-            elif self.mode == "ordinal":
-                Z[:, c] = codes[j]
-            else:
-                Z[:, c] = codes[j] == li
-        return Z
-
-    def allowed_levels(self, j: int, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-        """Levels of categorical feature ``j`` allowed by each box.
-
-        Parameters
-        ----------
-        lower, upper : ndarray, shape (n_boxes, n_encoded)
-
-        Returns
-        -------
-        ndarray of bool, shape (n_boxes, n_levels)
-        """
-        cols = [c for c, (jj, _) in enumerate(self.columns) if jj == j]
-        n_lv = len(self.levels[j])
-        if self.mode == "ordinal":
-            code = np.arange(n_lv, dtype=np.float64)
-            return (code > lower[:, cols[0], None]) & (code <= upper[:, cols[0], None])
-        lo, hi = lower[:, cols], upper[:, cols]
-        ok_one = (1.0 > lo) & (1.0 <= hi)  # the level's own indicator is 1 ...
-        ok_zero = (0.0 > lo) & (0.0 <= hi)  # ... and every other indicator is 0
-        others_ok = ok_zero.sum(axis=1, keepdims=True) - ok_zero == n_lv - 1
-        return ok_one & others_ok
-
-    def decode_all(self, lower: np.ndarray, upper: np.ndarray) -> dict:
-        """Per original feature, the bounds of all boxes (vectorised).
-
-        Returns
-        -------
-        dict name -> (gt, le) arrays of shape (n_boxes,) for numeric features, or a list of
-        tuples of allowed levels (None when unconstrained) for categorical ones.
-        """
-        out = {}
-        for j, name in enumerate(self.names):
-            if not self.categorical[j]:
-                c = next(c for c, (jj, _) in enumerate(self.columns) if jj == j)
-                out[name] = (lower[:, c].astype(float), upper[:, c].astype(float))
-            else:
-                ok = self.allowed_levels(j, lower, upper)
-                lv = self.levels[j]
-                out[name] = [None if row.all() else tuple(lv[row].tolist()) for row in ok]
-        return out
-
-    def decode(self, lower: np.ndarray, upper: np.ndarray) -> list:
-        """Bounds of one box: per original feature (gt, le) or allowed levels (or None)."""
-        d = self.decode_all(lower[None, :], upper[None, :])
-        return [
-            d[n][0] if self.categorical[j] else (float(d[n][0][0]), float(d[n][1][0]))
-            for j, n in enumerate(self.names)
-        ]
-
-
-def level_value(v):
-    """A categorical level as a plain Python number (8.0 -> 8) for text and JSON."""
-    if isinstance(v, float | np.floating) and float(v).is_integer():
-        return int(v)
-    if isinstance(v, np.generic):
-        return v.item()
-    return v
-
-
-def _fmt_level(v) -> str:
-    return str(level_value(v))
-
-
-def _fmt_num(v: float, digits: int) -> str:
-    return f"{v:.{digits}g}"
-
-
-def format_rule(bounds, names, *, categorical=(), digits: int = 4, scale=None, units=None) -> str:
-    """Render one decoded rule as text.
-
-    Parameters
-    ----------
-    bounds : list
-        Per feature ``(gt, le)`` for numeric features (``-inf``/``inf`` when unbounded) or a
-        tuple of allowed levels (None when unconstrained).
-    names : sequence of str
-    categorical : collection of str, default=()
-        Names of the categorical features (their bounds are tuples of levels).
-    digits : int, default=4
-        Significant digits of the thresholds.
-    scale, units : dict, optional
-        Display factor and unit per feature name (e.g. ``{"W": 1e3}``, ``{"W": "mm"}``).
-
-    Returns
-    -------
-    str
-        e.g. ``"tcrease <= 0.00078 and W > 0.0019 and m in {16, 24}"``; ``"(any design)"``
-        for an empty box.
-    """
-    scale = scale or {}
-    units = units or {}
-    parts = []
-    for name, b in zip(names, bounds, strict=True):
-        if b is None:
-            continue
-        if name in categorical:
-            levels = [_fmt_level(v) for v in b]
-            if len(levels) == 1:
-                parts.append(f"{name} = {levels[0]}")
-            else:
-                parts.append(f"{name} in {{{', '.join(levels)}}}")
-            continue
-        gt, le = b
-        s = scale.get(name, 1.0)
-        u = f" {units[name]}" if name in units else ""
-        if np.isfinite(gt) and np.isfinite(le):
-            parts.append(f"{_fmt_num(gt * s, digits)} < {name} <= {_fmt_num(le * s, digits)}{u}")
-        elif np.isfinite(gt):
-            parts.append(f"{name} > {_fmt_num(gt * s, digits)}{u}")
-        elif np.isfinite(le):
-            parts.append(f"{name} <= {_fmt_num(le * s, digits)}{u}")
-    return " and ".join(parts) if parts else "(any design)"
-
-
-# ---------------------------------------------------------------------------------------------
-# the estimator
-# ---------------------------------------------------------------------------------------------
-
-
-def _fit_one_tree(params, ccp_alpha, class_weight, Z32, y, n_sub, seed):
+def fit_one_tree(params, ccp_alpha, class_weight, Z32, y, n_sub, seed):
     """Fit one tree on ``n_sub`` rows drawn without replacement.
 
     Returns
@@ -980,11 +434,11 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
                 for code, label in enumerate(self.classes_.tolist())
             }
         return Parallel(n_jobs=self.n_jobs, prefer="threads")(
-            delayed(_fit_one_tree)(params, self.ccp_alpha, class_weight, Z32, y_pos, n_sub, s)
+            delayed(fit_one_tree)(params, self.ccp_alpha, class_weight, Z32, y_pos, n_sub, s)
             for s in seeds
         )
 
-    def _make_encoding(self, X, names, cat_mask) -> _Encoding:
+    def _make_encoding(self, X, names, cat_mask) -> Encoding:
         levels, columns = [], []
         for j in range(X.shape[1]):
             if cat_mask[j]:
@@ -1001,7 +455,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             else:
                 levels.append(None)
                 columns.append((j, -1))
-        return _Encoding(
+        return Encoding(
             tuple(names),
             tuple(bool(c) for c in cat_mask),
             tuple(levels),
@@ -1048,7 +502,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         pair_row, pair_tree = np.nonzero(box_of >= 0)
         pair_box = box_of[pair_row, pair_tree]
         pair_bag = in_bag[pair_row, pair_tree]
-        c = _box_counts(pair_box, pair_row, pair_bag, y_pos, m, n)
+        c = box_counts(pair_box, pair_row, pair_bag, y_pos, m, n)
         sup, tpu = c["support"], c["true_positives"]
         prec = np.where(sup > 0, tpu / np.maximum(sup, 1), 0.0)
         rec = tpu / n_pos
@@ -1063,7 +517,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         keep = enough & (prec >= self.precision_min)
 
         base_rate = float(y_pos.mean()) if n else 0.0
-        prior = _prior(self.prior_strength, o_tp[in_bag_ok], o_n[in_bag_ok], base_rate)
+        prior = fit_prior(self.prior_strength, o_tp[in_bag_ok], o_n[in_bag_ok], base_rate)
         self.prior_ = {"mean": prior[0], "strength": prior[1], "base_rate": base_rate}
         stats = {
             "precision": prec,
@@ -1087,15 +541,15 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         lo_all, up_all = lo_all[order], up_all[order]
         stats = {key: v[order] for key, v in stats.items()}
 
-        finders = _finder_matrix(inverse, forest.tree_of[cand], m, T)  # (m, T) 0/1
+        finders = finder_matrix(inverse, forest.tree_of[cand], m, T)  # (m, T) 0/1
         if self.simplify == "estimate" and idx.size:
             top = min(idx.size, max(8 * self.n_rules, 32))
             f_top = finders[stats["_box"][:top]]
             weight = f_top @ (~in_bag).T.astype(float)  # (top, n) out-of-bag pairs per row
-            new_lo, new_up = _simplify(
+            new_lo, new_up = simplify_boxes(
                 lo_all[:top], up_all[:top], Z32, y_pos, weight, prior, self.precision_min
             )
-            simplified = _box_stats(new_lo, new_up, Z32, y_pos, weight, f_top @ in_bag.T > 0)
+            simplified = box_stats(new_lo, new_up, Z32, y_pos, weight, f_top @ in_bag.T > 0)
             simplified["n_trees"] = stats["n_trees"][:top]
             simplified["_box"] = stats["_box"][:top]
             self._score(simplified, n_pos)
@@ -1122,14 +576,14 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         numeric = np.array([not self._encoding.categorical[j] for j, _ in self._encoding.columns])
 
         def shape(lo, up):  # what a kept rule becomes: tightened to its target rows, or as is
-            return _tighten(lo, up, Z32, y_pos, numeric) if self.tighten else (lo, up)
+            return tighten(lo, up, Z32, y_pos, numeric) if self.tighten else (lo, up)
 
         pick, self._lower, self._upper = self._pick(Z32, k, shape)
         kept = {key: v[pick] for key, v in self._all_stats.items()}
         if self.tighten and len(pick):
             f_kept = finders[kept["_box"]]
             weight = f_kept @ (~in_bag).T.astype(float)
-            new = _box_stats(self._lower, self._upper, Z32, y_pos, weight, f_kept @ in_bag.T > 0)
+            new = box_stats(self._lower, self._upper, Z32, y_pos, weight, f_kept @ in_bag.T > 0)
             kept.update(new)
             self._score(kept, n_pos)
             for key in (
@@ -1141,7 +595,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             ):
                 kept[key] = kept[key].astype(np.intp)
         if self.simplify != "none":
-            self._lower, self._upper = _drop_idle_conditions(self._lower, self._upper, Z32)
+            self._lower, self._upper = drop_idle_conditions(self._lower, self._upper, Z32)
         kept.pop("_box")
         self.rules_ = self._rules_frame(self._lower, self._upper, kept)
         if len(self.rules_) < k:
@@ -1163,7 +617,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
     def _score(self, stats: dict, n_pos: int) -> None:
         """Add the estimate (mean and interval), ``f_score`` and the ranking ``score``."""
         mu, k = self.prior_["mean"], self.prior_["strength"]
-        est, lo, hi, lcb = _posterior(
+        est, lo, hi, lcb = posterior(
             stats["estimate_true_positives"], stats["estimate_support"], mu, k
         )
         stats["estimate"], stats["estimate_low"], stats["estimate_high"] = est, lo, hi
@@ -1174,9 +628,9 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         if self.scoring == "estimate":
             p_rank = est if self.ranking == "fbeta" else lcb
         else:
-            p_rank = p if self.ranking == "fbeta" else _wilson_lower(p * n, n)
-        stats["f_score"] = _fbeta(stats["precision"], stats["recall"], self.beta)
-        stats["score"] = _fbeta(p_rank, stats["recall"], self.beta)
+            p_rank = p if self.ranking == "fbeta" else wilson_lower(p * n, n)
+        stats["f_score"] = fbeta(stats["precision"], stats["recall"], self.beta)
+        stats["score"] = fbeta(p_rank, stats["recall"], self.beta)
 
     def _pick(self, Z32: np.ndarray, k: int, shape):
         """The rules to keep: positions in the ranking and their (shaped) boxes.
@@ -1238,13 +692,13 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             for r in range(lower.shape[0])
         ]
         cats = {n for n, c in zip(enc.names, enc.categorical, strict=True) if c}
-        cols: dict = {"rule": [format_rule(b, enc.names, categorical=cats) for b in per_rule]}
+        cols: dict = {"rule": [box_text(b, enc.names, categorical=cats) for b in per_rule]}
         for j, name in enumerate(enc.names):
             if enc.categorical[j]:
                 cols[f"{name}_in"] = dec[name]
             else:
                 cols[f"{name}_gt"], cols[f"{name}_le"] = dec[name]
-        first = [c for c in _STAT_ORDER if c in stats]
+        first = [c for c in STAT_ORDER if c in stats]
         cols.update({c: stats[c] for c in first + [c for c in stats if c not in first]})
         return pd.DataFrame(cols)
 
@@ -1332,7 +786,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             if np.any(extra_tp < 0) or np.any(extra_tp > extra_n):
                 raise ValueError("held-out true_positives must lie between 0 and support")
             tp, n = tp + extra_tp, n + extra_n
-        mean, lo, hi, _ = _posterior(tp, n, self.prior_["mean"], self.prior_["strength"])
+        mean, lo, hi, _ = posterior(tp, n, self.prior_["mean"], self.prior_["strength"])
         return pd.DataFrame(
             {
                 "estimate": mean,
