@@ -23,8 +23,10 @@ def test_mine_prints_the_summary_and_writes_strict_json(reference_data, tmp_path
     assert text.count("    train:    precision") == 3 and text.count("    held-out: precision") == 3
     assert text.count("    estimate: precision") == 3 and "95 % interval" in text
     assert "the target does not depend on: " in text
-    recs = read_rules(out)
-    assert [r["rank"] for r in recs] == [1, 2, 3]
+    assert " mm" in text and " deg" in text  # thresholds in display units
+    assert [r.rank for r in read_rules(out)] == [1, 2, 3]
+    recs = json.loads(out.read_text())
+    assert all(r["display"]["tcrease"]["unit"] == "mm" for r in recs if "tcrease" in r["bounds"])
     for r in recs:
         lo, hi = r["estimate"]["interval"]
         assert 0 <= lo <= r["estimate"]["precision"] <= hi <= 1 and r["estimate"]["rows"] > 0
@@ -147,7 +149,7 @@ def test_the_papers_method_stays_selectable(reference_data, tmp_path, capsys):
         random_state=1,
     )
     assert ref.miner.get_params()["beta"] == 0.2
-    assert [r["rule"] for r in read_rules(out)] == ref.rules["rule"].tolist()
+    assert [r.text() for r in read_rules(out)] == ref.rules["rule"].tolist()
     assert main(argv) == 0  # the default: the same ranking, bounds tightened
-    assert [r["rule"] for r in read_rules(out)] != ref.rules["rule"].tolist()
+    assert [r.text() for r in read_rules(out)] != ref.rules["rule"].tolist()
     capsys.readouterr()
