@@ -1,4 +1,5 @@
-"""Kernel benchmark: assembly time per evaluation and one Newton solve, growing model size.
+"""Kernel benchmark: assembly time per evaluation and one Newton solve, growing model size,
+on each kernel path (numpy, the reference; compiled, numba).
 
 Run from the repository root::
 
@@ -16,12 +17,15 @@ size), with the linear-solver path taken (dense LAPACK, banded Cholesky or Super
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import time
 
 import numpy as np
 
-from holofold.mechanics.assembly import BANDED_MAX_WORK, DENSE_MAX_DOF, Assembler, solver_path
+from holofold.mechanics import kernels
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.linear import BANDED_MAX_WORK, DENSE_MAX_DOF, solver_path
 from holofold.mechanics.solvers import solve_newton
 from holofold.mechanics.springs import dihedral_angle
 from holofold.mechanics.structure import Structure
@@ -89,12 +93,13 @@ def _path(asm: Assembler) -> str:
 
 
 def bench(name: str, s: Structure, repeat: int) -> str:
+    """One table row on the active kernel path."""
     asm = Assembler(s)
     rng = np.random.default_rng(1)
     U = 1e-4 * rng.normal(size=(s.n_nodes, 3)) * ~s.supports
     nf = asm.free_dofs.size
     t_eval = _median_time(lambda: asm.evaluate_factorized(U), repeat)
-    t_asm = _median_time(lambda: asm._data(U, None), repeat)
+    t_asm = _median_time(lambda: asm.evaluate(U), repeat)
     rhs = np.ones(nf)
     solve = asm.evaluate_factorized(U)[2]
     t_sol = _median_time(lambda: solve(rhs), repeat)
@@ -105,9 +110,9 @@ def bench(name: str, s: Structure, repeat: int) -> str:
     t_nr = _median_time(
         lambda: solve_newton(s, load, increments=3, tol=1e-10, assembler=asm), repeat
     )
-    bw = asm.reduction.banded[1] if nf > asm.dense_max else 0
+    bw = asm.reduction.band.bandwidth if nf > asm.dense_max else 0
     return (
-        f"| {name:<14} | {s.n_nodes:5d} | {len(s.bars):5d} | {len(s.springs):5d} | {nf:5d} "
+        f"| {kernels.active().name:<8} | {name:<14} | {s.n_nodes:5d} | {len(s.bars):5d} | {len(s.springs):5d} | {nf:5d} "
         f"| {bw:4d} | {_path(asm):<7} | {t_asm[0] * 1e3:6.2f} / {t_asm[1] * 1e3:6.2f} "
         f"| {t_eval[0] * 1e3:6.2f} / {t_eval[1] * 1e3:6.2f} | {t_sol[0] * 1e3:6.3f} "
         f"| {int(res.iterations.sum()):3d} | {t_nr[0] * 1e3:7.1f} / {t_nr[1] * 1e3:7.1f} |"
@@ -126,10 +131,10 @@ def main() -> None:
     print("asm+fact = assemble + reduced factorisation; solve = one back-substitution;")
     print("NR = solve_newton, 3 increments, tol 1e-10 m, total iterations 'it')")
     print(
-        "| model          | nodes |  bars | sprgs |  free |   bw | solver  |     assemble    "
-        "|     asm+fact    |  solve | it |   Newton (3 inc)  |"
+        "| path     | model          | nodes |  bars | sprgs |  free |   bw | solver  "
+        "|     assemble    |     asm+fact    |  solve | it |   Newton (3 inc)  |"
     )
-    print("|" + "|".join("-" * w for w in (16, 7, 7, 7, 7, 6, 9, 17, 17, 8, 4, 19)) + "|")
+    print("|" + "|".join("-" * w for w in (10, 16, 7, 7, 7, 7, 6, 9, 17, 17, 8, 4, 19)) + "|")
     models = []
     for m, n in ((2, 2), (4, 4), (8, 4), (12, 6), (24, 8), (36, 12)):
         s = miura_model(m, n)
@@ -138,7 +143,9 @@ def main() -> None:
     for nx, ny in ((4, 4), (10, 6), (20, 10), (40, 16), (60, 20)):
         models.append((f"sheet {nx}x{ny}", synthetic_sheet(nx, ny)))
     for name, s in models:
-        print(bench(name, s, args.repeat), flush=True)
+        for path in kernels.KERNEL_PATHS:
+            os.environ[kernels.ENV] = path
+            print(bench(name, s, args.repeat), flush=True)
 
 
 if __name__ == "__main__":

@@ -17,8 +17,9 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from holofold.geometry.miura import miura_sheet
-from holofold.mechanics.assembly import BANDED_MAX_WORK, Assembler
+from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.hinges import build_concentrated
+from holofold.mechanics.linear import BANDED_MAX_WORK
 
 SIZES = ["24x8", "36x12", "48x16", "60x20", "72x24", "84x28", "96x32"]
 
@@ -47,7 +48,7 @@ def main(argv=None) -> None:
             red = asm.reduction
             _, _, K = asm.evaluate_reduced(np.zeros((s.n_nodes, 3)), dense=False)
             costs = bench_floor.path_costs(K, red)
-            _, bw, _, _ = red.banded
+            bw = red.band.bandwidth
             work = red.n_free * (bw + 1) ** 2
             band, slu = costs.get("banded Cholesky", np.nan), costs["SuperLU"]
             path = "banded" if work <= BANDED_MAX_WORK else "SuperLU"

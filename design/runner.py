@@ -41,6 +41,7 @@ from holofold.design.row_limits import (
 from holofold.design.row_status import STATE_COLUMNS, status_columns
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.scenarios.base import check_row, single_thread
+from holofold.mechanics.kernels import check_environment
 from holofold.mechanics.status import Status
 
 __all__ = [
@@ -572,6 +573,8 @@ def iter_results(
     k times as long, and past it its rows run again one by one); a row past its limit is
     ``failed: timeout after ... s``.
     """
+    if rows:  # the environment before any row: a fault here is never a row's outcome
+        check_environment()
     if address is not None:
         yield from _iter_on_dask(scenario, rows, limit_threads, address, row_timeout)
         return

@@ -14,6 +14,7 @@ import lazy_loader
 
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
+    submodules=["kernels"],
     submod_attrs={
         "analyses": [
             "LoadGroup",
@@ -26,6 +27,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "SnapCheck",
         ],
         "assembly": ["Assembler", "BatchAssembler", "SingularSystemError"],
+        "kernels": ["KERNEL_PATHS", "KernelPath", "KernelWarning", "check_environment"],
         "bars": ["bar_forces", "bar_strain"],
         "compat": ["Profile", "PAPER", "PHYSICAL"],
         "folding": [

@@ -1,23 +1,13 @@
-"""Compiled element kernels and scatters of the assembly (numba, cached on disk).
+"""The compiled kernel path (numba): element kernels, sums and whole Newton steps.
 
-The numpy kernels of :mod:`~holofold.mechanics.bars` and :mod:`~holofold.mechanics.springs`
-make some forty array operations per call: about 95 us of fixed cost whatever the model size,
-and a temporary per operation. Here each bar is one pass of scalar code, the springs one
-branch-free loop that runs vectorised across springs (:mod:`~holofold.mechanics._spring_loop`,
-after a scalar pass for the angles), and each scatter one loop, with no fixed cost beyond the
-call.
-
-The results are bit for bit those of the numpy kernels and ``np.bincount`` scatters
-(tests/test_compiled.py): every element performs the same IEEE operations in the same order
-(sums over the three components left to right as numpy reduces a length-3 axis, ``np.mod`` as
-numpy's ``npy_divmod``, no fast-math, no fused multiply-add), and :func:`scatter` adds the
-contributions of a target in the order ``np.bincount`` does (the flat order of the kernel
-layout, each family summed on its own, the families added as the numpy path added them). The
-layouts are the numpy kernels' (see :func:`~holofold.mechanics.bars.bar_kernel` and
-:func:`~holofold.mechanics.springs.spring_kernel`), so one slot map serves both.
-
-numba compiles on first use and caches the machine code next to this file (or under
-``NUMBA_CACHE_DIR``): a new process loads it in tens of milliseconds.
+The accelerator over the numpy path (:mod:`~holofold.mechanics._numpy_kernels`): the same
+functions, signatures and layouts, chosen by :mod:`~holofold.mechanics.kernels` (import this
+module through it: the kernel cache folder is set there). The numpy kernels make some forty
+array operations per call, about 95 us of fixed cost whatever the model size; here each bar is
+one pass of scalar code, the springs one branch-free loop that runs vectorised across springs
+(:mod:`~holofold.mechanics._spring_loop`, after a scalar pass for the angles), each sum one loop
+over the kernels' entries in memory order, and a Newton step one call with scipy's LAPACK by
+address. The two paths agree to round-off (tests/test_kernel_paths.py), not to the bit.
 """
 
 from __future__ import annotations
@@ -179,12 +169,10 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
 @njit(**_OPTS)
 def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest, acc, out):
     """``out[dest[p]] = (A_p + B_p) + C_p`` for every listed target p, where ``A_p`` is the
-    sum from 0.0 of the values ``val_a[src_a[q]]`` with ``pos_a[q] == p``, added for q in
-    order (likewise B, C). With each family's sources in flat order, this is ``bincount(a) +
-    bincount(b) + bincount(c)`` bit for bit, and the values are read in the order they lie in
-    memory (a gather target by target read them scattered: its sums took 1.2-1.6x as long,
-    benchmarks/bench_scatter.py). ``acc`` holds the sums (3 ``dest.size`` floats);
-    ``out`` must start as zeros where nothing is listed."""
+    sum of the values ``val_a[src_a[q]]`` with ``pos_a[q] == p`` (likewise B, C), the values
+    read in the order they lie in memory (a gather target by target read them scattered and
+    took 1.2-1.6x as long). ``acc`` holds the sums (3 ``dest.size`` floats); ``out`` must
+    start as zeros where nothing is listed."""
     n = dest.shape[0]
     for p in range(3 * n):
         acc[p] = 0.0
@@ -208,8 +196,7 @@ def _acc_size(force_lists, tangent_lists) -> int:
 # ------------------------------------------------------------------------ batches
 # A batch is S designs of one size: the arrays gain a leading sample axis and each listed
 # sample runs the single-design code above on one scratch set of element arrays, which stays
-# in cache between the kernels and the scatters (so each design's numbers are bit for bit those
-# of its own evaluation).
+# in cache between the kernels and the sums.
 
 
 @njit(**_OPTS)
@@ -252,8 +239,8 @@ def assemble_batch(
 
 # ------------------------------------------------------------------------ LAPACK calls
 # scipy's LAPACK routines by address (scipy.linalg.cython_lapack, the library that
-# scipy.linalg.lapack's wrappers call: the same code, the same results bit for bit). The
-# address is an argument, not a constant of the compiled code, so the code stays cacheable.
+# scipy.linalg.lapack's wrappers call). The address is an argument, not a constant of the
+# compiled code, so the code stays cacheable.
 
 
 @intrinsic
@@ -383,10 +370,8 @@ def dense_newton_step(
 
 # ------------------------------------------------------------------------ thermal
 # The small-model steady temperature of :mod:`holofold.mechanics.thermal` (reference
-# geometry) without its forty array operations per heating step: the same IEEE operations in
-# numpy's order (products and differences one by one, a length-3 sum left to right, the
-# element matrices summed into the dense matrix in ``np.bincount`` order, the incidence sum in
-# scipy's ``csr_matvecs`` order). numpy keeps the angle (einsum, arctan2, cos, sin) and the
+# geometry) without its forty array operations per heating step (the numpy path keeps
+# thermal.py's own array code). numpy keeps the angle (einsum, arctan2, cos, sin) and the
 # series sum over the air layers.
 
 

@@ -36,6 +36,7 @@ try:  # scipy's private csr loops (a fast path of _csr_times; scipy's @ where th
 except ImportError:  # pragma: no cover - depends on the scipy release
     _sparsetools = None
 
+from holofold.mechanics import kernels
 from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
 from holofold.mechanics.solvers import solve_selffold
@@ -376,11 +377,11 @@ def _solve_spd(A: sp.spmatrix, b: np.ndarray) -> np.ndarray:
 
 def _compiled_system(model: ThermalModel, x: np.ndarray):
     """The dense conduction matrix (nn, nn) and the chain conductances G (nn,) of the small
-    model fast path in the reference geometry, bit for bit those of :func:`triangle_edges`,
-    :func:`_element_matrices` + ``np.bincount`` and :func:`chain_conductance` (two compiled
-    calls around numpy's einsum, arctan2, cos and sin)."""
-    from holofold.mechanics import _compiled as ck
-
+    model fast path in the reference geometry on the compiled kernel path: those of
+    :func:`triangle_edges`, :func:`_element_matrices` + ``np.bincount`` and
+    :func:`chain_conductance` to round-off (two compiled calls around numpy's einsum, arctan2,
+    cos and sin)."""
+    ck = kernels.active().module
     tri = model.triangles
     nt, n = len(tri), model.n_nodes
     x = np.ascontiguousarray(x, dtype=float)
@@ -415,7 +416,7 @@ def steady_temperature(
     RT = model.room_temperature
     if K_cond is None and G is None and n <= _DENSE_MAX and not len(model.room_temp_nodes):
         # fast path for small models: one geometry pass, dense assembly, Cholesky
-        if model.reference_geometry:
+        if model.reference_geometry and kernels.active().compiled:
             A, G = _compiled_system(model, x)
         else:
             geo = triangle_edges(model, x)

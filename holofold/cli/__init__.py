@@ -33,6 +33,7 @@ import sys
 import warnings
 from pathlib import Path
 
+
 __all__ = ["main", "build_parser"]
 
 # preferred order in --help; modules not listed here follow alphabetically

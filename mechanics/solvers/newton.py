@@ -125,7 +125,7 @@ def solve_newton_batch(
     Every iteration evaluates the samples still iterating together (one kernel call and one
     scatter for the batch, :class:`~holofold.mechanics.assembly.BatchAssembler`); each sample
     keeps its own increment loop, convergence, iteration count and failure, and its
-    :class:`SolveResult` is bit for bit the one :func:`solve_newton` gives it alone.
+    :class:`SolveResult` is the one :func:`solve_newton` gives it alone (to round-off).
 
     Parameters
     ----------
@@ -173,8 +173,7 @@ def solve_newton_batch(
                 hists[s].record(U[s], i, False, step[s] - 1, R[s])
                 alive[s] = False
                 it[s] = False
-            # ||dU|| of each solved sample: vecdot is dU[s] @ dU[s] (numpy's BLAS dot) bit for
-            # bit, as solve_newton computes it (tests/test_batch.py)
+            # ||dU|| of each solved sample
             ok = np.flatnonzero(it)
             R[ok] = np.sqrt(np.vecdot(dU[ok], dU[ok]))
             step[ok] += 1

@@ -1,0 +1,153 @@
+"""The reference kernel path: numpy and scipy only, always available.
+
+Every function has the signature and the output layouts of its compiled twin in
+:mod:`~holofold.mechanics._compiled` (so the assembly calls either through
+:func:`holofold.mechanics.kernels.active`), and agrees with it to round-off: forces, tangents and
+energies to 1e-12 relative to their scale (tests/test_kernel_paths.py). The element kernels are
+:func:`~holofold.mechanics.bars.bar_kernel` and :func:`~holofold.mechanics.springs.spring_kernel`,
+the sums ``np.bincount``, the factorisations scipy's LAPACK wrappers; samples of a batch are a
+Python loop. About 3-5x the compiled assembly time (benchmarks/bench_kernels.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg.lapack import dgetrf, dgetrs, dpbtrf, dpbtrs
+
+from holofold.mechanics.bars import bar_kernel
+from holofold.mechanics.springs import spring_kernel
+
+__all__ = [
+    "bar_elements",
+    "spring_elements",
+    "scatter",
+    "assemble_batch",
+    "band_newton_step",
+    "dense_newton_step",
+    "lapack_addresses",
+]
+
+
+def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, energy, force, K):
+    """Bars into ``energy`` (nb,), ``force`` (3, 2, nb) and, if ``tangent``, ``K``
+    (3, 3, 2, 2, nb) (see ``_compiled.bar_elements``)."""
+    d = (U[b1] - U[b0]).T
+    res = bar_kernel(D0, d, L0, EA, tangent=tangent)
+    energy[...] = res.energy
+    force[...] = res.force
+    if tangent:
+        K[...] = res.tangent
+
+
+def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, theta):
+    """Springs into ``energy`` (ns,), ``force`` (3, 4, ns), ``theta`` (ns,) and, if
+    ``tangent``, ``K`` (3, 3, 10, ns) (see ``_compiled.spring_elements``)."""
+    res, th = spring_kernel((X + U).T[:, sT], k, theta0, tangent=tangent)
+    energy[...] = res.energy
+    force[...] = res.force
+    theta[...] = th
+    if tangent:
+        K[...] = res.tangent
+
+
+def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest, acc, out):
+    """``out[dest[p]] = A_p + B_p + C_p``, ``A_p`` the sum of ``val_a[src_a[q]]`` over the q
+    with ``pos_a[q] == p`` (likewise B, C); ``acc`` is unused (the compiled twin's scratch)."""
+    n = dest.shape[0]
+    s = np.bincount(pos_a, weights=val_a[src_a], minlength=n)
+    if src_b.size:
+        s += np.bincount(pos_b, weights=val_b[src_b], minlength=n)
+    if src_c.size:
+        s += np.bincount(pos_c, weights=val_c[src_c], minlength=n)
+    out[dest] = s
+
+
+def _assemble_sample(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+    views, flats, f, K,
+):  # fmt: skip
+    eb, fb, Kb, es, fs, Ks, th = views
+    f[:] = 0.0
+    K[:] = 0.0
+    _, vfb, vkb, _, vfs, vks, _ = flats
+    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
+    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
+    bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
+    spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
+    scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, None, f)
+    scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, None, K)
+
+
+def assemble_batch(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, f_out, k_out,
+):  # fmt: skip
+    """Samples ``idx``: force into ``f_out[j]``, tangent target into ``k_out[j]``."""
+    for j in range(idx.shape[0]):
+        _assemble_sample(
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
+            tangent_lists, views, flats, f_out[j], k_out[j],
+        )  # fmt: skip
+
+
+def _accept(x, Uflat, s, free) -> int:
+    if not np.all(np.isfinite(x)):
+        return 2
+    Uflat[s, free] += x
+    return 0
+
+
+def band_newton_step(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, Fi, free, perm, bw, addrs, Uflat, dU, f_out, info,
+):  # fmt: skip
+    """One Newton update per sample on the banded Cholesky path (``_compiled``'s twin: info
+    0 done, 1 not positive definite, 2 a non-finite solution)."""
+    nf = free.shape[0]
+    ab = np.empty((bw + 1) * nf)
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        f = f_out[j]
+        _assemble_sample(
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+            views, flats, f, ab,
+        )  # fmt: skip
+        c, inf = dpbtrf(ab.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
+        if inf != 0:
+            info[j] = 1
+            continue
+        y, _ = dpbtrs(c, (Fi[s] - f)[free][perm], lower=0)
+        x = dU[j]
+        x[perm] = y
+        info[j] = _accept(x, Uflat, s, free)
+
+
+def dense_newton_step(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, Fi, free, addrs, Uflat, dU, info, res,
+):  # fmt: skip
+    """One Newton update per sample on the dense LU path (``_compiled``'s twin: the tangent
+    lists fill the column-major free-free block; info 0 done, 1 singular, 2 non-finite)."""
+    nf = free.shape[0]
+    a = np.empty(nf * nf)
+    f = np.empty(Uflat.shape[1])
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        _assemble_sample(
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+            views, flats, f, a,
+        )  # fmt: skip
+        lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
+        if inf > 0:
+            info[j] = 1
+            continue
+        r = (Fi[s] - f)[free]
+        res[j] = r
+        x, _ = dgetrs(lu, piv, r)
+        dU[j] = x
+        info[j] = _accept(dU[j], Uflat, s, free)
+
+
+def lapack_addresses(*names: str) -> np.ndarray:
+    """Placeholder addresses (the numpy path calls scipy's wrappers by name)."""
+    return np.zeros(len(names), np.int64)

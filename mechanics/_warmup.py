@@ -1,0 +1,77 @@
+"""Small models through every assembly and solver path, so that the compiled path compiles (or
+loads) every specialisation holofold calls before a real run needs it
+(:func:`holofold.mechanics.kernels.compile_kernels`; tests/test_kernel_paths.py checks that a
+warm cache serves the scenarios without compiling)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["run_warmup"]
+
+
+def _sheet(m: int, n: int, *, compliant: bool = False):
+    from holofold.geometry.miura import miura_sheet
+    from holofold.mechanics.hinges import build_compliant, build_concentrated
+
+    pat = miura_sheet(m, n, a=0.02, b=0.02, gamma=1.0, ext=0.6)
+    kw = dict(crease_width=2e-3, crease_thickness=5e-4, panel_thickness=2e-3)
+    if compliant:
+        s = build_compliant(pat, **kw, E_panel=2e9, E_crease=2e9, nu_panel=0.3, nu_crease=0.3)
+    else:
+        s = build_concentrated(pat, **kw)
+    sup = np.zeros((s.n_nodes, 3), bool)
+    sup[:3] = True
+    return s.with_supports(sup)
+
+
+def _exercise(structures) -> None:
+    from holofold.mechanics.assembly import Assembler, BatchAssembler
+
+    s = structures[0]
+    rng = np.random.default_rng(0)
+    U = 1e-4 * rng.normal(size=(s.n_nodes, 3))
+    asm = Assembler(s)
+    asm.evaluate(U)
+    asm.evaluate_reduced(U, dense=True)
+    asm.evaluate_reduced(U, dense=False)
+    asm.internal_force(U)
+    asm.element_response(U)
+    _, f, solve = asm.evaluate_factorized(U)
+    solve(-f[asm.free_dofs])
+    Uf = np.ascontiguousarray(U.ravel())
+    F = np.zeros(s.n_dof)
+    step = asm.dense_stepper(Uf, F, r=np.empty(asm.free_dofs.size))
+    if step is not None:
+        step()
+    step = asm.dense_stepper(Uf, F)
+    if step is not None:
+        step()
+    batch = BatchAssembler(structures)
+    US = np.ascontiguousarray(np.tile(U.ravel(), (len(structures), 1)))
+    batch.factorized(US.reshape(len(structures), -1, 3), np.ones(len(structures), bool))
+    batch.newton_step(US, np.zeros_like(US), np.ones(len(structures), bool))
+
+
+def _thermal() -> None:
+    from holofold.geometry.gripper import two_panel_gripper
+    from holofold.mechanics.hinges import build_compliant
+    from holofold.mechanics.thermal import heat_input_matrix, steady_temperature, thermal_model
+
+    pat = two_panel_gripper(4.1e-3, 3.1e-3, 0.49).pattern
+    s = build_compliant(
+        pat, crease_width=150e-6, crease_thickness=1.2e-6, panel_thickness=27e-6,
+        E_panel=2e9, E_crease=2e9, nu_panel=0.3, nu_crease=0.3, diagonal_rate=100.0,
+    )  # fmt: skip
+    model = thermal_model(s, panel_conductivity=0.3, crease_conductivity=0.3, air_thickness=4.6e-3)
+    q = heat_input_matrix(s.creases.nodes, s.n_nodes) @ np.full(len(s.creases.ids), 0.01)
+    steady_temperature(model, s.nodes, q)
+
+
+def run_warmup() -> None:
+    """Evaluate, factorise and step small dense (2 x 2 Miura), banded (6 x 6) and compliant
+    models, one design and batches, and the gripper's small thermal model."""
+    for m, n in ((2, 2), (6, 6)):
+        _exercise([_sheet(m, n), _sheet(m, n)])
+    _exercise([_sheet(2, 2, compliant=True)] * 2)
+    _thermal()
