@@ -84,7 +84,10 @@ def main() -> None:
     ap.add_argument("--demo", action="store_true", help="also time holofold demo")
     args = ap.parse_args()
     print(f"load average at start: {os.getloadavg()[0]:.1f}; {os.cpu_count()} cores")
-    print("| case | evaluate arch, 1 row (s) |" + (" demo: first row / end (s) |" if args.demo else ""))
+    print(
+        "| case | evaluate arch, 1 row (s) |"
+        + (" demo: first chunk / end (s) |" if args.demo else "")
+    )
     print("|---|---|" + ("---|" if args.demo else ""))
     results: dict[str, list] = {}
     for _ in range(args.repeat):

@@ -112,7 +112,8 @@ def bench(name: str, s: Structure, repeat: int) -> str:
     )
     bw = asm.reduction.band.bandwidth if nf > asm.dense_max else 0
     return (
-        f"| {kernels.active().name:<8} | {name:<14} | {s.n_nodes:5d} | {len(s.bars):5d} | {len(s.springs):5d} | {nf:5d} "
+        f"| {kernels.active().name:<8} | {name:<14} | {s.n_nodes:5d} | {len(s.bars):5d} "
+        f"| {len(s.springs):5d} | {nf:5d} "
         f"| {bw:4d} | {_path(asm):<7} | {t_asm[0] * 1e3:6.2f} / {t_asm[1] * 1e3:6.2f} "
         f"| {t_eval[0] * 1e3:6.2f} / {t_eval[1] * 1e3:6.2f} | {t_sol[0] * 1e3:6.3f} "
         f"| {int(res.iterations.sum()):3d} | {t_nr[0] * 1e3:7.1f} / {t_nr[1] * 1e3:7.1f} |"

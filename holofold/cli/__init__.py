@@ -33,7 +33,6 @@ import sys
 import warnings
 from pathlib import Path
 
-
 __all__ = ["main", "build_parser"]
 
 # preferred order in --help; modules not listed here follow alphabetically
