@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.geometry.inputs import check_input_file
 from holofold.geometry.outputs import atomic_write, check_output_path
 
 __all__ = [
@@ -127,9 +128,7 @@ def read_table(path, columns=None) -> pd.DataFrame:
     OSError
         The file cannot be read.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"database {path} does not exist")
+    path = check_input_file(path, "table")
     suffix = path.suffix.lower()
     if suffix == ".csv":
         _check_csv_shape(path)

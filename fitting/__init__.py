@@ -33,6 +33,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "curve_files": [
             "CurveUnitWarning",
             "CurveSelectionWarning",
+            "CurveColumnsWarning",
+            "CurveClosedWarning",
             "MAX_SVG_BYTES",
             "MAX_SVG_NESTING",
             "MAX_SVG_ELEMENTS",

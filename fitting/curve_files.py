@@ -22,16 +22,20 @@ import io
 import math
 import re
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from holofold.fitting.curves import CurveError, CurveFormatError, PlanarCurve
+from holofold.geometry.inputs import check_input_file
 from holofold.geometry.units import LENGTH_UNITS, length_factor
 
 __all__ = [
     "CurveUnitWarning",
     "CurveSelectionWarning",
+    "CurveColumnsWarning",
+    "CurveClosedWarning",
     "MAX_SVG_BYTES",
     "MAX_SVG_NESTING",
     "MAX_SVG_ELEMENTS",
@@ -104,50 +108,136 @@ def check_curve_size(curve: PlanarCurve, unit: str, per_unit: float, where: str 
     )
 
 
-def read_points_csv(path, units: str = "m", *, check_size: bool = True) -> PlanarCurve:
+def read_points_csv(
+    path, units: str = "m", *, check_size: bool = True, columns: Sequence | None = None
+) -> PlanarCurve:
     """Curve through the (x, z) points of a CSV file (comma, semicolon or blank separated).
 
-    The first two columns are used, in ``units`` (default m); a header line (any non-numeric
-    first row) is skipped. ``check_size`` warns about an implausible size.
+    ``columns``: the two columns to read, as 0-based positions or header names (default: the
+    first two; a file with more numeric columns gets a :class:`CurveColumnsWarning` naming
+    the two read). Points in ``units`` (default m); a header line (any non-numeric first row)
+    is skipped. Decimal commas (``1,5``) are refused with a hint; a closed curve (last point
+    on the first) gets a :class:`CurveClosedWarning`. Errors never quote the file's content.
+    ``check_size`` warns about an implausible size.
     """
     k = length_factor(units)
-    path = Path(path)
+    path = _checked_input(path, "points file")
     try:
         text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CurveFormatError(f"cannot read points file {str(path)!r}: {exc}") from exc
-    rows = []
+    except UnicodeDecodeError:
+        raise CurveFormatError(f"points file {str(path)!r} is not a UTF-8 text file") from None
+    except OSError as exc:
+        why = exc.strerror or type(exc).__name__
+        raise CurveFormatError(f"cannot read points file {str(path)!r}: {why}") from None
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise CurveFormatError(f"points file {str(path)!r} is empty")
     try:
-        dialect = csv.Sniffer().sniff(lines[0], delimiters=",;\t ")
-        delim = dialect.delimiter
+        delim = csv.Sniffer().sniff(lines[0], delimiters=",;\t ").delimiter
     except csv.Error:
         delim = ","
+    table, header = [], None
     for n, ln in enumerate(lines):
-        fields = [f for f in next(csv.reader(io.StringIO(ln), delimiter=delim)) if f.strip()]
+        fields = [f.strip() for f in next(csv.reader(io.StringIO(ln), delimiter=delim))]
+        fields = [f for f in fields if f]
         if delim != " " and len(fields) < 2:
             fields = ln.split()
         try:
-            vals = [float(f) for f in fields[:2]]
+            vals = [float(f) for f in fields]
             if len(vals) < 2:
                 raise ValueError
         except ValueError:
             if n == 0:
-                continue  # header
+                header = fields
+                continue
+            comma = any(_DECIMAL_COMMA.fullmatch(f) for f in fields)
+            hint = "; decimal commas? write 1.5, not 1,5" if comma else ""
             raise CurveFormatError(
-                f"{str(path)!r} line {n + 1}: expected two numbers x, z, got {ln.strip()!r}"
+                f"{str(path)!r} line {n + 1}: expected at least two numbers x, z, got "
+                f"{len(fields)} field(s) that are not all numbers{hint}"
             ) from None
-        rows.append(vals)
-    if not rows:
+        table.append(vals)
+    if not table:
         raise CurveFormatError(f"points file {str(path)!r} has no numeric rows")
+    width = min(len(r) for r in table)
+    if max(len(r) for r in table) != width:
+        raise CurveFormatError(f"points file {str(path)!r}: rows have different numbers of values")
+    pick = _pick_columns(path, columns, header, width)
+    rows = [[r[pick[0]], r[pick[1]]] for r in table]
     curve = PlanarCurve.from_points(np.array(rows) * k, name=path.stem, source=str(path))
     curve = PlanarCurve(curve.func, name=curve.name, kind="points",
                         params={**curve.params, "units": units, "metres_per_unit": k})  # fmt: skip
+    _warn_if_closed(np.array(rows, float), path)
     if check_size:
         check_curve_size(curve, units, k, f" from {path.name}")
     return curve
+
+
+def _checked_input(path, what: str) -> Path:
+    """:func:`~holofold.geometry.check_input_file` as the curve error (one line)."""
+    try:
+        return check_input_file(path, what)
+    except OSError as exc:
+        raise CurveFormatError(str(exc)) from None
+
+
+_DECIMAL_COMMA = re.compile(r"[-+]?\d+,\d+")
+
+
+class CurveColumnsWarning(UserWarning):
+    """A points file with more than two numeric columns read without ``columns``."""
+
+
+class CurveClosedWarning(UserWarning):
+    """A closed curve: a strip over it would collide with itself."""
+
+
+def _pick_columns(path: Path, columns, header, width: int) -> tuple[int, int]:
+    """The 0-based positions of the two columns to read."""
+    names = header if header and len(header) == width else None
+    if columns is None:
+        if width > 2:
+            shown = f" ({', '.join(names)})" if names else ""
+            first = f"{names[0]}, {names[1]}" if names else "1 and 2"
+            warnings.warn(
+                f"points file {path.name} has {width} numeric columns{shown}; reading columns "
+                f"{first} as (x, z): choose two with columns = [...] (names or 0-based "
+                "positions)",
+                CurveColumnsWarning,
+                stacklevel=3,
+            )
+        return (0, 1)
+    cols = list(columns)
+    if len(cols) != 2:
+        raise CurveFormatError(f"columns = {cols!r}: give the two columns to read as (x, z)")
+    out = []
+    for c in cols:
+        if isinstance(c, str) and not c.isdigit():
+            if not names or c not in names:
+                known = ", ".join(names) if names else "none (no header)"
+                raise CurveFormatError(
+                    f"points file {path.name} has no column {c!r}; its columns: {known}"
+                )
+            out.append(names.index(c))
+        else:
+            i = int(c)
+            if not 0 <= i < width:
+                raise CurveFormatError(
+                    f"columns = {cols!r}: {path.name} has {width} columns (0 to {width - 1})"
+                )
+            out.append(i)
+    return out[0], out[1]
+
+
+def _warn_if_closed(xz: np.ndarray, path: Path) -> None:
+    size = float(np.ptp(xz, axis=0).max())
+    if len(xz) > 2 and size > 0 and np.linalg.norm(xz[-1] - xz[0]) <= 1e-9 * size:
+        warnings.warn(
+            f"points file {path.name} describes a closed curve (its last point is its first): "
+            "a strip over it closes on itself and its panels collide; fit an open arc",
+            CurveClosedWarning,
+            stacklevel=3,
+        )
 
 
 def _document_unit(svg) -> tuple[str | None, float]:
@@ -257,6 +347,7 @@ def _check_svg_structure(file: str) -> None:
     before svgelements (which recurses per level) parses it: one streaming pass of expat."""
     from xml.parsers import expat
 
+    _checked_input(file, "SVG file")
     try:
         size = Path(file).stat().st_size
     except OSError as exc:

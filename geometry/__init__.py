@@ -55,6 +55,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "miura_nodes_batch",
             "miura_faces",
         ],
+        "inputs": ["check_input_file", "path_kind"],
         "outputs": [
             "check_output_path",
             "check_output_folder",

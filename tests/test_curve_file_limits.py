@@ -86,8 +86,8 @@ def test_not_xml_and_missing_files(tmp_path):
     _refused(f, r"not well-formed XML: no element found \(line 1, column 28\)")
     f.write_bytes(bytes(range(256)))
     _refused(f, "not well-formed XML")
-    _refused(tmp_path / "missing.svg", "cannot read SVG file .*No such file")
-    _refused(tmp_path, "cannot read SVG file")
+    _refused(tmp_path / "missing.svg", r"SVG file .*missing.svg' does not exist")
+    _refused(tmp_path, r"SVG file .* is a folder, not a file")  # named as what it is
 
 
 TAGS = ["<g>", "</g>", "<svg>", "</svg>", '<path d="M 0 0 L 1 1"/>', '<path id="a" d="M 0 0"/>',

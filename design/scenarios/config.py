@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from holofold.design.scenarios.base import Column
+from holofold.design.scenarios.plausible import MATERIAL, check_lengths, check_plausible
 
 __all__ = [
     "ScenarioFileError",
@@ -126,11 +127,16 @@ class Section:
 
     def path(self, key: str) -> Path:
         """An existing file named by ``key``, relative to the scenario file's folder."""
+        from holofold.geometry.inputs import path_kind
+
         v = self.string(key)
         file = v.partition("#")[0]
         p = Path(file) if Path(file).is_absolute() else self.base / file
-        if not p.is_file():
+        kind = path_kind(p)
+        if kind == "missing":
             raise self.error(f"{key} = {v!r}: no such file {str(p)!r}")
+        if kind != "a file":
+            raise self.error(f"{key} = {v!r}: {str(p)!r} is {kind}, not a file")
         return p
 
     def done(self, allowed: Sequence[str] | None = None) -> None:
@@ -141,12 +147,17 @@ class Section:
             raise self.error(f"unknown key {unknown[0]!r}; allowed: {', '.join(names)}")
 
 
-def read_features(section: Section, defaults: Sequence[Column]) -> tuple[Column, ...]:
+def read_features(
+    section: Section, defaults: Sequence[Column], kind: str | None = None
+) -> tuple[Column, ...]:
     """The design features of a ``[features]`` table over the kind's ``defaults``.
 
     ``name = [low, high]`` sets a continuous range, ``name = {choices = [...]}`` the levels of a
     categorical feature, ``name = value`` fixes it (a range of one value); a feature not named
-    keeps its default. Returns the columns in the defaults' order.
+    keeps its default. Returns the columns in the defaults' order. With ``kind``, the lengths
+    given are checked against the kind's physical ranges
+    (:mod:`~holofold.design.scenarios.plausible`: metres that look like millimetres are
+    refused, naming the values in metres).
     """
     by_name = {c.name: c for c in defaults}
     out = dict(by_name)
@@ -185,6 +196,9 @@ def read_features(section: Section, defaults: Sequence[Column]) -> tuple[Column,
                 out[name] = replace(base, low=v, high=v, choices=())
         else:
             raise section.error(f"{where}: give [low, high], {{choices = [...]}} or a number")
+        if kind is not None:
+            c = out[name]
+            check_lengths(section, kind, {name: c.choices or sorted({c.low, c.high})})
     return tuple(out[c.name] for c in defaults)
 
 
@@ -203,6 +217,8 @@ def read_material(doc: Section) -> tuple[float, float, float]:
     if nu == 0.5:
         raise mat.error("nu = 0.5 is outside (-1, 0.5): an incompressible material has no model")
     density = mat.number("density", 1200.0, low=0.0, low_open=True)
+    for key, value in (("E", E), ("density", density)):
+        check_plausible(mat, key, value, *MATERIAL[key])
     mat.done()
     return E, nu, density
 

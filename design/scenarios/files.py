@@ -21,6 +21,7 @@ from pathlib import Path
 from holofold.design.scenarios.base import Scenario
 from holofold.design.scenarios.config import ScenarioFileError, Section
 from holofold.design.scenarios.kinds import get_kind, kind_names
+from holofold.geometry.inputs import check_input_file
 
 __all__ = [
     "read_scenario",
@@ -36,6 +37,10 @@ _SHIPPED = Path(__file__).with_name("shipped")
 def read_scenario(path: str | os.PathLike) -> Scenario:
     """The :class:`Scenario` described by a TOML file (relative paths inside are relative to it)."""
     path = Path(path)
+    try:
+        check_input_file(path, "scenario file")
+    except OSError as exc:
+        raise ScenarioFileError(str(exc)) from None
     try:
         text = path.read_bytes().decode("utf-8")
     except OSError as exc:

@@ -32,6 +32,12 @@ from holofold.design.scenarios.gripper import (
     simulate,
     write_gripper_files,
 )
+from holofold.design.scenarios.plausible import (
+    ENVIRONMENT,
+    MATERIAL,
+    check_lengths,
+    check_plausible,
+)
 
 __all__ = [
     "GRIPPER_FEATURES",
@@ -115,6 +121,10 @@ def _material(doc: Section) -> GripperMaterial:
     )
     if fields["nu"] == 0.5:
         raise mat.error("nu = 0.5 is outside (-1, 0.5)")
+    for key in ("E", "density"):
+        check_plausible(mat, key, fields[key], *MATERIAL[key])
+    for key in ("d_alpha", "k_panel", "k_crease"):
+        check_plausible(mat, key, fields[key], *ENVIRONMENT[key])
     mat.done()
     env = doc.sub("environment")
     fields |= dict(
@@ -125,6 +135,8 @@ def _material(doc: Section) -> GripperMaterial:
             "dissipation_deg", d.dissipation_deg, low=0.0, high=89.0, low_open=True
         ),
     )
+    for key, name in (("k_air", "k_air"), ("room_temperature", "room_temperature")):
+        check_plausible(env, name, fields[key], *ENVIRONMENT[key])
     env.done()
     return GripperMaterial(**fields)
 
@@ -150,13 +162,14 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
     q_load = heat.number("q_load", QLOAD, low=0.0, low_open=True)
     closure = heat.number("closure", CLOSURE, low=0.0, low_open=True)
     step_cap = heat.number("step_cap", None, low=1, high=100000, integer=True)
+    check_lengths(heat, "gripper", {"closure": closure})
     heat.done()
     sol = doc.sub("solver")
     converged = sol.raw("converged", False)
     if not isinstance(converged, bool):
         raise sol.error(f"converged = {converged!r} must be true or false")
     sol.done()
-    features = read_features(doc.sub("features"), GRIPPER_FEATURES)
+    features = read_features(doc.sub("features"), GRIPPER_FEATURES, kind="gripper")
     _check_features(doc, features)
     options = GripperOptions(
         converged=converged,

@@ -54,6 +54,7 @@ from holofold.design.scenarios.config import (
     read_material,
     read_solver,
 )
+from holofold.design.scenarios.plausible import FORCE, check_lengths, check_plausible
 from holofold.geometry import MAX_PANELS
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.miura import (
@@ -589,6 +590,7 @@ def _read_load(sec: Section, names: set) -> SheetLoad:
         force=sec.number("force", low=0.0, low_open=True),
         increments=sec.number("increments", 3, low=1, high=1000, integer=True),
     )
+    check_plausible(sec, "force", load.force, *FORCE)
     return load
 
 
@@ -623,6 +625,7 @@ def _read_sheet(sec: Section) -> dict:
         "size_y": sec.number("size_y", low=0.0, low_open=True),
         "extensions": _read_extensions(sec),
     }
+    check_lengths(sec, "sheet", {"size_x": out["size_x"], "size_y": out["size_y"]})
     if sec.has("gamma") and sec.has("gamma_deg"):
         raise sec.error("give gamma (rad) or gamma_deg, not both")
     if sec.has("gamma_deg"):
@@ -730,7 +733,7 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
     )
     # the optional moduli are features when the file names them (else E holds everywhere)
     moduli = any(fsec.has(k) for k in _OPTIONAL_E)
-    features = read_features(fsec, sheet_features(setting, moduli))
+    features = read_features(fsec, sheet_features(setting, moduli), kind="sheet")
     if moduli and not all(fsec.has(k) for k in _OPTIONAL_E):
         features = tuple(c for c in features if c.name not in _OPTIONAL_E or fsec.has(c.name))
     _check_features(doc, sheet, features)

@@ -54,6 +54,7 @@ from holofold.design.scenarios.config import (
     read_material,
     read_solver,
 )
+from holofold.design.scenarios.plausible import FORCE, check_plausible
 from holofold.fitting import (
     BUILTIN_CURVES,
     MAX_M,
@@ -523,11 +524,18 @@ def _read_curve(sec: Section) -> tuple[PlanarCurve, str, str | None]:
                             + ", ".join(LENGTH_UNITS))  # fmt: skip
         file = sec.path(given[0])
         if given[0] == "points":
-            curve = read_points_csv(file, units=unit)
+            columns = sec.raw("columns")
+            if columns is not None and not (
+                isinstance(columns, list) and len(columns) == 2
+                and all(isinstance(c, str | int) and not isinstance(c, bool) for c in columns)
+            ):  # fmt: skip
+                raise sec.error(f"columns = {columns!r} must be two column names or positions")
+            curve = read_points_csv(file, units=unit, columns=columns)
         else:  # without units: the drawing's own (width/height units and viewBox)
             frag = sec.raw("svg").partition("#")[2]
             curve = read_svg_curve(f"{file}#{frag}" if frag else file, units=unit)
-        sec.done(["svg" if given[0] == "svg" else "points", "units", "sampling"])
+        keys = ["svg"] if given[0] == "svg" else ["points", "columns"]
+        sec.done([*keys, "units", "sampling"])
         shown = unit or "the drawing's units"
         return curve, f"{given[0]} from {file.name} ({shown})", sampling
     except ValueError as exc:
@@ -547,6 +555,7 @@ def _read_load(sec: Section, names: set) -> StripLoad:
         snap_displacement=sec.number("snap_displacement", low=0.0, low_open=True),
     )  # fmt: skip
     sec.done(["name", "at", "direction", "force", "increments", "snap_displacement"])
+    check_plausible(sec, "force", load.force, *FORCE)
     return load
 
 
@@ -577,7 +586,7 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
         sampling=sampling,
         curve_label=label,
     )
-    features = read_features(doc.sub("features"), STRIP_FEATURES)
+    features = read_features(doc.sub("features"), STRIP_FEATURES, kind="strip")
     for c in features:
         if c.name != "m":
             continue
@@ -586,4 +595,29 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
             raise doc.error(f"[features] m must be integers >= 2, got {levels}")
         if max(levels) > MAX_M:
             raise doc.error(f"[features] m = {levels}: at most {MAX_M} (4m panels; docs/limits.md)")
+    _check_loads_off_supports(doc, setting, features)
     return strip_scenario(name, description, setting, features)
+
+
+def _check_loads_off_supports(doc: Section, setting: StripSetting, features) -> None:
+    """Refuse a load whose node is a support fixed along the load (for the smallest ``m``,
+    the coarsest snapping, and every ``m`` of a list of choices): it would carry nothing and
+    every row would give a non-finite or meaningless stiffness."""
+    if setting.supports == "side-ends":
+        return  # the loads act on the centre line
+    m = next(c for c in features if c.name == "m")
+    levels = sorted({int(v) for v in m.choices}) if m.choices else [int(m.low)]
+    axes = ["xyz".index(a) for a in setting.support_dofs]
+    for k, ld in enumerate(setting.loads, start=1):
+        if not any(ld.direction[a] for a in axes):
+            continue  # along free directions only
+        for level in levels:
+            g = strip_geometry(setting.curve, level, 0.2, 0.02, 0.15, setting.curve_sampling)
+            node = loaded_node(setting, level, ld.at, g.t)
+            if node in (int(g.centre[0]), int(g.centre[-1])):
+                raise doc.error(
+                    f"[load] {k}: at = {ld.at:g} puts the load on a support (the end node "
+                    f"{node} of the centre line for m = {level}, fixed in "
+                    f"{setting.support_dofs!r}): it would carry nothing; move it inside the "
+                    "arc, away from the supported ends"
+                )

@@ -13,9 +13,13 @@ iterates, starting from the previous increment's displacement::
 
 so there are at most ``max_iter - 1`` iterations and the first one always runs (the reference
 starts from ``R = 1``, which is the same for every ``tol < 1 m``). Convergence means
-``R <= tol`` after the last update. A non-converged increment is *accepted* (the last iterate is
-kept and the next increment starts from it), as the reference does; it is recorded in
-``SolveResult.converged`` and ``status``. Supported DOFs keep their current value (``U0``).
+``R <= tol`` after the last update, and, for an increment that adds load, a displacement change
+of at least ``RESOLUTION`` (1e-10) times the model's size: below that the displacement is at the
+round-off of the coordinates (a force of 1e-14 N, a modulus of 1e25 Pa) and whatever stiffness
+it gives is noise, so the increment is "not converged" with that reason. A non-converged
+increment is *accepted* (the last iterate is kept and the next increment starts from it), as
+the reference does; it is recorded in ``SolveResult.converged`` and ``status``. Supported DOFs
+keep their current value (``U0``).
 """
 
 from __future__ import annotations
@@ -25,9 +29,11 @@ import numpy as np
 from holofold.geometry.errors import ParameterError
 from holofold.mechanics.assembly import Assembler, BatchAssembler, SingularSystemError
 from holofold.mechanics.solvers._common import (
+    RESOLUTION,
     History,
     check_controls,
     get_assembler,
+    model_size,
     nodal_array,
 )
 from holofold.mechanics.solvers.result import SolveResult
@@ -83,11 +89,13 @@ def solve_newton(
     U = nodal_array("U0", U0, nn).ravel()
     free = asm.free_dofs
     hist = History(increments, nn)
+    floor = RESOLUTION * model_size(structure) if np.any(P[free]) else 0.0
     i = 0
     for i in range(1, increments + 1):
         Fi = F0v + i * P
         step = 1
         R = np.inf
+        start = U.copy() if floor else None
         # the compiled dense step where it applies, else the same operations here
         dense = asm.dense_stepper(U, Fi)
         try:
@@ -104,7 +112,8 @@ def solve_newton(
             hist.failure = f"increment {i}, iteration {step}: {exc}"
             hist.record(U, i, False, step - 1, R)
             break
-        hist.record(U, i, R <= tol, step - 1, R)
+        resolved = not floor or hist.check_resolution(float(np.abs(U - start).max()), floor)
+        hist.record(U, i, R <= tol and resolved, step - 1, R)
     return hist.result(tol, "||dU||", F0v + i * P, structure.spring_rest, "solve_newton")
 
 
@@ -158,11 +167,15 @@ def solve_newton_batch(
     hists = [History(increments, nn) for _ in range(S)]
     alive = np.ones(S, bool)
     last = np.zeros(S, np.int64)
+    free = B.free_dofs
+    floors = np.array([RESOLUTION * model_size(st) if np.any(P[s, free]) else 0.0
+                       for s, st in enumerate(structures)])  # fmt: skip
     for i in range(1, increments + 1):
         Fi = F0v + i * P
         step = np.ones(S, np.int64)
         R = np.full(S, np.inf)
         last[alive] = i
+        start = U.copy()
         while True:
             it = alive & (step < max_iter) & (R > tol)
             if not it.any():
@@ -177,8 +190,10 @@ def solve_newton_batch(
             ok = np.flatnonzero(it)
             R[ok] = np.sqrt(np.vecdot(dU[ok], dU[ok]))
             step[ok] += 1
+        moved = np.abs(U - start).max(axis=1)
         for s in np.flatnonzero(alive):
-            hists[s].record(U[s], i, R[s] <= tol, step[s] - 1, R[s])
+            ok = not floors[s] or hists[s].check_resolution(float(moved[s]), floors[s])
+            hists[s].record(U[s], i, R[s] <= tol and ok, step[s] - 1, R[s])
     return [
         hists[s].result(
             tol, "||dU||", F0v[s] + last[s] * P[s], structures[s].spring_rest, "solve_newton"
