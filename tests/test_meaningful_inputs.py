@@ -170,3 +170,11 @@ def test_unreadable_files_never_echo_content_and_say_what_the_path_is(tmp_path, 
     (tmp_path / "s.toml").write_text(shipped_text("arch").replace('builtin = "half-circle"',
                                      f'points = "{fifo}"\nunits = "m"'))  # fmt: skip
     _refused(tmp_path / "s.toml", "is a FIFO (named pipe), not a file")
+
+
+def test_a_gripper_rows_time_limit_follows_its_heating_step_cap(tmp_path):
+    from holofold.design import get_scenario
+
+    assert get_scenario("gripper").row_timeout == pytest.approx(120.0)  # 60 + 0.15 x 400
+    assert read_scenario(_edited(tmp_path, "gripper", r"^# step_cap = .*$",
+                                 "step_cap = 100")).row_timeout == pytest.approx(75.0)  # fmt: skip

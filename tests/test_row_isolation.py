@@ -127,7 +127,7 @@ def test_row_timeout_settings():
     assert get_scenario("arch").row_timeout == 60
     assert get_scenario("canopy").row_timeout == ROW_TIMEOUTS["sheet"] == 300
     assert get_scenario("gripper").row_timeout == get_scenario("gripper-converged").row_timeout
-    assert get_scenario("gripper").row_timeout == 600
+    assert get_scenario("gripper").row_timeout == 120
     assert TOY.row_timeout == ROW_TIMEOUTS[""]
     assert resolve_row_timeout(60.0) == 60.0
     assert resolve_row_timeout(60.0, 2) == 2.0

@@ -80,7 +80,7 @@ def single_thread():
 #: built-in scenario: slowest 0.02 s single Miura, 0.19 s arch, 1.3 s canopy, 2.3 s gripper of
 #: 6): over 100x the slowest row and at least 60 s, 4-7x the first row of a process whose numba
 #: kernels are compiled rather than loaded from their cache (9-13 s); docs/scenarios.md §1.3
-ROW_TIMEOUTS = {"": 60.0, "strip": 60.0, "sheet": 300.0, "gripper": 600.0}
+ROW_TIMEOUTS = {"": 60.0, "strip": 60.0, "sheet": 300.0, "gripper": 120.0}
 
 
 def _number(v: float, digits: int) -> str:

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from holofold.design.scenarios.base import ROW_TIMEOUTS, Column, Scenario, positive, single_thread
+from holofold.design.scenarios.base import Column, Scenario, positive, single_thread
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.gripper import DEFAULT_RANGE, GripperPattern, gripper_pattern
 from holofold.geometry.pattern import CreasePattern
@@ -93,6 +93,7 @@ __all__ = [
     "STATUS_NO_CLOSURE",
     "gripper_shape",
     "write_gripper_files",
+    "gripper_row_timeout",
 ]
 
 # constants of every gripper script (the defaults of GripperMaterial and GripperOptions)
@@ -108,6 +109,19 @@ ROOM_T = 21.0
 ENV_LAYERS = 10
 DISSIPATION_DEG = 20.0
 STEP_CAP = {1: 400, 2: 400, 3: 300}
+
+
+def gripper_row_timeout(step_cap: int | None = None) -> float:
+    """Seconds a gripper row may take, from the size of its work: 60 s (a process's first row
+    compiles the kernels in 9-13 s) plus 0.15 s per heating step of the cap (``step_cap``, or
+    the largest pattern's). Measured: about 6 ms per heating step, 2.3 s for the slowest of six
+    warm rows (cap 400), so 120 s by default is 50 times that; a row past it (a design far
+    outside the paper's sizes: arms of metres took 20 s per row) is cut short and recorded as
+    a timeout."""
+    cap = step_cap or max(STEP_CAP.values())
+    return 60.0 + 0.15 * cap
+
+
 PREBIAS_FORCE = 1e-10  #: N per node and increment (step B)
 PREBIAS_INCREMENTS = 10
 PREBIAS_TOL = 5e-6  #: m
@@ -841,7 +855,7 @@ SCENARIO = Scenario(
     check=check,
     evaluate=evaluate,
     categorical=("Pattern",),
-    row_timeout=ROW_TIMEOUTS["gripper"],
+    row_timeout=gripper_row_timeout(),
     shape=gripper_shape,
     write_files=write_gripper_files,
 )

@@ -28,6 +28,7 @@ from holofold.design.scenarios.gripper import (
     GripperMaterial,
     GripperOptions,
     check,
+    gripper_row_timeout,
     gripper_shape,
     simulate,
     write_gripper_files,
@@ -103,6 +104,7 @@ def gripper_scenario(
         source=source,
         shape=gripper_shape,
         write_files=write_gripper_files,
+        row_timeout=gripper_row_timeout(options.step_cap),
     )
 
 

@@ -68,7 +68,7 @@ def add_row_arguments(p: argparse.ArgumentParser, on_invalid: str = "fail") -> N
         help=(
             "time limit per design in seconds, past which the row is recorded as "
             "'failed: timeout ...' and the run goes on; 0 or none = no limit (default: the "
-            "scenario's, 60 s for single-miura and arch, 300 s canopy, 600 s gripper)"
+            "scenario's, 60 s for single-miura and arch, 300 s canopy, 120 s gripper)"
         ),
     )
 
