@@ -3,7 +3,8 @@
 Models (:mod:`~holofold.mechanics.structure`, :mod:`~holofold.mechanics.hinges`: concentrated
 and compliant creases), element kernels (:mod:`~holofold.mechanics.bars`,
 :mod:`~holofold.mechanics.springs`), the sparse assembly built once per topology
-(:mod:`~holofold.mechanics.assembly`), solvers (:mod:`~holofold.mechanics.solvers`: Newton-
+(:mod:`~holofold.mechanics.assembly`; the optional supernodal sparse Cholesky of large models,
+:mod:`~holofold.mechanics.sparse_cholesky`), solvers (:mod:`~holofold.mechanics.solvers`: Newton-
 Raphson, displacement control, MGDCM, self-folding), analyses (secant stiffness, snapping),
 :mod:`~holofold.mechanics.thermal`, :mod:`~holofold.mechanics.modal`, the :class:`Status` of
 a computation, and every paper quirk in :mod:`~holofold.mechanics.compat`. See
