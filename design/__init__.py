@@ -68,6 +68,17 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "faults": ["as_environment_fault"],
         "row_limits": ["RowTimeout", "ON_INVALID", "check_on_invalid", "resolve_row_timeout"],
         "sampling": ["sample_designs", "METHODS"],
+        "simulate": [
+            "PatternLoad",
+            "PatternSetting",
+            "PatternSimulation",
+            "LoadOutcome",
+            "simulate_pattern",
+            "write_simulation",
+            "plot_simulation",
+            "scaled_pattern",
+            "pattern_mass",
+        ],
         "scenarios.strip": ["StripSetting", "StripLoad", "strip_scenario", "STRIP_FEATURES"],
         "scenarios": [
             "Scenario",

@@ -34,6 +34,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "dxf": ["DXF_LAYERS", "export_dxf"],
         "facets": ["split_faces", "nonconvex_faces", "SPLIT_MODES"],
         "fold_io": ["export_fold", "fold_dict", "load_fold", "read_fold", "FoldWarning"],
+        "fold_frames": ["fold_path_dict", "export_fold_path"],
         "gripper": [
             "GripperPattern",
             "gripper_pattern",
@@ -84,5 +85,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "svg": ["export_svg", "load_svg", "polylines_svg"],
         "tmp": ["tmp_sheet", "tmp_nodes", "tmp_faces"],
         "units": ["LENGTH_UNITS", "length_factor"],
+        "vertex_sets": ["VertexSet", "parse_vertex_set", "VERTEX_SET_KINDS"],
     },
 )

@@ -201,7 +201,8 @@ def pattern_from_lines(
     split: str = "as-needed", meta: dict | None = None, notes=(),
 ) -> CreasePattern:  # fmt: skip
     """The crease pattern of drawn lines (drawing units; ``unit`` metres per drawing unit;
-    ``tol`` the merge distance in drawing units, default 1e-3 of the drawing's larger side)."""
+    ``tol`` the merge distance in drawing units, default 2e-3 of the drawing's larger side),
+    placed with the lower-left corner of its extent at the origin."""
     from holofold.geometry.arrangement import arrange_lines
 
     if not (np.isfinite(unit) and unit > 0):
@@ -212,7 +213,8 @@ def pattern_from_lines(
         arr = arrange_lines(segments, assignment, fold_angle, tol=tol)
     except FormatError as exc:
         raise FormatError(f"{name}: {exc}") from None
+    xy = (arr.vertices - arr.vertices.min(axis=0)) * unit  # lower-left corner at the origin
     return finish_pattern(
-        arr.vertices * unit, arr.faces, arr.edges, arr.assignment, arr.fold_angle,
+        xy, arr.faces, arr.edges, arr.assignment, arr.fold_angle,
         name=name, notes=[*notes, *arr.notes], split=split, meta=meta,
     )  # fmt: skip

@@ -40,6 +40,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "MAX_FOLD_DEG",
         ],
         "hinges": ["build_concentrated", "build_compliant", "crease_rest_targets"],
+        "materials": ["Material", "MATERIALS", "get_material"],
         "measures": ["model_energy", "ModelEnergy"],
         "modal": ["lumped_mass", "natural_frequencies", "eigenvalues"],
         "solvers": [

@@ -136,8 +136,10 @@ def secant_stiffness(
     tol: float,
     max_iter: int = 30,
     assembler=None,
+    U0=None,
 ) -> StiffnessResult:
-    """Newton-Raphson load control from the stress-free state and the secant stiffness.
+    """Newton-Raphson load control from the stress-free state (or from ``U0``) and the
+    secant stiffness.
 
     Parameters
     ----------
@@ -151,21 +153,29 @@ def secant_stiffness(
     increments, tol, max_iter
         Newton-Raphson controls (``tol`` on ||dU||_2 in metres; at most ``max_iter - 1``
         iterations per increment, the reference's cap).
+    U0 : (nn, 3) float, optional
+        An equilibrium to load from (e.g. a folded state: the structure's rest angles must be
+        those it was reached with); the displacement is then measured from it. Default 0.
 
     Returns
     -------
     StiffnessResult
-        ``increments * force_per_increment / mean |U_axis(group)|`` after the last increment.
+        ``increments * force_per_increment / mean |U_axis(group)|`` after the last increment
+        (``U - U0``).
     """
     load = group.load(structure.n_nodes, force_per_increment)
     res = solve_newton(
-        structure, load, increments=increments, tol=tol, max_iter=max_iter, assembler=assembler
-    )
-    return _stiffness(group, res, force_per_increment)
+        structure, load, increments=increments, tol=tol, max_iter=max_iter, assembler=assembler,
+        U0=U0,
+    )  # fmt: skip
+    return _stiffness(group, res, force_per_increment, U0)
 
 
-def _stiffness(group: LoadGroup, res: SolveResult, force_per_increment: float) -> StiffnessResult:
-    u = float(np.mean(np.abs(group.displacements(res.U))))
+def _stiffness(
+    group: LoadGroup, res: SolveResult, force_per_increment: float, U0=None
+) -> StiffnessResult:
+    U = res.U if U0 is None else res.U - np.asarray(U0, float).reshape(res.U.shape)
+    u = float(np.mean(np.abs(group.displacements(U))))
     total = force_per_increment * len(res.load_factor)
     k = total / u if u > 0 else float("inf")
     return StiffnessResult(stiffness=k, displacement=u, result=res)

@@ -1,5 +1,5 @@
-"""The registry of scenario-file kinds: ``kind = "strip"``, ``"sheet"``, ``"gripper"`` and any
-kind another package adds.
+"""The registry of scenario-file kinds: ``kind = "strip"``, ``"sheet"``, ``"gripper"``,
+``"pattern"`` and any kind another package adds.
 
 A kind is a :class:`ScenarioKind`: a name, one line of description and
 ``from_config(doc, name, description) -> Scenario``, which reads the file's tables through
@@ -71,6 +71,10 @@ BUILTIN_KINDS = {
     "gripper": (
         "holofold.design.scenarios.gripper_kind",
         "the electro-thermal grippers with your material",
+    ),
+    "pattern": (
+        "holofold.design.scenarios.pattern_kind",
+        "any crease pattern file (FOLD, SVG, DXF, ORIPA), folded, then loaded",
     ),
 }
 _REGISTERED: dict[str, ScenarioKind] = {}

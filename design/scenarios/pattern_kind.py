@@ -1,0 +1,350 @@
+"""The pattern kind: any crease-pattern file as the design's geometry (``kind = "pattern"``).
+
+docs/scenarios.md §8.5. The file names a crease pattern (FOLD, SVG, DXF, ORIPA; read once, when
+the scenario file is read, by :func:`holofold.geometry.read_pattern`), the material, the
+supports and loads as named vertex sets (:mod:`holofold.geometry.vertex_sets`) and the design
+features. Every design is :func:`holofold.design.simulate.simulate_pattern`: the pattern, scaled
+by ``scale``, folded by rest-angle actuation to ``fold`` x its fold angles, then loaded.
+
+Features (SI): ``tpanel``, ``tcrease``, ``W`` (panel and crease thickness, crease width, m),
+``fold`` (fold fraction), ``scale`` (uniform scale of the pattern as read, and as ``[pattern]
+size`` sets it).
+
+Columns: per load ``{name}stiff`` (N/m, from the folded state), ``energy`` (J, stored by the
+fold), ``mass`` (kg, the flat sheet: panels of tpanel thinned to tcrease over W along every
+crease), ``overlap`` (m^3) and ``clearance`` (m) of the folded thick panels, ``reached`` (the
+fold fraction reached: below ``fold`` when the fold stops short, which makes the row not
+converged).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from functools import partial
+
+import numpy as np
+
+from holofold.design.scenarios.base import Column, Scenario, positive
+from holofold.design.scenarios.config import (
+    Section,
+    load_name,
+    read_direction,
+    read_dofs,
+    read_features,
+    read_loads,
+    read_material,
+    read_solver,
+)
+from holofold.design.simulate import (
+    PatternLoad,
+    PatternSetting,
+    scaled_pattern,
+    simulate_pattern,
+)
+from holofold.geometry import CreasePattern
+from holofold.geometry.vertex_sets import parse_vertex_set
+from holofold.mechanics.materials import Material
+from holofold.mechanics.status import Outcome, Status
+
+__all__ = [
+    "PATTERN_FEATURES",
+    "PatternScenarioSetting",
+    "pattern_scenario",
+    "evaluate_pattern",
+    "pattern_shape",
+    "write_pattern_files",
+    "from_config",
+    "DESCRIPTION",
+]
+
+DESCRIPTION = "any crease pattern file (FOLD, SVG, DXF, ORIPA), folded, then loaded"
+
+#: the features of a pattern design, with default ranges
+PATTERN_FEATURES = (
+    Column("tpanel", "m", "panel thickness", 0.5e-3, 2e-3),
+    Column("tcrease", "m", "crease thickness", 0.2e-3, 0.6e-3),
+    Column("W", "m", "crease width", 0.5e-3, 2e-3),
+    Column("fold", "-", "fold fraction (Origami Simulator's fold percent / 100)", 0.3, 0.9),
+    Column("scale", "-", "uniform scale of the pattern", 0.8, 1.2),
+)
+#: a pattern row may fold a large pattern: its default time limit, s
+PATTERN_ROW_TIMEOUT = 900.0
+
+
+@dataclass(frozen=True)
+class PatternScenarioSetting:
+    """The fixed setting of a pattern scenario.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+        As read (and sized by ``[pattern] size``), m.
+    source : str
+        The file it was read from.
+    material : Material
+    model : str
+    supports : tuple of str
+        Vertex sets held during the loads.
+    support_dofs : str
+    loads : tuple of PatternLoad
+    tol, max_iter
+        Newton controls of the loads.
+    collisions : bool
+        Compute overlap and clearance (the folded thick panels).
+    """
+
+    pattern: CreasePattern
+    source: str
+    material: Material
+    model: str = "concentrated"
+    supports: tuple[str, ...] = ()
+    support_dofs: str = "xyz"
+    loads: tuple[PatternLoad, ...] = ()
+    tol: float = 1e-9
+    max_iter: int = 30
+    collisions: bool = True
+
+
+def pattern_columns(setting: PatternScenarioSetting) -> tuple[Column, ...]:
+    cols = [
+        Column(
+            f"{ld.name}stiff", "N/m", f"secant stiffness under {ld.force:g} N at {ld.at}, folded"
+        )
+        for ld in setting.loads
+    ]
+    cols += [
+        Column("energy", "J", "elastic energy stored by the fold"),
+        Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
+        Column("overlap", "m^3", "intersection volume of the folded thick panels"),
+        Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
+        Column("reached", "-", "fold fraction reached"),
+    ]
+    return tuple(cols)
+
+
+def _setting_for(setting: PatternScenarioSetting, row) -> PatternSetting:
+    return PatternSetting(
+        material=setting.material, panel_thickness=float(row["tpanel"]),
+        crease_thickness=float(row["tcrease"]), crease_width=float(row["W"]),
+        fold=float(row["fold"]), model=setting.model, supports=setting.supports,
+        support_dofs=setting.support_dofs, loads=setting.loads, tol=setting.tol,
+        max_iter=setting.max_iter, collisions=setting.collisions,
+    )  # fmt: skip
+
+
+def _pattern(setting: PatternScenarioSetting, row) -> CreasePattern:
+    s = float(row["scale"])
+    return setting.pattern if s == 1.0 else scaled_pattern(setting.pattern, s)
+
+
+def check_pattern(setting: PatternScenarioSetting, row) -> list[str]:
+    errs = positive(row, ("tpanel", "tcrease", "W", "scale"))
+    f = row.get("fold")
+    if f is None or not math.isfinite(f) or not 0 <= f <= 1:
+        errs.append(f"fold = {f!r} must lie in [0, 1]")
+    return errs
+
+
+def evaluate_pattern(setting: PatternScenarioSetting, columns: Sequence[str], row) -> dict:
+    """The columns of one design and its status."""
+    sim = simulate_pattern(_pattern(setting, row), _setting_for(setting, row))
+    out = {f"{o.name}stiff": o.stiffness for o in sim.loads}
+    out["energy"] = sim.fold.energy.total
+    out["mass"] = sim.mass
+    out["overlap"] = math.nan if sim.overlap is None else sim.overlap
+    out["clearance"] = math.nan if sim.clearance is None else min(sim.clearance, 1e3)
+    out["reached"] = sim.fold.reached
+    status = sim.status
+    if not status.converged and status.outcome is Outcome.FAILED:
+        status = Status.not_converged(*status.reasons)
+    return {**{c: out[c] for c in columns}, "status": status}
+
+
+def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
+    """The design's pattern folded as far as its fold got (flat layout kept), m."""
+    from holofold.mechanics.folding import fold_pattern
+
+    s = _setting_for(setting, row)
+    fold = fold_pattern(
+        _pattern(setting, row), s.fold, panel_thickness=s.panel_thickness,
+        crease_thickness=s.crease_thickness, crease_width=s.crease_width, E=s.material.E,
+        nu=s.material.nu, model=s.model,
+    )  # fmt: skip
+    return fold.folded()
+
+
+def write_pattern_files(
+    setting: PatternScenarioSetting, row, folder, units: str = "mm", cutter=None
+):
+    """The design's fabrication set (:func:`~holofold.geometry.write_fabrication_set`) for the
+    pattern folded as far as its fold got: printable part, FOLD, SVG and DXF for ``cutter``,
+    STL/OBJ and the thick solid; without the solids (a note says why) where the panels do not
+    allow them."""
+    from holofold.geometry import FabricationSet, write_fabrication_set
+
+    shape = pattern_shape(setting, row)
+    W = float(row["W"])
+    try:
+        return write_fabrication_set(
+            shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
+            crease_thickness=float(row["tcrease"]), units=units, cutter=cutter,
+        )  # fmt: skip
+    except ValueError as exc:
+        warnings.warn(f"no solids: {exc}", stacklevel=2)
+        got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
+        return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
+
+
+def pattern_scenario(
+    name: str,
+    description: str,
+    setting: PatternScenarioSetting,
+    features: tuple[Column, ...] = PATTERN_FEATURES,
+    *,
+    source: str = "",
+) -> Scenario:
+    """The :class:`Scenario` of a pattern setting (picklable for worker processes)."""
+    perf = pattern_columns(setting)
+    p = setting.pattern
+    size = np.ptp(p.flat if p.flat is not None else p.coords, axis=0)
+    words = {
+        "pattern": f"{setting.source}: {p.n_vertices} vertices, {p.n_faces} panels, "
+        f"{1e3 * size[0]:.4g} x {1e3 * size[1]:.4g} mm at scale 1",
+        "model": setting.model,
+        "E (Pa)": setting.material.E,
+        "nu": setting.material.nu,
+        "density (kg/m^3)": setting.material.density,
+        "supports": ", ".join(setting.supports) + f" fixed in {setting.support_dofs}"
+        if setting.supports else "none (no loads)",
+    }  # fmt: skip
+    for ld in setting.loads:
+        words[f"load {ld.name}"] = (
+            f"{ld.force:g} N along ({', '.join(f'{v:g}' for v in ld.direction)}) shared by "
+            f"{ld.at}, {ld.increments} increments, from the folded state"
+        )
+    cols = tuple(c.name for c in perf)
+    return Scenario(
+        name=name,
+        description=description or f"crease pattern {setting.source}, folded and loaded",
+        features=features,
+        performance=perf,
+        check=partial(check_pattern, setting),
+        evaluate=partial(evaluate_pattern, setting, cols),
+        kind="pattern",
+        setting=words,
+        source=source,
+        shape=partial(pattern_shape, setting),
+        write_files=partial(write_pattern_files, setting),
+        row_timeout=PATTERN_ROW_TIMEOUT,
+    )
+
+
+# ---------------------------------------------------------------------- scenario files
+_PATTERN_KEYS = ("file", "size", "unit", "tol", "frame", "split", "curves", "model")
+
+
+def _read_pattern(sec: Section) -> tuple[CreasePattern, str, str]:
+    from holofold.geometry import read_pattern, reader_for
+
+    for k in _PATTERN_KEYS:
+        sec.raw(k)
+    sec.done(_PATTERN_KEYS)
+    if not sec.has("file"):
+        raise sec.error("missing key 'file' (the crease pattern: .fold, .svg, .dxf, .opx, .cp)")
+    path = sec.path("file")
+    try:
+        reader = reader_for(path)
+    except ValueError as exc:
+        raise sec.error(str(exc)) from None
+    opts = {}
+    for k, kind in (("unit", "number"), ("tol", "number"), ("frame", "int"), ("split", "str"),
+                    ("curves", "str")):  # fmt: skip
+        if not sec.has(k):
+            continue
+        if k not in reader.options:
+            raise sec.error(f"{k}: {reader.name} files take no {k!r}")
+        if kind == "number":
+            opts[k] = sec.number(k, low=0.0, low_open=True)
+        elif kind == "int":
+            opts[k] = sec.number(k, low=0, integer=True)
+        else:
+            opts[k] = sec.string(k)
+    model = sec.choice("model", ("concentrated", "compliant"), "concentrated")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # repairs are reported when the file is simulated
+            pattern = read_pattern(path, **opts)
+    except ValueError as exc:
+        raise sec.error(f"file = {sec.raw('file')!r}: {exc}") from None
+    if sec.has("size"):
+        size = sec.number("size", low=0.0, low_open=True)
+        span = float(
+            np.ptp(pattern.flat if pattern.flat is not None else pattern.coords, axis=0).max()
+        )
+        pattern = scaled_pattern(pattern, size / span)
+    return replace(pattern, meta={**pattern.meta, "source": path.name}), path.name, model
+
+
+def _read_load(sec: Section, names: set) -> PatternLoad:
+    for k in ("name", "at", "direction", "force", "increments"):
+        sec.raw(k)
+    sec.done(["name", "at", "direction", "force", "increments"])
+    name = load_name(sec, names, "'press'")
+    at = sec.string("at")
+    if not at:
+        raise sec.error("missing key 'at' (a vertex set such as 'near:50%,50%,4')")
+    if not sec.has("force"):
+        raise sec.error("missing key 'force' (total force, N)")
+    try:
+        return PatternLoad(
+            name=name, at=parse_vertex_set(at), direction=read_direction(sec),
+            force=sec.number("force", low=0.0, low_open=True),
+            increments=sec.number("increments", 5, low=1, high=1000, integer=True),
+        )  # fmt: skip
+    except ValueError as exc:
+        raise sec.error(str(exc)) from None
+
+
+def from_config(doc: Section, name: str, description: str) -> Scenario:
+    """The pattern scenario of a parsed scenario file (``kind = "pattern"``)."""
+    pattern, source, model = _read_pattern(doc.sub("pattern", required=True))
+    E, nu, density = read_material(doc)
+    sup = doc.sub("supports")
+    at = sup.raw("at", [])
+    if isinstance(at, str):
+        at = [at]
+    if not isinstance(at, list) or not all(isinstance(a, str) for a in at):
+        raise sup.error(f"at = {at!r} must be a vertex set or a list of them")
+    for a in at:
+        try:
+            parse_vertex_set(a).select(pattern)
+        except ValueError as exc:
+            raise sup.error(str(exc)) from None
+    dofs = read_dofs(sup)
+    sup.done()
+    tol, max_iter = read_solver(doc)
+    loads = read_loads(doc, _read_load) if doc.has("load") else []
+    for ld in loads:
+        try:
+            ld.at.select(pattern)
+        except ValueError as exc:
+            raise doc.error(f"[load] {ld.name}: {exc}") from None
+    if loads and not at:
+        raise sup.error("loads need supports: at = ['side:-x', ...] (vertex sets held)")
+    setting = PatternScenarioSetting(
+        pattern=pattern, source=source, material=Material("file", E, nu, density), model=model,
+        supports=tuple(at), support_dofs=dofs, loads=tuple(loads), tol=tol,
+        max_iter=max_iter,
+    )  # fmt: skip
+    features = read_features(doc.sub("features"), PATTERN_FEATURES)
+    for c in features:
+        lo = min(c.choices) if c.choices else c.low
+        hi = max(c.choices) if c.choices else c.high
+        if c.name == "fold" and not (0 <= lo and hi <= 1):
+            raise doc.error(f"[features] fold = [{lo:g}, {hi:g}] must lie in [0, 1]")
+        if c.name != "fold" and not lo > 0:
+            raise doc.error(f"[features] {c.name} must be > 0, got {lo:g}")
+    return pattern_scenario(name, description, setting, features)
