@@ -7,7 +7,11 @@
 :mod:`~holofold.fitting.error` (index-matched and closest-point errors),
 :mod:`~holofold.fitting.auto` (choosing m and offset for a tolerance) and
 :mod:`~holofold.fitting.strip_files` (a fitted strip's fabrication files). See
-docs/strip-fit.md. Imports only from holofold.geometry.
+docs/strip-fit.md. Surfaces (docs/surface-fit.md): :mod:`~holofold.fitting.surfaces` (target
+surfaces: built-ins, height functions, mesh files), :mod:`~holofold.fitting.quadmesh` (the
+generalised Miura-ori's conditions and flat layout), :mod:`~holofold.fitting.surface_fit` (the
+fit) and :mod:`~holofold.fitting.surface_files` (its files). Imports only from
+holofold.geometry.
 """
 
 import lazy_loader
@@ -48,5 +52,26 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "strip": ["SAMPLINGS", "MAX_M", "StripGeometry", "strip_geometry"],
         "strip_files": ["export_strip_files", "write_strip_set"],
         "strip_fit": ["StripFit", "fit_strip"],
+        "surfaces": [
+            "BUILTIN_SURFACES",
+            "MESH_SURFACE_TYPES",
+            "SurfaceError",
+            "SurfaceUnitWarning",
+            "TargetSurface",
+            "builtin_surface",
+            "height_surface",
+            "load_surface",
+            "mesh_surface",
+            "read_surface",
+        ],
+        "quadmesh": ["QuadGrid", "develop", "sector_angles", "quad_warp"],
+        "surface_fit": [
+            "CONSTRAINT_TOL",
+            "Placement",
+            "SurfaceFit",
+            "SurfaceFitError",
+            "fit_surface",
+            "starting_tiling",
+        ],
     },
 )

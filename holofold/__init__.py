@@ -36,8 +36,16 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
         "geometry": ["CreasePattern", "miura_sheet", "tmp_sheet", "export"],
-        "fitting": ["builtin_curve", "load_curve", "fit_strip", "fit_auto"],
-        "mechanics": ["build_concentrated", "secant_stiffness", "PAPER"],
+        "fitting": [
+            "builtin_curve",
+            "load_curve",
+            "fit_strip",
+            "fit_auto",
+            "builtin_surface",
+            "load_surface",
+            "fit_surface",
+        ],
+        "mechanics": ["build_concentrated", "secant_stiffness", "PAPER", "check_fold"],
         "design": [
             "get_scenario",
             "evaluate_designs",

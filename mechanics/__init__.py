@@ -6,7 +6,8 @@ and compliant creases), element kernels (:mod:`~holofold.mechanics.bars`,
 (:mod:`~holofold.mechanics.assembly`; the optional supernodal sparse Cholesky of large models,
 :mod:`~holofold.mechanics.sparse_cholesky`), solvers (:mod:`~holofold.mechanics.solvers`: Newton-
 Raphson, displacement control, MGDCM, self-folding), analyses (secant stiffness, snapping),
-:mod:`~holofold.mechanics.thermal`, :mod:`~holofold.mechanics.modal`, the :class:`Status` of
+:mod:`~holofold.mechanics.thermal`, :mod:`~holofold.mechanics.modal`,
+:mod:`~holofold.mechanics.fold_check` (a fitted surface folded from flat), the :class:`Status` of
 a computation, and every paper quirk in :mod:`~holofold.mechanics.compat`. See
 docs/bar-and-hinge.md and docs/electro-thermal.md. Imports only geometry and fitting.
 """
@@ -31,6 +32,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "kernels": ["KERNEL_PATHS", "KernelPath", "KernelWarning", "check_environment"],
         "bars": ["bar_forces", "bar_strain"],
         "compat": ["Profile", "PAPER", "PHYSICAL"],
+        "fold_check": ["FoldCheck", "check_fold", "FOLD_TOLERANCE"],
         "folding": [
             "fold_pattern",
             "FoldResult",

@@ -1,0 +1,614 @@
+"""A generalised Miura-ori fitted to a target surface (docs/surface-fit.md).
+
+:func:`fit_surface` lays an m x n Miura-ori over a chart of the target (the starting tiling: its
+even rows of vertices on the surface, the odd rows offset along the normal by the Miura's
+height), then solves for the folded vertex positions X (nv, 3):
+
+    minimise   sum over the side vertices (n . (x - foot))^2 + w_f^2 |fairness|^2 + anchor
+    subject to every quad planar, angle sum 2 pi and Kawasaki at every interior vertex
+
+by Gauss-Newton sequential quadratic programming with analytic Jacobians: a restoration phase
+(Newton steps onto the constraints from the tiling) then feasible Gauss-Newton steps, each with
+second-order corrections back onto the constraints, damped Levenberg-Marquardt style. Each
+linear step is a saddle-point (KKT) system, solved by MINRES preconditioned with the augmented
+Lagrangian block ``J_s^T J_s + mu I + rho J_c^T J_c`` (a banded Cholesky factorisation, reused
+while it keeps MINRES short) and ``I / rho``. The result carries its flat crease pattern (the
+exact development of the folded quads), a :class:`~holofold.geometry.pattern.CreasePattern` with
+M/V assignments and fold angles, the distances of the fitted side to the target and every
+constraint's residual.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg as sl
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from threadpoolctl import threadpool_limits
+
+from holofold.fitting.quadmesh import (
+    QuadGrid,
+    SparsePattern,
+    constraints,
+    develop,
+    planarity_scale,
+    quad_warp,
+    sector_angles,
+    vertex_conditions,
+)
+from holofold.fitting.surfaces import TargetSurface, load_surface
+from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
+from holofold.geometry.miura import check_count, miura_nodes
+from holofold.geometry.pattern import MAX_PANELS, CreasePattern
+from holofold.geometry.units import length_factor
+
+__all__ = [
+    "CONSTRAINT_TOL",
+    "Placement",
+    "SurfaceFit",
+    "SurfaceFitError",
+    "fit_surface",
+    "starting_tiling",
+]
+
+#: constraint residual (rad, and relative warp) a fit must reach
+CONSTRAINT_TOL = 1e-10
+#: augmented-Lagrangian weight of the preconditioner (dimensionless units)
+_RHO = 1e6
+
+
+class SurfaceFitError(DegenerateGeometryError):
+    """A fit that cannot be made (a placement off the chart, constraints that cannot be met)."""
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the pattern sits on the target's chart.
+
+    ``centre`` (u, v) m, default the chart's centre; ``size`` (Lu, Lv) m, the folded footprint
+    of the starting tiling along the pattern's i and j directions, default the chart's extent;
+    ``angle`` rad, the i direction's angle from the chart's u axis.
+    """
+
+    centre: tuple[float, float] | None = None
+    size: tuple[float, float] | None = None
+    angle: float = 0.0
+
+    def resolved(self, surface: TargetSurface) -> tuple[np.ndarray, np.ndarray, float]:
+        u0, u1, v0, v1 = surface.domain
+        c = np.array([(u0 + u1) / 2, (v0 + v1) / 2] if self.centre is None else self.centre, float)
+        s = np.array([u1 - u0, v1 - v0] if self.size is None else self.size, float)
+        if c.shape != (2,) or s.shape != (2,) or not np.isfinite(np.r_[c, s]).all():
+            raise ParameterError(f"placement centre and size must be two finite numbers each, "
+                                 f"got {self.centre!r}, {self.size!r}")  # fmt: skip
+        if (s <= 0).any():
+            raise ParameterError(f"placement size must be > 0, got {s.tolist()}")
+        check_range("placement angle", self.angle, -2 * math.pi, 2 * math.pi)
+        return c, s, float(self.angle)
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class SurfaceFit:
+    """A generalised Miura-ori fitted to a target surface.
+
+    Attributes
+    ----------
+    target : TargetSurface
+    m, n : int
+        Quads along i (the zig-zag direction) and along j.
+    coords : (nv, 3) float
+        Folded vertex positions, m.
+    flat : (nv, 2) float
+        The flat crease pattern, m (every quad counter-clockwise).
+    side : (k,) int
+        Vertex ids of the fitted side (rows j = 0, 2, ...).
+    distance : (k,) float
+        Signed distances of the side vertices to the target, m.
+    residuals : dict
+        Largest planarity warp (diagonal distance / mean diagonal), angle-sum and Kawasaki
+        residuals (rad), development mismatch (largest relative edge-length difference
+        between the flat and the folded pattern).
+    ok : bool
+        The constraints are met to :data:`CONSTRAINT_TOL`: the pattern is a generalised
+        Miura-ori (planar quads, developable and flat-foldable vertices).
+    message : str
+        How the solve ended.
+    iterations : int
+    seconds : float
+        Time to fit.
+    options : dict
+        The fit's inputs (gamma, ext, side, placement, fairness).
+    """
+
+    target: TargetSurface
+    m: int
+    n: int
+    coords: np.ndarray
+    flat: np.ndarray
+    side: np.ndarray
+    distance: np.ndarray
+    residuals: dict
+    ok: bool
+    message: str
+    iterations: int
+    seconds: float
+    options: dict = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        return (f"SurfaceFit({self.target.name!r}, {self.m}x{self.n}, rms={self.rms:.4g} m, "
+                f"max={self.max:.4g} m, ok={self.ok})")  # fmt: skip
+
+    @property
+    def grid(self) -> QuadGrid:
+        return QuadGrid(self.m, self.n)
+
+    @property
+    def n_panels(self) -> int:
+        return self.m * self.n
+
+    @property
+    def rms(self) -> float:
+        """RMS distance of the fitted side to the target, m."""
+        return float(np.sqrt(np.mean(self.distance**2)))
+
+    @property
+    def max(self) -> float:
+        """Largest distance of the fitted side to the target, m."""
+        return float(np.abs(self.distance).max())
+
+    @property
+    def flat_size(self) -> tuple[float, float]:
+        """Width and height of the flat pattern's bounding box, m."""
+        w, h = np.ptp(self.flat, axis=0)
+        return float(w), float(h)
+
+    @cached_property
+    def pattern(self) -> CreasePattern:
+        """The crease pattern: folded ``coords``, ``flat`` layout, M/V and fold angles (FOLD
+        convention) measured on the folded state."""
+        return CreasePattern.from_faces(
+            self.coords,
+            list(self.grid.quads),
+            flat=self.flat,
+            meta={
+                "kind": "surface-fit",
+                "generator": "holofold.fitting.fit_surface",
+                "target": self.target.name,
+                "target_params": _plain(self.target.params),
+                "m": self.m,
+                "n": self.n,
+            },
+        )
+
+    @property
+    def errors(self) -> dict[str, float]:
+        """Distances (m, relative to the target's size, and in the target file's units), the
+        constraint residuals and the flat pattern's size (m)."""
+        size = self.target.size
+        per = length_factor(self.target.units)
+        w, h = self.flat_size
+        return {
+            "rms_error": self.rms,
+            "max_error": self.max,
+            "rms_error_rel": self.rms / size,
+            "max_error_rel": self.max / size,
+            f"rms_error_{self.target.units}": self.rms / per,
+            f"max_error_{self.target.units}": self.max / per,
+            "target_size": size,
+            **self.residuals,
+            "flat_width": w,
+            "flat_height": h,
+        }
+
+    @property
+    def summary(self) -> dict:
+        """Inputs, errors and solve statistics as plain JSON-ready values."""
+        return {
+            "target": self.target.name,
+            "target_params": _plain(self.target.params),
+            "units": self.target.units,
+            "m": self.m,
+            "n": self.n,
+            "panels": self.n_panels,
+            **_plain(self.options),
+            **self.errors,
+            "ok": self.ok,
+            "message": self.message,
+            "iterations": self.iterations,
+            "seconds": self.seconds,
+        }
+
+
+def _plain(d):
+    if isinstance(d, dict):
+        return {str(k): _plain(v) for k, v in d.items()}
+    if isinstance(d, (list, tuple, np.ndarray)):
+        return (
+            [_plain(v) for v in np.asarray(d).tolist()]
+            if isinstance(d, np.ndarray)
+            else [_plain(v) for v in d]
+        )
+    if isinstance(d, (np.floating, np.integer)):
+        return d.item()
+    return d
+
+
+# ---------------------------------------------------------------------------- tiling
+def starting_tiling(target: TargetSurface, m: int, n: int, placement: Placement, gamma: float,
+                    ext: float, side: str) -> np.ndarray:  # fmt: skip
+    """The starting folded state (nv, 3) m: a uniform Miura-ori (sector angle ``gamma``,
+    extension ``ext``) laid on the target's chart, even rows on the surface, odd rows offset
+    along the normal by the Miura's height (``side`` "below" or "above" the target)."""
+    c, s, angle = placement.resolved(target)
+    theta = math.asin(ext * math.sin(gamma))
+    beta = math.acos(min(1.0, max(-1.0, math.cos(gamma) / math.cos(theta))))
+    b = s[0] / (m * math.sin(theta))
+    a = (s[1] - b * math.cos(theta)) / (n * math.cos(beta))
+    if not a > 0:
+        raise ParameterError(
+            f"placement size {s.tolist()} m is too short along j for {n} rows at gamma = "
+            f"{math.degrees(gamma):.4g} deg, ext = {ext:g}: enlarge it or lower ext"
+        )
+    L = miura_nodes(m, n, a, b, gamma, ext)
+    L[:, :2] -= 0.5 * (L[:, :2].min(axis=0) + L[:, :2].max(axis=0))
+    rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+    uv = c + L[:, :2] @ rot.T
+    u0, u1, v0, v1 = target.domain
+    tol = 1e-9 * max(u1 - u0, v1 - v0)
+    out = (
+        (uv[:, 0] < u0 - tol)
+        | (uv[:, 0] > u1 + tol)
+        | (uv[:, 1] < v0 - tol)
+        | (uv[:, 1] > v1 + tol)
+    )
+    if out.any():
+        raise ParameterError(
+            f"the pattern ({np.ptp(uv[:, 0]):.4g} x {np.ptp(uv[:, 1]):.4g} m at centre "
+            f"{c.tolist()}) leaves the target's chart [{u0:.4g}, {u1:.4g}] x [{v0:.4g}, {v1:.4g}] "
+            f"m: a smaller placement size or another centre"
+        )
+    S, N = target.chart(uv[:, 0], uv[:, 1])
+    sign = -1.0 if side == "below" else 1.0
+    return S + sign * L[:, 2:3] * N
+
+
+# ---------------------------------------------------------------------------- the solver
+class _Problem:
+    """Residuals and Jacobians of one fit in dimensionless units (lengths over ``h``)."""
+
+    def __init__(self, grid: QuadGrid, target: TargetSurface, X0: np.ndarray, fairness: float):
+        self.grid = grid
+        self.target = target
+        self.X0 = X0
+        self.scale = planarity_scale(X0, grid.quads)
+        P = X0[grid.quads]
+        self.h = float(np.sqrt(np.mean(np.sum((P[:, 2] - P[:, 0]) ** 2, axis=1))))
+        self.wf = float(fairness)
+        nv, side = grid.nv, grid.side
+        # anchor: the side vertex nearest the centre keeps its tangential place, a neighbour
+        # along i keeps its bearing (removes the target's symmetries, fixes the placement)
+        i, j = grid.ij
+        centre = X0[side].mean(axis=0)
+        a0 = side[np.argmin(np.linalg.norm(X0[side] - centre, axis=1))]
+        a1 = a0 + (grid.n + 1) if i[a0] < grid.m else a0 - (grid.n + 1)
+        self.anchor = np.array([a0, a1])
+        _, nrm = target.closest(X0[self.anchor])
+        t1 = X0[a1] - X0[a0]
+        t1 -= (t1 @ nrm[0]) * nrm[0]
+        t1 /= np.linalg.norm(t1)
+        self.T = np.stack([t1, np.cross(nrm[0], t1), np.cross(nrm[0], t1)])
+        # sparsity patterns: side rows, fairness rows, anchor rows
+        ks = len(side)
+        st = grid.fairness_stencils
+        rows, cols = [np.repeat(np.arange(ks), 3)], [(3 * side[:, None] + np.arange(3)).ravel()]
+        r0 = ks
+        for ids, _ in st:
+            nk, sz = ids.shape
+            rr = r0 + 3 * np.arange(nk)[:, None, None] + np.arange(3)[None, None, :]
+            rows.append(np.broadcast_to(rr, (nk, sz, 3)).ravel())
+            cols.append((3 * ids[:, :, None] + np.arange(3)).ravel())
+            r0 += 3 * nk
+        self.n_fair = r0 - ks
+        rows.append(r0 + np.repeat(np.arange(3), 3))
+        cols.append(np.concatenate([3 * a0 + np.arange(3)] * 2 + [3 * a1 + np.arange(3)]))
+        self.n_obj = r0 + 3
+        self.obj_pattern = SparsePattern(np.concatenate(rows), np.concatenate(cols),
+                                         (self.n_obj, 3 * nv))  # fmt: skip
+        keep = np.ones(self.n_obj, bool)
+        keep[ks : ks + self.n_fair] = False
+        self.base_rows = np.flatnonzero(keep)  # side + anchor: the preconditioner's part
+
+    def objective(self, X: np.ndarray):
+        g = self.grid
+        side = g.side
+        foot, nrm = self.target.closest(X[side])
+        rs = np.einsum("kd,kd->k", nrm, X[side] - foot) / self.h
+        parts, vals = [rs], [nrm.ravel()]
+        for ids, w in g.fairness_stencils:
+            f = np.einsum("s,ksd->kd", w, X[ids]) / self.h
+            parts.append(self.wf * f.ravel())
+            nk = len(ids)
+            vals.append(np.broadcast_to((self.wf * w)[None, :, None], (nk, len(w), 3)).ravel())
+        e = X[self.anchor] - self.X0[self.anchor]
+        parts.append(np.array([self.T[0] @ e[0], self.T[1] @ e[0], self.T[2] @ e[1]]) / self.h)
+        vals.append(self.T.ravel())
+        return np.concatenate(parts), self.obj_pattern.matrix(np.concatenate(vals))
+
+    def constraints(self, X: np.ndarray, jacobian: bool = True):
+        if not jacobian:
+            return constraints(X, self.grid, self.scale, jacobian=False)
+        c, J = constraints(X, self.grid, self.scale)
+        return c, J * self.h
+
+
+class _KKT:
+    """Saddle-point solves min 1/2 d^T H d + g^T d s.t. Jc d = -c by preconditioned MINRES."""
+
+    def __init__(self, grid: QuadGrid):
+        self.order = grid.band_order
+        self.inv = np.argsort(self.order)
+        self.bw = grid.bandwidth
+        self.factor = None
+        self.n_factor = 0
+        self.minres_its: list[int] = []
+
+    def refactor(self, Jb: sp.csr_matrix, Jc: sp.csr_matrix, mu: float) -> None:
+        A = (Jb.T @ Jb + _RHO * (Jc.T @ Jc)).tocsr()
+        A = A[self.order][:, self.order].tocoo()
+        n, bw = A.shape[0], self.bw
+        up = A.col >= A.row
+        if (A.col[up] - A.row[up]).max(initial=0) > bw:
+            raise AssertionError("band pattern wider than planned")
+        ab = np.zeros((bw + 1, n))
+        ab[bw + A.row[up] - A.col[up], A.col[up]] = A.data[up]
+        ab[bw] += mu
+        self.factor = sl.cholesky_banded(ab, lower=False, check_finite=False)
+        self.n_factor += 1
+
+    def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
+              tol: float = 1e-10) -> tuple[np.ndarray, int]:  # fmt: skip
+        n, m = H.shape[0], Jc.shape[0]
+        JcT = Jc.T.tocsr()
+        cf, order, inv = self.factor, self.order, self.inv
+
+        def mv(v):
+            x, y = v[:n], v[n:]
+            return np.concatenate([H @ x + JcT @ y, Jc @ x])
+
+        def prec(r):
+            out = np.empty_like(r)
+            out[:n] = sl.cho_solve_banded((cf, False), r[:n][order], check_finite=False)[inv]
+            out[n:] = _RHO * r[n:]
+            return out
+
+        count = [0]
+
+        def cb(_):
+            count[0] += 1
+
+        K = spla.LinearOperator((n + m, n + m), matvec=mv, dtype=float)
+        M = spla.LinearOperator((n + m, n + m), matvec=prec, dtype=float)
+        sol, _ = spla.minres(K, np.concatenate([-g, -c]), M=M, rtol=tol, maxiter=300, callback=cb)
+        self.minres_its.append(count[0])
+        return sol[:n], count[0]
+
+
+def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time_limit: float,
+           t0: float):  # fmt: skip
+    """Restoration, then feasible Gauss-Newton SQP steps.
+
+    Returns X, ok (the constraints are met), a sentence on how the solve ended, the number of
+    iterations and the KKT solver (for its statistics)."""
+    h = problem.h
+    ndof = 3 * problem.grid.nv
+    eye = sp.identity(ndof, format="csr")
+    kkt = _KKT(problem.grid)
+    mu_p = 1e-2  # preconditioner damping
+    refactor_after = 12  # MINRES iterations that call for a fresh factorisation
+
+    def fresh(Jo, Jc, mu):
+        kkt.refactor(Jo[problem.base_rows], Jc, mu)
+
+    ro, Jo = problem.objective(X)
+    c, Jc = problem.constraints(X)
+    fresh(Jo, Jc, mu_p)
+    # ---- phase 1: restoration (Newton steps onto the constraints, min |d|_H)
+    its = 0
+    H = (Jo.T @ Jo + 1e-2 * eye).tocsr()
+    for its in range(1, 31):
+        d, k = kkt.solve(H, Jc, np.zeros(ndof), c)
+        X = X + d.reshape(-1, 3) * h
+        c, Jc = problem.constraints(X)
+        cm = float(np.abs(c).max())
+        if not np.isfinite(cm):
+            return X, False, "the restoration diverged (non-finite constraints)", its, kkt
+        if cm < CONSTRAINT_TOL:
+            break
+        if k > refactor_after or cm > 1e-6:
+            ro, Jo = problem.objective(X)
+            H = (Jo.T @ Jo + 1e-2 * eye).tocsr()
+            fresh(Jo, Jc, mu_p)
+    else:
+        return X, False, (f"the constraints could not be met from the starting tiling (largest "
+                          f"residual {cm:.3g} after {its} Newton steps): a smaller placement, "
+                          f"more cells or a less curved region"), its, kkt  # fmt: skip
+    ro, Jo = problem.objective(X)
+    # ---- phase 2: feasible Gauss-Newton with second-order corrections
+    mu = 1e-4
+    F = float(ro @ ro)
+    message = f"stopped after {max_iter} Gauss-Newton iterations (the distance was still falling)"
+    for _ in range(max_iter):
+        if time.perf_counter() - t0 > time_limit:
+            message = f"stopped at the time limit ({time_limit:g} s)"
+            break
+        its += 1
+        g = Jo.T @ ro
+        JtJ = (Jo.T @ Jo).tocsr()
+        cm = float(np.abs(c).max())
+        accepted = False
+        while mu <= 1e6:
+            fresh(Jo, Jc, mu)
+            H = JtJ + mu * eye
+            d, _ = kkt.solve(H, Jc, g, c)
+            Xn = X + d.reshape(-1, 3) * h
+            cn = problem.constraints(Xn, jacobian=False)
+            for _ in range(3):  # second-order corrections onto the constraints
+                if np.abs(cn).max() < CONSTRAINT_TOL:
+                    break
+                dc, _ = kkt.solve(H, Jc, np.zeros(ndof), cn)
+                Xn = Xn + dc.reshape(-1, 3) * h
+                cn = problem.constraints(Xn, jacobian=False)
+            ron, Jon = problem.objective(Xn)
+            Fn = float(ron @ ron)
+            cnm = float(np.abs(cn).max())
+            if np.isfinite(Fn) and Fn <= F and cnm <= max(10 * cm, 1e-8):
+                accepted = True
+                break
+            mu *= 10
+        if not accepted:
+            message = "converged (no step lowers the distance further)"
+            break
+        X, ro, Jo = Xn, ron, Jon
+        c, Jc = problem.constraints(X)
+        mu = max(mu / 10, 1e-6)
+        gain = (F - Fn) / max(F, 1e-300)
+        F = Fn
+        if gain < ftol:
+            message = f"converged (the last step lowered the squared distance by {gain:.2g})"
+            break
+    cm = float(np.abs(c).max())
+    # ---- polish the constraints to the tolerance
+    for _ in range(10):
+        if cm < CONSTRAINT_TOL:
+            break
+        H = (Jo.T @ Jo + 1e-2 * eye).tocsr()
+        d, _ = kkt.solve(H, Jc, np.zeros(ndof), c)
+        X = X + d.reshape(-1, 3) * h
+        c, Jc = problem.constraints(X)
+        cm = float(np.abs(c).max())
+    if cm >= CONSTRAINT_TOL:
+        return (
+            X,
+            False,
+            f"the constraints are met only to {cm:.3g} (tolerance {CONSTRAINT_TOL:g})",
+            its,
+            kkt,
+        )
+    return X, True, message, its, kkt
+
+
+def fit_surface(
+    surface,
+    cells,
+    *,
+    placement: Placement | None = None,
+    gamma: float = math.radians(60.0),
+    ext: float = 0.7,
+    side: str = "below",
+    fairness: float = 1e-4,
+    max_iter: int = 6,
+    ftol: float = 0.1,
+    time_limit: float = 600.0,
+    units: str | None = None,
+) -> SurfaceFit:
+    """Fit an m x n generalised Miura-ori to ``surface`` (docs/surface-fit.md).
+
+    Parameters
+    ----------
+    surface : TargetSurface, built-in spec or mesh file (:func:`load_surface`; ``units`` is a
+        file's unit)
+    cells : (m, n) ints or "MxN"
+        Quads along the zig-zag direction and across it; m n <= MAX_PANELS.
+    placement : Placement, optional
+        Where the pattern sits on the chart (default: the whole chart).
+    gamma : float
+        Sector angle of the starting Miura-ori, rad, in (0, pi/2).
+    ext : float
+        How far the starting Miura-ori is folded: its projected length over its flat length
+        along i, in (0, 1).
+    side : {"below", "above"}
+        Which way the corrugation hangs from the fitted side (against or along the normal).
+    fairness : float
+        Weight of the fairness term (relative to the distance term).
+    max_iter, ftol, time_limit
+        Gauss-Newton iterations at most; stop when a step lowers the squared distance by less
+        than ``ftol`` (relative); wall time limit, s.
+
+    Returns
+    -------
+    SurfaceFit
+        ``ok`` False with ``message`` when the constraints could not be met.
+    """
+    t0 = time.perf_counter()
+    target = load_surface(surface, units)
+    m, n = _cells(cells)
+    gamma = check_range("gamma", gamma, 0.0, math.pi / 2, low_open=True, high_open=True)
+    ext = check_range("ext", ext, 0.0, 1.0, low_open=True, high_open=True)
+    if side not in ("below", "above"):
+        raise ParameterError(f"side must be 'below' or 'above', got {side!r}")
+    check_range("fairness", fairness, 0.0, None)
+    max_iter = check_count("max_iter", max_iter, 0)
+    placement = placement or Placement()
+    grid = QuadGrid(m, n)
+    X0 = starting_tiling(target, m, n, placement, gamma, ext, side)
+    problem = _Problem(grid, target, X0, fairness)
+    with threadpool_limits(1):  # one core: BLAS threads only contend on these small vectors
+        X, ok, message, its, kkt = _solve(
+            problem, X0.copy(), max_iter=max_iter, ftol=ftol, time_limit=time_limit, t0=t0
+        )
+    if not np.isfinite(X).all():
+        raise SurfaceFitError(f"the {m}x{n} fit diverged: {message}")
+    c, s, a = placement.resolved(target)
+    options = {
+        "gamma_deg": math.degrees(gamma),
+        "ext": ext,
+        "side": side,
+        "fairness": fairness,
+        "placement": {"centre": c.tolist(), "size": s.tolist(), "angle_deg": math.degrees(a)},
+        "factorisations": kkt.n_factor,
+        "minres_iterations": int(sum(kkt.minres_its)),
+    }
+    flat = develop(X, grid)
+    residuals = _residuals(X, flat, grid)
+    dist = target.distance(X[grid.side])
+    return SurfaceFit(target, m, n, X, flat, grid.side, dist, residuals, ok, message,
+                      its, time.perf_counter() - t0, options)  # fmt: skip
+
+
+def _residuals(X: np.ndarray, flat: np.ndarray, grid: QuadGrid) -> dict[str, float]:
+    r, _ = vertex_conditions(X, grid)
+    ni = len(grid.interior[0])
+    Q = grid.quads
+    e = np.concatenate([Q[:, [0, 1]], Q[:, [1, 2]], Q[:, [2, 3]], Q[:, [3, 0]], Q[:, [0, 2]]])
+    l3 = np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1)
+    lf = np.linalg.norm(flat[e[:, 1]] - flat[e[:, 0]], axis=1)
+    th = sector_angles(X, Q)
+    return {
+        "planarity_max": float(quad_warp(X, Q).max()),
+        "angle_sum_max": float(np.abs(r[:ni]).max(initial=0.0)),
+        "kawasaki_max": float(np.abs(r[ni:]).max(initial=0.0)),
+        "development_max": float(np.max(np.abs(lf - l3) / l3)),
+        "sector_angle_min_deg": float(np.degrees(th.min())),
+        "sector_angle_max_deg": float(np.degrees(th.max())),
+    }
+
+
+def _cells(cells) -> tuple[int, int]:
+    if isinstance(cells, str):
+        parts = cells.lower().replace("×", "x").split("x")
+        if len(parts) != 2:
+            raise ParameterError(f"cells must be 'MxN' (e.g. 16x16), got {cells!r}")
+        cells = parts
+    try:
+        m, n = cells
+    except (TypeError, ValueError):
+        raise ParameterError(f"cells must be two integers (m, n), got {cells!r}") from None
+    m, n = check_count("m", m, 2), check_count("n", n, 2)
+    if m * n > MAX_PANELS:
+        raise ParameterError(f"{m}x{n} = {m * n} panels is more than MAX_PANELS = {MAX_PANELS}")
+    return m, n
