@@ -20,10 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from holofold.geometry.errors import check_range
-from holofold.mechanics.compat import PHYSICAL
-from holofold.mechanics.hinges import build_concentrated
-from holofold.mechanics.solvers import solve_selffold
-from holofold.mechanics.springs import dihedral_angle
+from holofold.mechanics.folding import fold_pattern
 
 __all__ = ["FoldCheck", "check_fold", "FOLD_TOLERANCE"]
 
@@ -39,7 +36,8 @@ class FoldCheck:
     ``reached`` is True when the solver converged at every increment and the simulated shape
     lies within ``tolerance`` (m) of the fitted one everywhere. ``deviation_rms`` and
     ``deviation_max`` are vertex distances after the best rigid alignment (m); ``coords``
-    (nv, 3) the simulated vertices so aligned; ``reason`` says why a check failed.
+    (nv, 3) the simulated vertices so aligned; ``reason`` says why a check failed, ``verdict``
+    is :func:`~holofold.mechanics.folding.fold_pattern`'s, ``steps`` its actuation steps.
     """
 
     reached: bool
@@ -47,8 +45,8 @@ class FoldCheck:
     deviation_max: float
     tolerance: float
     reason: str
-    status: str
-    increments: int
+    verdict: str
+    steps: int
     seconds: float
     coords: np.ndarray
 
@@ -60,6 +58,7 @@ class FoldCheck:
             "fold_deviation_max": self.deviation_max,
             "fold_tolerance": self.tolerance,
             "fold_reason": self.reason,
+            "fold_verdict": self.verdict,
             "fold_seconds": self.seconds,
         }
 
@@ -76,7 +75,6 @@ def _kabsch(A: np.ndarray, B: np.ndarray) -> np.ndarray:
 def check_fold(
     fit,
     *,
-    increments: int = 20,
     tolerance: float = FOLD_TOLERANCE,
     panel_thickness: float | None = None,
     crease_thickness: float | None = None,
@@ -94,42 +92,31 @@ def check_fold(
     t0 = time.perf_counter()
     tolerance = check_range("tolerance", tolerance, 0.0, None, low_open=True)
     pattern = fit.pattern
-    nv = pattern.n_vertices
     h = float(np.mean(pattern.flat_edge_lengths))
     tp = h / 20 if panel_thickness is None else panel_thickness
     tc = tp / 4 if crease_thickness is None else crease_thickness
     W = h / 10 if crease_width is None else crease_width
-    flat = pattern.with_coords(np.column_stack([pattern.flat, np.zeros(nv)]), measure=False)
-    structure = build_concentrated(flat, crease_width=W, crease_thickness=tc, panel_thickness=tp,
-                                   E_panel=E, E_crease=E, profile=PHYSICAL)  # fmt: skip
-    # fix the four corners of the central panel (it stays congruent on the way)
-    centre = np.asarray(pattern.flat).mean(axis=0)
-    q = fit.grid.quads
-    qc = int(np.argmin(np.linalg.norm(pattern.flat[q].mean(axis=1) - centre, axis=1)))
-    structure = structure.fixed(q[qc], "xyz")
-    folded_nodes = np.concatenate([fit.coords, fit.coords[q].mean(axis=1)])
-    target = dihedral_angle(folded_nodes, structure.springs)
-    force = E * tp * tp
-    res = solve_selffold(structure, target, increments=increments, tol=1e-9 * force,
-                         max_iter=max_iter)  # fmt: skip
+    res = fold_pattern(pattern, 1.0, panel_thickness=tp, crease_thickness=tc, crease_width=W,
+                       E=E, max_iter=max_iter)  # fmt: skip
     size = fit.target.size
     tol_m = tolerance * size
-    final = structure.nodes[:nv] + res.U[:nv]
+    final = res.coords[-1]
+    steps = len(res.fractions) - 1
     if not np.isfinite(final).all():
         return FoldCheck(False, np.inf, np.inf, tol_m, "the simulation diverged (non-finite "
-                         "positions)", str(res.status), increments, time.perf_counter() - t0,
+                         "positions)", str(res.status), steps, time.perf_counter() - t0,
                          final)  # fmt: skip
     aligned = _kabsch(final, fit.coords)
     d = np.linalg.norm(aligned - fit.coords, axis=1)
     rms, mx = float(np.sqrt(np.mean(d**2))), float(d.max())
-    if res.failed:
-        reason = f"the simulation stopped: {res.status}"
-    elif not res.ok:
-        reason = f"the simulation did not converge: {res.status}"
+    if res.fractions[-1] < 1.0 or not res.status.converged:
+        reason = (f"the simulation reached {100 * res.fractions[-1]:.3g} % of the fold: "
+                  f"{res.verdict} ({res.note}; {res.status})")  # fmt: skip
     elif mx > tol_m:
         reason = (f"the simulated shape ends {mx:.3g} m ({mx / size:.3g} of the target's size) "
-                  f"from the fitted one, more than the tolerance {tolerance:g}")  # fmt: skip
+                  f"from the fitted one, more than the tolerance {tolerance:g} ({res.verdict}: "
+                  f"{res.note})")  # fmt: skip
     else:
         reason = ""
-    return FoldCheck(not reason, rms, mx, tol_m, reason, str(res.status), increments,
+    return FoldCheck(not reason, rms, mx, tol_m, reason, f"{res.verdict}: {res.note}", steps,
                      time.perf_counter() - t0, aligned)  # fmt: skip
