@@ -44,23 +44,26 @@ def write_strip_set(
     candidates: pd.DataFrame | None = None,
     units: str = MESH_UNITS,
     cutter: CutterOptions | None = None,
+    thick: str = "centred",
 ) -> FabricationSet:
     """Write the strip's fabrication set into ``folder`` (created if needed).
 
     ``panel_thickness`` and ``crease_width`` (m, both or neither) add the thick solid;
     ``crease_thickness`` (m, with both) the printable part, which needs the flat layout. They
     are built, and can be refused, before the first file is written. Meshes in ``units``;
-    ``cutter`` draws the SVG and DXF.
+    ``cutter`` draws the SVG and DXF; ``thick`` is the thickness accommodation of the solids
+    (:data:`~holofold.geometry.thick.TECHNIQUES`; checked in the folded state: a fitted strip
+    has no fold path of its own).
     """
     length_factor(units)
-    thick = (panel_thickness, crease_width)
-    if crease_thickness is not None and any(v is None for v in thick):
+    pair = (panel_thickness, crease_width)
+    if crease_thickness is not None and any(v is None for v in pair):
         raise ParameterError(
             "a printable part needs a panel thickness and a crease width besides the crease "
             "thickness"
         )
-    if any(v is not None for v in thick):
-        if any(v is None for v in thick):
+    if any(v is not None for v in pair):
+        if any(v is None for v in pair):
             raise ParameterError("a thick solid needs both a panel thickness and a crease width")
         check_range("crease_width", crease_width, 0.0, None, low_open=True)
     flat = fit.flat_pattern  # layout + 3-D state, side B loops counter-clockwise
@@ -71,7 +74,7 @@ def write_strip_set(
     out = write_fabrication_set(
         fit.pattern, folder, flat=flat, names=STRIP_NAMES, panel_thickness=panel_thickness,
         crease_width=crease_width or 0.0, crease_thickness=crease_thickness, units=units,
-        cutter=cutter, plan_view=plan,
+        cutter=cutter, plan_view=plan, thick=thick,
     )  # fmt: skip
     if candidates is not None:
         path = Path(folder) / "candidates.csv"

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -153,6 +153,8 @@ def write_fabrication_set(
     units: str = MESH_UNITS,
     cutter: CutterOptions | None = None,
     plan_view: str | None = None,
+    thick: str = "centred",
+    path: Sequence[CreasePattern] | None = None,
 ) -> FabricationSet:
     """Write a design's fabrication files into ``folder`` (created if needed).
 
@@ -174,9 +176,30 @@ def write_fabrication_set(
         The SVG and DXF drawing (default: Origami Simulator's convention, one face).
     plan_view : str, optional
         SVG text written as the ``svg`` file when there is no flat layout.
+    thick : str
+        Thickness accommodation of the ``thick`` and printable files
+        (:data:`~holofold.geometry.thick.TECHNIQUES`): "centred" (slabs on the mid-surface, the
+        default), "offset" or "tapered" (:func:`~holofold.geometry.thick.thick_panels`).
+    path : sequence of CreasePattern, optional
+        States on the way to ``folded`` (same pattern) whose overlap is checked and whose fold
+        angles bound the bevels; default a Miura sheet's rigid path from flat
+        (:func:`~holofold.geometry.thick.miura_path`), else the folded state alone.
     """
-    from holofold.geometry.printable import folded_printable, printable_solid
+    from holofold.geometry.errors import DegenerateGeometryError
+    from holofold.geometry.printable import (
+        folded_printable,
+        folded_printable_solid,
+        printable_solid,
+    )
     from holofold.geometry.solid import shrunk_panels, thick_solid
+    from holofold.geometry.thick import (
+        TECHNIQUES,
+        miura_path,
+        path_overlap,
+        thick_panel_mesh,
+        thick_panels,
+        thick_printable,
+    )
     from holofold.geometry.units import length_factor
 
     length_factor(units)
@@ -196,7 +219,33 @@ def write_fabrication_set(
             raise ParameterError(
                 "this design has no flat layout (its development overlaps): no printable part"
             )
-    if panel_thickness is not None:
+    if thick not in TECHNIQUES:
+        known = ", ".join(TECHNIQUES)
+        raise ParameterError(f"unknown thickness technique {thick!r}; known: {known}")
+    if panel_thickness is not None and thick != "centred":
+        t = check_range("panel_thickness", panel_thickness, 0.0, None, low_open=True)
+        shrunk_panels(folded, W)
+        geo = layout if layout is not None else folded  # one face orientation for both states
+        if path is None:
+            path = miura_path(geo, 10) if geo.meta.get("kind") == "miura" else ()
+        panels = thick_panels(geo, t, W, thick, path=path)
+        over = path_overlap([*path, geo], panels)
+        solid = thick_panel_mesh(geo, panels)
+        where = {1: "above the hinge face", -1: "below the hinge face", 0: "centred"}
+        checked = f"{len(path) + 1} states of the fold path" if len(path) else "the folded state"
+        worst = float(over.fraction.max())
+        notes.append(
+            f"{thick} panels ({where[panels.side]}), {100 * panels.kept:.3g} % of the "
+            f"{1000 * t:g} mm slabs kept after the bevels; overlap over {checked}: "
+            + ("none" if worst == 0 else f"up to {100 * worst:.3g} % of the panel volume")
+        )
+        if crease_thickness is not None:
+            part = thick_printable(geo, panels, tc)
+            try:
+                bent = folded_printable_solid(geo, t, tc, W, panels=panels)
+            except DegenerateGeometryError as exc:
+                notes.append(f"no folded printable part: {exc}")
+    elif panel_thickness is not None:
         t = check_range("panel_thickness", panel_thickness, 0.0, None, low_open=True)
         shrunk_panels(folded, W)  # a crease wider than a panel fails here
         solid = thick_solid(folded, t, W)
@@ -258,6 +307,7 @@ def export_pattern_files(
     crease_thickness: float | None = None,
     units: str = MESH_UNITS,
     cutter: CutterOptions | None = None,
+    thick: str = "centred",
 ) -> list[Path]:
     """The fabrication files of a sheet in ``folder``: :func:`write_fabrication_set` with the
     pattern kind's names (``pattern.fold``, ``pattern.svg``, ``pattern.dxf``, ``folded.stl``,
@@ -265,5 +315,5 @@ def export_pattern_files(
     ``printable_folded.stl`` with ``crease_thickness`` too); returns the paths written."""
     return write_fabrication_set(
         pattern, folder, panel_thickness=thickness, crease_width=crease_width,
-        crease_thickness=crease_thickness, units=units, cutter=cutter,
+        crease_thickness=crease_thickness, units=units, cutter=cutter, thick=thick,
     ).paths  # fmt: skip

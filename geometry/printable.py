@@ -272,7 +272,14 @@ def printable_solid(
 
 
 def _one_body(whole, name: str) -> trimesh.Trimesh:
-    """The manifold3d solid as a trimesh (float64), refused unless one watertight body."""
+    """The manifold3d solid as a trimesh (float64), refused unless one watertight body
+    (slivers of no volume that a union can leave, below 1e-9 of the whole, are dropped)."""
+    import manifold3d as m3d
+
+    pieces = whole.decompose()
+    keep = [q for q in pieces if q.volume() > 1e-9 * whole.volume()]
+    if 0 < len(keep) < len(pieces):
+        whole = m3d.Manifold.batch_boolean(keep, m3d.OpType.Add)
     mesh = whole.to_mesh64()
     out = trimesh.Trimesh(
         vertices=np.asarray(mesh.vert_properties)[:, :3],
@@ -296,6 +303,7 @@ def folded_printable_solid(
     crease_width,
     *,
     segments: int = 6,
+    panels=None,
 ) -> trimesh.Trimesh:
     """The printable part in the folded state, hinges bent (see the module docstring), metres.
 
@@ -309,6 +317,9 @@ def folded_printable_solid(
         W, m (> 0 on fold lines).
     segments : int
         Slabs per bent hinge (>= 1).
+    panels : ThickPanels, optional
+        Thick panels of another technique (:func:`~holofold.geometry.thick.thick_panels`): its
+        panel solids, and the hinges at its reference face (offset) instead of the mid-surface.
     """
     import warnings
 
@@ -340,7 +351,15 @@ def folded_printable_solid(
     prev[nxt] = np.arange(len(fv))
 
     parts = []
+    shift = 0.0
+    if panels is not None:
+        from holofold.geometry.thick import panel_solids_of
+
+        parts = panel_solids_of(pattern, panels)
+        shift = panels.side * tc / 2  # the hinge's mid-surface, along the panel normal
     for f, (a, k) in enumerate(zip(starts, sizes, strict=True)):  # the thick panels
+        if panels is not None:
+            break
         c = S[a : a + k]
         h = normals[f] * tp / 2
         parts.append(m3d.Manifold.hull_points(np.vstack([c + h, c - h])))
@@ -392,9 +411,12 @@ def folded_printable_solid(
             u = np.array([u0, u1])
             w_ = np.clip(u, 0.0, 1.0)[:, None]
             nrm = (1 - w_) * n1 + w_ * n2
-            h = nrm / np.linalg.norm(nrm, axis=1, keepdims=True) * tc / 2
-            A, B = point(u, curves[0]), point(u, curves[1])
+            unit = nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+            h = unit * tc / 2
+            A, B = point(u, curves[0]) + shift * unit, point(u, curves[1]) + shift * unit
             parts.append(m3d.Manifold.hull_points(np.vstack([A + h, A - h, B + h, B - h])))
+    # a hull of coplanar points (a hinge slab folded flat onto itself) is a body of no volume
+    parts = parts[: len(faces)] + [q for q in parts[len(faces) :] if q.volume() > 0]
     total_panels = sum(p.volume() for p in parts[: len(faces)])
     panels = m3d.Manifold.batch_boolean(parts[: len(faces)], m3d.OpType.Add)
     lost = 1.0 - panels.volume() / total_panels

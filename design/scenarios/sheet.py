@@ -56,6 +56,7 @@ from holofold.design.scenarios.config import (
 )
 from holofold.design.scenarios.plausible import FORCE, check_lengths, check_plausible
 from holofold.geometry import MAX_PANELS
+from holofold.geometry import TECHNIQUES as THICK_TECHNIQUES
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.miura import (
     miura_faces,
@@ -207,6 +208,7 @@ class SheetSetting:
     support_dofs: str = "xyz"
     tol: float = 1e-7
     max_iter: int = 30
+    thick: str = "centred"
 
 
 def extension_tag(ext: float) -> int:
@@ -513,6 +515,7 @@ def write_sheet_files(
         return write_fabrication_set(
             shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
             crease_thickness=float(row["tcrease"]), units=units, cutter=cutter,
+            thick=setting.thick,
         )  # fmt: skip
     except DegenerateGeometryError as exc:
         warnings.warn(f"no thick.stl: {exc}", stacklevel=2)
@@ -730,6 +733,7 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
         support_dofs=dofs,
         tol=tol,
         max_iter=max_iter,
+        thick=doc.choice("thick", THICK_TECHNIQUES, "centred"),
     )
     # the optional moduli are features when the file names them (else E holds everywhere)
     moduli = any(fsec.has(k) for k in _OPTIONAL_E)

@@ -68,6 +68,7 @@ from holofold.fitting import (
     strip_geometry,
 )
 from holofold.geometry import LENGTH_UNITS, non_simple_faces
+from holofold.geometry import TECHNIQUES as THICK_TECHNIQUES
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
@@ -171,6 +172,9 @@ class StripSetting:
         Report a design whose panels are not simple polygons (a self-overlapping strip, which
         :func:`~holofold.fitting.fit_strip` refuses and nobody can build) as a failed row
         instead of simulating it. None of the 3000 published arch rows overlaps.
+    thick : str
+        Thickness accommodation of the fabrication files' solids ("centred", "offset",
+        "tapered"; :func:`~holofold.geometry.thick_panels`); the simulation is the same.
     curve_label : str
         How the curve was given (for reports).
     """
@@ -187,6 +191,7 @@ class StripSetting:
     sampling: str | None = None
     refuse_overlap: bool = True
     curve_label: str = field(default="", compare=False)
+    thick: str = field(default="centred", compare=False)
 
     @property
     def curve_sampling(self) -> str:
@@ -454,6 +459,7 @@ def write_strip_files(setting: StripSetting, row, folder, units: str = "mm", cut
         crease_thickness=float(row["tcrease"]),
         units=units,
         cutter=cutter,
+        thick=setting.thick,
     )
 
 
@@ -585,6 +591,7 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
         max_iter=max_iter,
         sampling=sampling,
         curve_label=label,
+        thick=doc.choice("thick", THICK_TECHNIQUES, "centred"),
     )
     features = read_features(doc.sub("features"), STRIP_FEATURES, kind="strip")
     for c in features:

@@ -3,7 +3,7 @@ the cutter profile of the flat pattern's SVG and DXF."""
 
 from __future__ import annotations
 
-__all__ = ["add_cutter_arguments", "cutter_options"]
+__all__ = ["add_cutter_arguments", "cutter_options", "add_thick_argument"]
 
 _PROFILES = ("origami-simulator", "laser", "cricut")
 
@@ -34,4 +34,15 @@ def cutter_options(args):
     return CutterOptions(
         args.profile, dash=args.dash, gap=args.gap, vertex_gap=args.vertex_gap,
         two_sided=args.two_sided,
+    )  # fmt: skip
+
+
+def add_thick_argument(p) -> None:
+    """``--thick centred|offset|tapered``: the thickness accommodation of the solids."""
+    p.add_argument(
+        "--thick", choices=("centred", "offset", "tapered"), default="centred",
+        help="thick panels: centred on the mid-surface (default), offset (on one side, hinges "
+        "at the panel face, bevelled where a fold closes on the material) or tapered (centred, "
+        "bevelled on both faces); the hinges stay on the simulated surface "
+        "(docs/fabrication.md)",
     )  # fmt: skip

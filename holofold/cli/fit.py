@@ -32,7 +32,7 @@ import argparse
 import math
 from pathlib import Path
 
-from holofold.cli._fabrication import add_cutter_arguments, cutter_options
+from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
 from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
 
@@ -112,6 +112,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
+    add_thick_argument(p)
     add_cutter_arguments(p)
     return p
 
@@ -202,10 +203,10 @@ def run(args) -> int:
 
     from holofold.fitting import (
         check_curve_size,
-        export_strip_files,
         fit_auto,
         fit_strip,
         load_curve,
+        write_strip_set,
     )
 
     opts = _validate(args)
@@ -238,7 +239,7 @@ def run(args) -> int:
             curve, opts["m"], opts["offset"], opts["strip_width"], opts["extrude"],
             sampling=args.sampling,
         )  # fmt: skip
-    written = export_strip_files(
+    written = write_strip_set(
         fit,
         args.output,
         **thick,
@@ -246,11 +247,18 @@ def run(args) -> int:
         candidates=table,
         units=args.units,
         cutter=cutter,
+        thick=args.thick,
     )
     units = {"lengths": "m", "errors": "m", "warp": "relative (1 = 100 %)",
              "mesh files": args.units, "strip.fold": "m", "strip.svg": "mm",
              "strip.dxf": "mm"}  # fmt: skip
-    summary = {**fit.parameters, **fit.errors, "units": units, "files": [str(w) for w in written]}
+    summary = {
+        **fit.parameters,
+        **fit.errors,
+        "units": units,
+        "files": [str(f.path) for f in written],
+        "notes": list(written.notes),
+    }
     warp = fit.errors["warp_max"]
     limit = f" (limit {100 * args.max_warp:.3g} %)" if args.auto else ""
     print(

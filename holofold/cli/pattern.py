@@ -23,7 +23,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from holofold.cli._fabrication import add_cutter_arguments, cutter_options
+from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -61,6 +61,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
+    add_thick_argument(p)
     add_cutter_arguments(p)
     return p
 
@@ -99,7 +100,7 @@ def _build(args):
 def run(args) -> int:
     import numpy as np
 
-    from holofold.geometry import ParameterError, check_range, export_pattern_files
+    from holofold.geometry import ParameterError, check_range, write_fabrication_set
 
     cutter = cutter_options(args)
     pattern = _build(args)
@@ -116,21 +117,24 @@ def run(args) -> int:
         check_range("--crease-thickness", args.crease_thickness, 0.0, None, low_open=True)
     elif args.crease_thickness is not None:
         raise ParameterError("--crease-thickness is for --printable; add --printable")
-    written = export_pattern_files(
+    written = write_fabrication_set(
         pattern,
         args.output,
-        thickness=args.thickness,
+        panel_thickness=args.thickness,
         crease_width=args.crease_width,
         crease_thickness=args.crease_thickness if args.printable else None,
         units=args.units,
         cutter=cutter,
+        thick=args.thick,
     )
     ext = np.ptp(pattern.coords, axis=0)
     print(
         f"{args.kind} {args.m}x{args.n} at ext {args.ext:g}: {pattern.n_vertices} vertices, "
         f"{int(pattern.interior.sum())} creases, {pattern.n_faces} panels, extent "
         f"{ext[0]:.4g} x {ext[1]:.4g} x {ext[2]:.4g} m; wrote "
-        + ", ".join(p.name for p in written)
+        + ", ".join(f.path.name for f in written)
         + f" to {args.output}"
     )
+    for note in written.notes:
+        print(f"  note: {note}")
     return 0
