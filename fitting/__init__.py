@@ -65,6 +65,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "read_surface",
         ],
         "quadmesh": ["QuadGrid", "develop", "sector_angles", "quad_warp"],
+        "surface_files": ["export_surface_files"],
         "surface_fit": [
             "CONSTRAINT_TOL",
             "Placement",

@@ -1,4 +1,5 @@
-"""``holofold fit``: fit a Miura-like strip to a planar curve and export it.
+"""``holofold fit``: fit a Miura-like strip to a planar curve, or a generalised Miura-ori to a
+surface, and export it.
 
 Examples::
 
@@ -33,6 +34,7 @@ import math
 from pathlib import Path
 
 from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
+from holofold.cli._surface_fit import add_surface_arguments, run_surface
 from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
 
@@ -46,7 +48,15 @@ def register(subparsers) -> argparse.ArgumentParser:
         "parabola:span=..,height=.., sine:span=..,amplitude=..,periods=.., "
         "catenary:span=..,height=..), a CSV of x,z points, or an SVG file[#path-id].",
     )
-    p.add_argument("--curve", required=True, help="built-in spec, points.csv or drawing.svg[#id]")
+    p.add_argument("--curve", help="built-in spec, points.csv or drawing.svg[#id]")
+    p.add_argument(
+        "--surface",
+        help="fit a generalised Miura-ori to a surface instead: a mesh file (.stl .obj .ply "
+        ".off, numbers in --units, default mm) or a built-in spec (sphere-cap:radius=1,rim=0.4, "
+        "cylinder:radius=..,length=..,angle=.., saddle:radius=..,width=..,depth=.., "
+        "paraboloid:radius=.., wave:amplitude=..,wavelength=..); see docs/surface-fit.md",
+    )
+    add_surface_arguments(p)
     p.add_argument(
         "--curve-units",
         choices=tuple(LENGTH_UNITS),
@@ -107,9 +117,10 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--units",
-        choices=("mm", "m"),
-        default="mm",
-        help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
+        choices=tuple(LENGTH_UNITS),
+        default=None,
+        help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them); with "
+        "a --surface file, the unit of its numbers too (the errors and meshes are in it)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
     add_thick_argument(p)
@@ -200,6 +211,12 @@ def _validate(args) -> dict:
 
 def run(args) -> int:
     import json
+
+    if (args.curve is None) == (args.surface is None):
+        raise ParameterError("give one of --curve (a strip) or --surface (a surface fit)")
+    if args.surface is not None:
+        return run_surface(args)
+    args.units = args.units or "mm"
 
     from holofold.fitting import (
         check_curve_size,
