@@ -184,6 +184,8 @@ class FoldResult:
     snaps : (n,) float
         Fractions at which no equilibrium lay near the last one and the sheet snapped to the
         energy minimum beyond (a limit point of the rest-angle path).
+    elapsed : (k,) float
+        Seconds from the first step to each stored state (the model's build not counted).
     """
 
     pattern: CreasePattern
@@ -202,6 +204,7 @@ class FoldResult:
     wrong_way: np.ndarray = field(default_factory=lambda: np.zeros(0, np.intp))
     halvings: int = 0
     snaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    elapsed: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
     @property
     def reached(self) -> float:
@@ -277,6 +280,7 @@ def fold_pattern(
     rel_tol: float = 1e-7,
     max_iter: int = 30,
     profile: Profile = PHYSICAL,
+    time_limit: float | None = None,
 ) -> FoldResult:
     """Fold ``pattern`` towards ``fraction`` x its target fold angles (see the module
     docstring).
@@ -308,6 +312,8 @@ def fold_pattern(
         Newton iteration cap per step (``max_iter - 1`` iterations).
     profile : Profile
         Model switches (default :data:`~holofold.mechanics.compat.PHYSICAL`).
+    time_limit : float, optional
+        Seconds after which the fold stops where it got (verdict ``stalls``).
 
     Returns
     -------
@@ -367,10 +373,16 @@ def fold_pattern(
     n_steps = max(2, math.ceil(top / max_step_deg)) if top > 0 else 1
     h0 = fraction / n_steps
     done, h, halvings = 0.0, h0, 0
-    fr, Us = [0.0], [U.copy()]
+    fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
     stalled = ""
+    import time
+
+    started = time.perf_counter()
     while done < fraction - 1e-12:
+        if time_limit is not None and time.perf_counter() - started > time_limit:
+            stalled = f"the time limit of {time_limit:g} s ran out at {100 * done:.1f} %"
+            break
         nxt = done + h
         if nxt > fraction - 1e-9 * h0:
             nxt = fraction
@@ -383,6 +395,7 @@ def fold_pattern(
             done = nxt
             fr.append(done)
             Us.append(U.copy())
+            clock.append(time.perf_counter() - started)
             h = min(h0, 2.0 * h)
             continue
         if h <= h0 / 2**_MAX_HALVINGS:
@@ -394,6 +407,7 @@ def fold_pattern(
                 done = nxt
                 fr.append(done)
                 Us.append(U.copy())
+                clock.append(time.perf_counter() - started)
                 snaps.append(done)
                 h = h0
                 continue
@@ -462,7 +476,7 @@ def fold_pattern(
         pattern=base, structure=structure, target=tgt, requested=fraction, fractions=fractions,
         U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
         verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
-        snaps=np.array(snaps),
+        snaps=np.array(snaps), elapsed=np.array(clock),
     )  # fmt: skip
 
 

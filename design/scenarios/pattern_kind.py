@@ -1,6 +1,6 @@
 """The pattern kind: any crease-pattern file as the design's geometry (``kind = "pattern"``).
 
-docs/scenarios.md §8.5. The file names a crease pattern (FOLD, SVG, DXF, ORIPA; read once, when
+docs/scenarios.md §8.4. The file names a crease pattern (FOLD, SVG, DXF, ORIPA; read once, when
 the scenario file is read, by :func:`holofold.geometry.read_pattern`), the material, the
 supports and loads as named vertex sets (:mod:`holofold.geometry.vertex_sets`) and the design
 features. Every design is :func:`holofold.design.simulate.simulate_pattern`: the pattern, scaled
