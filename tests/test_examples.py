@@ -24,6 +24,22 @@ def test_render_miura_writes_a_png(tmp_path, monkeypatch):
     assert (width, height) == (1400, 600)
 
 
+@pytest.mark.skipif(
+    __import__("shutil").which("rsvg-convert") is None, reason="rsvg-convert not installed"
+)
+def test_render_cutter_profiles_writes_a_png(tmp_path, monkeypatch):
+    png = tmp_path / "profiles.png"
+    monkeypatch.setattr(sys, "argv", ["render_cutter_profiles.py", str(png)])
+    runpy.run_path(str(ROOT / "examples" / "render_cutter_profiles.py"))
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(png)[..., :3]
+    assert img.shape[:2] == (810, 1170)  # 13 x 9 in at 90 dpi
+    red = (img[..., 0] - img[..., 1:].max(axis=2)) > 0.3
+    blue = (img[..., 2] - img[..., :2].max(axis=2)) > 0.3
+    assert red.sum() > 500 and blue.sum() > 500  # the profiles' lines are drawn
+
+
 #: (closing step, stiff N/m, Tmax °C) of the example's two designs, recorded on 2026-11-22
 RECORDED_GRIPPERS = {3: (155, 2.0807132979735573e-04, 337.41693604377355),
                      2: (116, 5.822928844141693e-04, 229.6125885094683)}  # fmt: skip
