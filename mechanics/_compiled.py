@@ -368,6 +368,100 @@ def dense_newton_step(
         info[j] = _accept(x, Uflat, s, free)
 
 
+@njit(**_OPTS)
+def newton_increments(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol, max_iter,
+    U_hist, conv, iters, res, moved, failed,
+):  # fmt: skip
+    """Newton-Raphson load control of each sample ``s = idx[j]``, every increment and
+    iteration in this one call (:func:`holofold.mechanics.solvers.solve_newton`'s semantics).
+
+    At increment ``i = 1..increments`` the force is ``F0[s] + i P[s]``; iterate
+    ``U[free] += K_ff^-1 (F - f_int)[free]`` while ``step < max_iter`` and ``||dU|| > tol``.
+    Records per increment (row ``i - 1``): ``U_hist[j]`` (ndof), ``conv[j]`` (R <= tol),
+    ``iters[j]`` (steps - 1), ``res[j]`` (the last R) and ``moved[j]`` (max |U - U at the
+    increment's start|). A failed step (``banded``: the band's Cholesky; otherwise dense LU)
+    stops the sample: ``failed[j] = (code, increment, step)`` with code 1 (singular, or not
+    positive definite on the banded path: the caller solves that sample another way) or 2 (a
+    non-finite solution), the failing increment recorded with the last U and R, not
+    converged."""
+    nf = free.shape[0]
+    nd = Uflat.shape[1]
+    c_u = np.array([ord("U")], np.uint8)
+    c_n = np.array([ord("N")], np.uint8)
+    n_ = np.array([nf], np.int32)
+    kd_ = np.array([bw], np.int32)
+    ld_ = np.array([bw + 1], np.int32)
+    one = np.array([1], np.int32)
+    inf_ = np.zeros(1, np.int32)
+    piv = np.empty(nf, np.int32)
+    a = np.empty((bw + 1) * nf if banded else nf * nf)
+    f = np.empty(nd)
+    Fi = np.empty(nd)
+    start = np.empty(nd)
+    x = np.empty(nf)
+    y = np.empty(nf)
+    acc = np.empty(_acc_size(force_lists, tangent_lists))
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        failed[j, 0] = 0
+        for i in range(1, increments + 1):
+            for d in range(nd):
+                Fi[d] = F0[s, d] + i * P[s, d]
+                start[d] = Uflat[s, d]
+            step = 1
+            R = np.inf
+            code = 0
+            while step < max_iter and R > tol:
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    tangent_lists, views, flats, f, a, acc,
+                )  # fmt: skip
+                if banded:
+                    _fcall(addrs[0], (c_u, n_, kd_, a, ld_, inf_))
+                    if inf_[0] != 0:
+                        code = 1
+                        break
+                    for q in range(nf):
+                        d = free[perm[q]]
+                        y[q] = Fi[d] - f[d]
+                    _fcall(addrs[1], (c_u, n_, kd_, one, a, ld_, y, n_, inf_))
+                    for q in range(nf):
+                        x[perm[q]] = y[q]
+                else:
+                    _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
+                    if inf_[0] > 0:
+                        code = 1
+                        break
+                    for q in range(nf):
+                        d = free[q]
+                        x[q] = Fi[d] - f[d]
+                    _fcall(addrs[1], (c_n, n_, one, a, n_, piv, x, n_, inf_))
+                code = _accept(x, Uflat, s, free)
+                if code:
+                    break
+                R2 = 0.0
+                for q in range(nf):
+                    R2 += x[q] * x[q]
+                R = math.sqrt(R2)
+                step += 1
+            row = i - 1
+            mv = 0.0
+            for d in range(nd):
+                U_hist[j, row, d] = Uflat[s, d]
+                mv = max(mv, abs(Uflat[s, d] - start[d]))
+            moved[j, row] = mv
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j, 0] = code
+                failed[j, 1] = i
+                failed[j, 2] = step
+                break
+
+
 # ------------------------------------------------------------------------ thermal
 # The small-model steady temperature of :mod:`holofold.mechanics.thermal` (reference
 # geometry) without its forty array operations per heating step (the numpy path keeps

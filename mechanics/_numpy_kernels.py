@@ -24,6 +24,7 @@ __all__ = [
     "assemble_batch",
     "band_newton_step",
     "dense_newton_step",
+    "newton_increments",
     "lapack_addresses",
 ]
 
@@ -146,6 +147,58 @@ def dense_newton_step(
         x, _ = dgetrs(lu, piv, r)
         dU[j] = x
         info[j] = _accept(dU[j], Uflat, s, free)
+
+
+def newton_increments(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
+    views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol, max_iter,
+    U_hist, conv, iters, res, moved, failed,
+):  # fmt: skip
+    """Newton-Raphson load control of each sample, every increment in this call (the
+    compiled twin's semantics and records; see ``_compiled.newton_increments``)."""
+    nf = free.shape[0]
+    a = np.empty((bw + 1) * nf if banded else nf * nf)
+    f = np.empty(Uflat.shape[1])
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        failed[j] = 0
+        for i in range(1, increments + 1):
+            Fi = F0[s] + i * P[s]
+            start = Uflat[s].copy()
+            step, R, code = 1, np.inf, 0
+            while step < max_iter and R > tol:
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    tangent_lists, views, flats, f, a,
+                )  # fmt: skip
+                r = (Fi - f)[free]
+                if banded:
+                    c, inf = dpbtrf(a.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
+                    if inf != 0:
+                        code = 1
+                        break
+                    x = np.empty(nf)
+                    x[perm] = dpbtrs(c, r[perm], lower=0)[0]
+                else:
+                    lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
+                    if inf > 0:
+                        code = 1
+                        break
+                    x = dgetrs(lu, piv, r)[0]
+                code = _accept(x, Uflat, s, free)
+                if code:
+                    break
+                R = float(np.sqrt(x @ x))
+                step += 1
+            row = i - 1
+            U_hist[j, row] = Uflat[s]
+            moved[j, row] = np.abs(Uflat[s] - start).max(initial=0.0)
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j] = (code, i, step)
+                break
 
 
 def lapack_addresses(*names: str) -> np.ndarray:

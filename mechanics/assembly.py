@@ -122,8 +122,24 @@ class KernelInputs(NamedTuple):
         return KernelInputs(*(a.reshape((1, *a.shape)) for a in self))
 
     @classmethod
-    def stack(cls, items) -> KernelInputs:
-        return cls(*(np.stack(col) for col in zip(*items, strict=True)))
+    def stack_of(cls, structures) -> KernelInputs:
+        """The inputs of S structures of one size, stacked (S, ...), built as arrays."""
+        X = np.stack([np.asarray(s.nodes, float) for s in structures])
+        bars = np.stack([s.bars for s in structures]).astype(np.intp)
+        b0 = np.ascontiguousarray(bars[:, :, 0])
+        b1 = np.ascontiguousarray(bars[:, :, 1])
+        D0 = np.take_along_axis(X, b1[..., None], 1) - np.take_along_axis(X, b0[..., None], 1)
+        springs = np.stack([s.springs for s in structures]).astype(np.intp)
+        return cls(
+            X,
+            b0,
+            b1,
+            np.ascontiguousarray(D0.transpose(0, 2, 1)),
+            np.stack([np.asarray(s.bar_length, float) for s in structures]),
+            np.stack([s.bar_E * s.bar_area for s in structures]).astype(float),
+            np.ascontiguousarray(springs.transpose(0, 2, 1)),
+            np.stack([np.asarray(s.spring_k, float) for s in structures]),
+        )
 
 
 def sum_into(lists: SumLists, bar_values, spring_values, out) -> np.ndarray:
@@ -348,33 +364,41 @@ class BatchAssembler:
         structures = list(structures)
         if not structures:
             raise ValueError("a batch needs at least one structure")
-        asms = [Assembler(s, dense_max=dense_max) for s in structures]
-        a0 = asms[0]
-        sizes = {(a.n_dof, len(a.bars), len(a.springs)) for a in asms}
-        masks = {a.structure.supports.tobytes() for a in asms}
+        sizes = {(s.n_dof, len(s.bars), len(s.springs)) for s in structures}
+        masks = {s.supports.tobytes() for s in structures}
         if len(sizes) > 1 or len(masks) > 1:
             raise ValueError("the structures of a batch need the same sizes and supports")
-        self.assemblers = asms
+        self.structures = structures
         self.dense_max = int(dense_max)
-        self.n = len(asms)
-        self.n_dof = a0.n_dof
+        self.n = len(structures)
+        self.n_dof = structures[0].n_dof
+        self.patterns = [assembly_pattern(s) for s in structures]
         groups: dict[int, list[int]] = {}
-        for i, a in enumerate(asms):
-            groups.setdefault(id(a.pattern), []).append(i)
+        for i, pat in enumerate(self.patterns):
+            groups.setdefault(id(pat), []).append(i)
+        free = ~structures[0].supports.ravel()
         #: (pattern, reduction, samples) of each connectivity
         self.groups = [
-            (asms[g[0]].pattern, asms[g[0]].reduction, np.array(g, np.intp))
+            (self.patterns[g[0]], self.patterns[g[0]].reduced(free), np.array(g, np.intp))
             for g in groups.values()
         ]
-        self.inputs = KernelInputs.stack([a.inputs for a in asms])
-        self.theta0 = np.stack([np.asarray(a.theta0, float) for a in asms])
-        self.k_nonneg = np.array([a.k_nonneg for a in asms])
-        self.arccos = [a.arccos for a in asms]
-        self.scratch = ElementArrays.empty(len(a0.bars), len(a0.springs))
+        self.inputs = KernelInputs.stack_of(structures)
+        self.theta0 = np.stack([np.asarray(s.spring_rest, float) for s in structures])
+        self.k_nonneg = np.all(self.inputs.k >= 0.0, axis=1)
+        self.arccos = [s.profile.arccos_dihedral and len(s.springs) > 0 for s in structures]
+        self.scratch = ElementArrays.empty(len(structures[0].bars), len(structures[0].springs))
+
+    @cached_property
+    def assemblers(self) -> list[Assembler]:
+        """One :class:`Assembler` per structure (built on first use: the fallbacks)."""
+        return [
+            Assembler(s, pat, dense_max=self.dense_max)
+            for s, pat in zip(self.structures, self.patterns, strict=True)
+        ]
 
     @property
     def free_dofs(self) -> np.ndarray:
-        return self.assemblers[0].free_dofs
+        return self.groups[0][1].free
 
     def rest_angles(self, U3, active, spring_rest=None) -> np.ndarray:
         """(S, ns) rest angles the kernels use (the reference's arccos shift where asked)."""
@@ -385,8 +409,8 @@ class BatchAssembler:
             rest = rest.copy()
             for s in np.flatnonzero(active):
                 if self.arccos[s]:
-                    a = self.assemblers[s]
-                    rest[s] = rest[s] + arccos_shift(a.X + U3[s], a.springs)
+                    st = self.structures[s]
+                    rest[s] = rest[s] + arccos_shift(st.nodes + U3[s], st.springs)
         return np.ascontiguousarray(rest)
 
     def factorized(self, U, active, spring_rest=None):

@@ -265,12 +265,21 @@ class _Auto:
 _AUTO = _Auto()
 
 
+_FIXED: dict[str, KernelPath] = {}
+
+
 def active() -> KernelPath:
-    """The kernel path this process runs now (see the module docstring)."""
+    """The kernel path this process runs now (see the module docstring). Cheap: called once
+    per evaluation."""
+    mode = os.environ.get(ENV, "auto")
+    path = _FIXED.get(mode)
+    if path is not None:
+        return path
     mode = requested()
     if mode == "auto":
         return _AUTO.resolve()
-    return kernel_path(mode)
+    path = _FIXED[os.environ.get(ENV, "auto")] = kernel_path(mode)
+    return path
 
 
 # ------------------------------------------------------------------------------ compiling

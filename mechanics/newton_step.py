@@ -11,7 +11,7 @@ angle, banded tangents that are not positive definite) the batch falls back to
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -21,7 +21,7 @@ from holofold.mechanics.linear import NON_FINITE, SINGULAR, SingularSystemError,
 if TYPE_CHECKING:
     from holofold.mechanics.assembly import Assembler, BatchAssembler
 
-__all__ = ["DenseStepper", "batch_newton_step"]
+__all__ = ["DenseStepper", "NewtonRecords", "batch_newton_step", "batch_newton_increments"]
 
 _LAPACK = {"banded": ("dpbtrf", "dpbtrs"), "dense": ("dgetrf", "dgetrs")}
 
@@ -127,3 +127,63 @@ def batch_newton_step(batch: BatchAssembler, U, rhs_force, active):
             U[s, free] += dU_s
             dU_all[s] = dU_s
     return dU_all, errors
+
+
+class NewtonRecords(NamedTuple):
+    """Per-increment records of S samples' Newton-Raphson load control
+    (:func:`batch_newton_increments`): ``U`` (S, increments, ndof) m, ``converged`` (R <= tol),
+    ``iterations``, ``residual`` (the last ||dU||, m) and ``moved`` (max |U - U at the
+    increment's start|, m), each (S, increments); ``failed`` (S, 3): (code, increment, step)
+    of the step that stopped a sample (code 0 none, 1 singular or, ``banded[s]``, not positive
+    definite, 2 a non-finite solution); rows after a failing increment are undefined."""
+
+    U: np.ndarray
+    converged: np.ndarray
+    iterations: np.ndarray
+    residual: np.ndarray
+    moved: np.ndarray
+    failed: np.ndarray
+    banded: np.ndarray
+
+
+def batch_newton_increments(batch: BatchAssembler, U, F0, P, increments, tol, max_iter):
+    """Every increment and iteration of :func:`~holofold.mechanics.solvers.solve_newton` for
+    each sample of ``batch`` in one kernel call per connectivity (``U`` (S, ndof) C-contiguous,
+    updated in place; ``F0``, ``P`` (S, ndof): applied force and load per increment, N), or
+    None where some sample is on neither the dense nor the banded path or uses the reference's
+    arccos angle (then iterate with :func:`batch_newton_step`)."""
+    kinds = [solver_path(red, batch.dense_max) for _, red, _ in batch.groups]
+    if any(batch.arccos) or any(k not in _LAPACK for k in kinds):
+        return None
+    ck = kernels.active().module
+    S, nd = U.shape
+    U3 = U.reshape(S, -1, 3)
+    rec = NewtonRecords(
+        np.empty((S, increments, nd)), np.zeros((S, increments), bool),
+        np.zeros((S, increments), np.int64), np.full((S, increments), np.nan),
+        np.zeros((S, increments)), np.zeros((S, 3), np.int64), np.zeros(S, bool),
+    )  # fmt: skip
+    F0 = np.ascontiguousarray(F0, dtype=float)
+    P = np.ascontiguousarray(P, dtype=float)
+    flats = batch.scratch.flat()
+    for (pat, red, members), kind in zip(batch.groups, kinds, strict=True):
+        banded = kind == "banded"
+        band = red.band if banded else None
+        perm = band.perm if banded else np.zeros(0, np.intp)
+        bw = band.bandwidth if banded else 0
+        idx = np.ascontiguousarray(members, dtype=np.intp)
+        n = idx.size
+        out = (np.empty((n, increments, nd)), np.zeros((n, increments), bool),
+               np.zeros((n, increments), np.int64), np.full((n, increments), np.nan),
+               np.zeros((n, increments)), np.zeros((n, 3), np.int64))  # fmt: skip
+        ck.newton_increments(
+            *batch.inputs.with_displacements(U3), batch.theta0, batch.k_nonneg, idx,
+            pat.force_sums, red.tangent_sums("banded" if banded else "dense_cm"),
+            batch.scratch, flats, F0, P, red.free, banded, perm, bw,
+            ck.lapack_addresses(*_LAPACK[kind]), U, int(increments), float(tol),
+            int(max_iter), *out,
+        )  # fmt: skip
+        for field, values in zip(rec[:6], out, strict=True):
+            field[idx] = values
+        rec.banded[idx] = banded
+    return rec
