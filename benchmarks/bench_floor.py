@@ -59,6 +59,7 @@ import holofold.mechanics.assembly as assembly
 from holofold import mechanics as threads
 from holofold.design.scenarios import arch, canopy, gripper, single_miura
 from holofold.mechanics import linear
+from holofold.mechanics.solvers import newton as newton_solvers
 
 ROOT = Path(__file__).resolve().parents[1]
 REF = Path(os.environ.get("HOLOFOLD_REFERENCE_DATA", ROOT.parent / "shared" / "reference-data"))
@@ -139,9 +140,30 @@ class Capture:
             self.K[key].append(sp.csr_matrix(K))
             self.red[key] = asm.reduction
 
+    def _record_iterations(self, asm, Us, counts):
+        """``counts[r]`` iterations that ended at displacement ``Us[r]`` (one row per
+        increment, from a whole-increments kernel call)."""
+        for U, n in zip(Us, counts, strict=True):
+            for _ in range(int(n)):
+                self._record(asm, U, None)
+
     def __enter__(self):
         cap = self
         self.orig = assembly.Assembler.evaluate_factorized
+        self.orig_incr = newton_solvers.batch_newton_increments
+
+        def spy_incr(b, U, F0, P, increments, tol, max_iter):
+            rec = cap.orig_incr(b, U, F0, P, increments, tol, max_iter)
+            if rec is not None:
+                for s in range(b.n):
+                    code, at = int(rec.failed[s, 0]), int(rec.failed[s, 1])
+                    count = at if code else rec.U.shape[1]
+                    asm = b.assemblers[s]
+                    Us = rec.U[s, :count].reshape(count, -1, 3)
+                    cap._record_iterations(asm, Us, rec.iterations[s, :count])
+            return rec
+
+        newton_solvers.batch_newton_increments = spy_incr
 
         def spy(asm, U, spring_rest=None):
             cap._record(asm, U, spring_rest)
@@ -194,6 +216,7 @@ class Capture:
 
     def __exit__(self, *exc):
         assembly.Assembler.evaluate_factorized = self.orig
+        newton_solvers.batch_newton_increments = self.orig_incr
         if self.orig_stepper is not None:
             assembly.Assembler.dense_stepper = self.orig_stepper
         if getattr(assembly, "BatchAssembler", None) is not None:

@@ -179,7 +179,7 @@ def test_a_hanging_row_times_out_and_the_run_goes_on():
 @pytest.mark.parametrize("workers", [1, 2])
 def test_tiny_limit_times_out_every_row_and_leaves_results_unchanged(miura, workers):
     sc, designs = miura
-    res = evaluate_designs(sc, designs, workers=workers, row_timeout=1e-3)
+    res = evaluate_designs(sc, designs, workers=workers, row_timeout=1e-7)
     assert len(res) == len(designs)
     assert res["status"].str.startswith(TIMEOUT).all()
     assert res[sc.performance_names].isna().all().all()
@@ -191,7 +191,7 @@ def test_tiny_limit_times_out_every_row_and_leaves_results_unchanged(miura, work
 def test_batched_rows_time_out_one_by_one():
     sc = load_scenario("arch")
     designs = sample_designs(sc, 3, seed=2, fixed={"m": 8})
-    res = evaluate_designs(sc, designs, row_timeout=1e-3)
+    res = evaluate_designs(sc, designs, row_timeout=1e-7)
     assert res["status"].str.startswith(TIMEOUT).all()
     ok = evaluate_designs(sc, designs, on_invalid="skip")  # the default limit: no timeout
     assert (ok["status"] == "converged").all()
@@ -200,7 +200,7 @@ def test_batched_rows_time_out_one_by_one():
 # ---------------------------------------------------------------------------- databases
 def test_resume_of_a_generate_with_timeouts_duplicates_nothing(tmp_path):
     folder = tmp_path / "db"
-    first = generate_database("single-miura", 6, folder, chunk_size=2, row_timeout=1e-3)
+    first = generate_database("single-miura", 6, folder, chunk_size=2, row_timeout=1e-7)
     assert first["status"].str.startswith(TIMEOUT).all()
     chunks = sorted((folder / "chunks").glob("part-*.parquet"))
     assert len(chunks) == 3
@@ -257,7 +257,7 @@ def test_verify_command_with_row_timeout(tmp_path, capsys):
     rules = tmp_path / "rules.json"
     rules.write_text(json.dumps([{"rule": "any", "bounds": {"gama": {"gt": 1.0, "le": None}}}]))
     argv = ["verify", "single-miura", "--rules", str(rules), "--target", "axialstiff60 < 6000",
-            "-n", "3", "--row-timeout", "0.001", "--on-invalid", "skip"]  # fmt: skip
+            "-n", "3", "--row-timeout", "1e-7", "--on-invalid", "skip"]  # fmt: skip
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "no fresh design simulated successfully (3 failed)" in out

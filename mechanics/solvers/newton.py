@@ -28,11 +28,15 @@ import numpy as np
 
 from holofold.geometry.errors import ParameterError
 from holofold.mechanics.assembly import Assembler, BatchAssembler, SingularSystemError
+from holofold.mechanics.linear import NON_FINITE, SINGULAR
+from holofold.mechanics.newton_step import batch_newton_increments
 from holofold.mechanics.solvers._common import (
     RESOLUTION,
     History,
     check_controls,
+    describe,
     get_assembler,
+    logger,
     model_size,
     nodal_array,
 )
@@ -162,14 +166,28 @@ def solve_newton_batch(
     if len(loads) != S:
         raise ParameterError(f"loads: {len(loads)} given for {S} structures")
     P = np.stack([nodal_array("load", ld, nn).ravel() for ld in loads])
-    F0v = np.stack([nodal_array("F0", None if F0 is None else F0[s], nn).ravel() for s in range(S)])
-    U = np.stack([nodal_array("U0", None if U0 is None else U0[s], nn).ravel() for s in range(S)])
+    F0v = _stacked("F0", F0, S, nn)
+    U = _stacked("U0", U0, S, nn)
+    free = B.free_dofs
+    X = B.inputs.X  # model_size of every structure at once
+    size = np.maximum(np.ptp(X, axis=1).max(axis=1), np.abs(X).max(axis=(1, 2)))
+    floors = np.where(np.any(P[:, free] != 0.0, axis=1), RESOLUTION * np.maximum(size, 1e-300), 0.0)
+    rec = batch_newton_increments(B, U, F0v, P, increments, tol, max_iter)
+    if rec is not None:  # every increment of every sample in one kernel call per connectivity
+        out = []
+        for s in range(S):
+            if rec.failed[s, 0] == 1 and rec.banded[s]:  # not positive definite: LU alone
+                out.append(solve_newton(
+                    structures[s], loads[s], increments=increments, tol=tol,
+                    max_iter=max_iter, U0=None if U0 is None else U0[s],
+                    F0=None if F0 is None else F0[s],
+                ))  # fmt: skip
+                continue
+            out.append(_from_records(rec, s, structures[s], tol, floors[s], F0v[s], P[s]))
+        return out
     hists = [History(increments, nn) for _ in range(S)]
     alive = np.ones(S, bool)
     last = np.zeros(S, np.int64)
-    free = B.free_dofs
-    floors = np.array([RESOLUTION * model_size(st) if np.any(P[s, free]) else 0.0
-                       for s, st in enumerate(structures)])  # fmt: skip
     for i in range(1, increments + 1):
         Fi = F0v + i * P
         step = np.ones(S, np.int64)
@@ -200,3 +218,41 @@ def solve_newton_batch(
         )
         for s in range(S)
     ]
+
+
+def _stacked(name, values, S, nn) -> np.ndarray:
+    """(S, 3 nn) C-contiguous: the per-sample nodal arrays ``values`` (checked), or zeros."""
+    if values is None:
+        return np.zeros((S, 3 * nn))
+    return np.stack([nodal_array(name, values[s], nn).ravel() for s in range(S)])
+
+
+def _from_records(rec, s, structure, tol, floor, F0, P) -> SolveResult:
+    """Sample ``s``'s :class:`SolveResult` from :func:`batch_newton_increments`' records, as
+    :func:`solve_newton` builds it."""
+    code, at, step = (int(v) for v in rec.failed[s])
+    count = at if code else rec.U.shape[1]
+    conv = rec.converged[s, :count].copy()
+    unresolved = {}
+    if floor:
+        for c in range(count - (1 if code else 0)):
+            if rec.moved[s, c] < floor:
+                unresolved[c] = (float(rec.moved[s, c]), floor)
+                conv[c] = False
+    failure = None
+    if code:
+        failure = f"increment {at}, iteration {step}: {SINGULAR if code == 1 else NON_FINITE}"
+    iters, res = rec.iterations[s, :count].copy(), rec.residual[s, :count].copy()
+    status = describe(conv, iters, res, tol, "||dU||", failure, unresolved)
+    if not status.converged:
+        logger.info("solve_newton: %s", status)
+    return SolveResult(
+        U_history=rec.U[s, :count].reshape(count, -1, 3).copy(),
+        load_factor=np.arange(1, count + 1, dtype=float),
+        converged=conv,
+        iterations=iters,
+        residual=res,
+        status=status,
+        applied_force=(F0 + count * P).reshape(-1, 3),
+        spring_rest=np.asarray(structure.spring_rest, float).copy(),
+    )
