@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from sklearn.base import clone
+from sklearn.tree import DecisionTreeClassifier
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner, forest_boxes, stack_trees
@@ -71,7 +72,7 @@ def test_threshold_zero_is_a_real_bound():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FewRulesWarning)
         m = _one_tree().fit(X, y)
-    assert m.estimators_[0].tree_.threshold[0] == 0.0
+    assert m.trees_[0].threshold[0] == 0.0
     assert len(m.rules_) == 1
     assert m.rules_.loc[0, "x0_gt"] == 0.0  # not dropped as a "no bound" sentinel
     assert m.rules_.loc[0, "x0_le"] == np.inf
@@ -80,7 +81,7 @@ def test_threshold_zero_is_a_real_bound():
     np.testing.assert_array_equal(m.predict([[0.0], [1e-30], [-1e-30], [5.0]]), [0, 1, 0, 1])
 
 
-def test_upper_bound_is_inclusive():
+def test_upper_bound_is_inclusive_in_float64():
     X = np.array([[1.0], [2.0], [3.0], [4.0]])
     y = np.array([1, 1, 0, 0])  # split at 2.5, left branch (x <= 2.5) is the target
     with warnings.catch_warnings():
@@ -88,23 +89,22 @@ def test_upper_bound_is_inclusive():
         m = _one_tree().fit(X, y)
     assert m.rules_.loc[0, "x0_le"] == 2.5
     above32 = float(np.nextafter(np.float32(2.5), np.float32(3)))
-    above64 = np.nextafter(2.5, 3.0)  # rounds to 2.5 in float32, so it goes left like sklearn
+    above64 = np.nextafter(2.5, 3.0)  # rounds to 2.5 in float32, but is above it: outside
     probe = [[2.5], [above32], [above64], [-7.0]]
-    np.testing.assert_array_equal(m.predict(probe), [1, 0, 1, 1])
-    np.testing.assert_array_equal(m.predict(probe), m.estimators_[0].predict(probe))
+    np.testing.assert_array_equal(m.predict(probe), [1, 0, 0, 1])
 
 
-def test_rules_apply_exactly_like_the_tree_float32():
-    """Each leaf's box matches exactly the rows the tree sends to that leaf, including values
-    at thresholds and their float32-rounding neighbours."""
+def test_rules_apply_exactly_like_the_trees():
+    """Each leaf's box holds exactly the rows the trees send to that leaf, including values
+    at thresholds and one float64 ulp around them (one semantics: float64, x <= t left)."""
     rng = np.random.default_rng(1)
     X = rng.normal(size=(300, 3))
     y = (X[:, 0] + 0.5 * X[:, 1] ** 2 - X[:, 2] > 0.3).astype(int)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FewRulesWarning)
         m = _one_tree(precision_min=0.0).fit(X, y)
-    tree = m.estimators_[0]
-    thr = tree.tree_.threshold[tree.tree_.children_left >= 0]
+    tree = m.trees_[0]
+    thr = tree.threshold[tree.left >= 0]
     # probe rows: random, exactly at thresholds, and one float64 ulp around them
     probes = [rng.normal(size=(500, 3))]
     for t in thr:
@@ -113,9 +113,9 @@ def test_rules_apply_exactly_like_the_tree_float32():
             row[np.arange(3), np.arange(3)] = v
             probes.append(row)
     P = np.vstack(probes)
-    leaf = tree.apply(P)
-    ids = np.flatnonzero(tree.tree_.children_left < 0)
-    positive = tree.classes_[np.argmax(tree.tree_.value[ids, 0, :], axis=1)] == 1
+    leaf = m.apply(P)[:, 0]
+    ids = np.flatnonzero(tree.left < 0)
+    positive = tree.positive[ids]
     inside = m.rule_matches(P, which="all")
     # every target leaf is one rule (no duplicates within one tree) ...
     assert inside.shape[0] == positive.sum()
@@ -124,7 +124,34 @@ def test_rules_apply_exactly_like_the_tree_float32():
     want = sorted(tuple(np.flatnonzero(leaf == i)) for i in ids[positive])
     assert got == want
     # predict with all rules kept equals the tree's own prediction
-    np.testing.assert_array_equal(m.predict(P), tree.predict(np.asarray(P, np.float32)))
+    np.testing.assert_array_equal(m.predict(P), tree.positive[leaf])
+
+
+@pytest.mark.parametrize("ccp_alpha", [0.0, 1e-3])
+def test_the_trees_are_scikit_learns_on_a_well_scaled_table(ccp_alpha):
+    """Grown on rank codes, a tree is the one scikit-learn grows on the values themselves
+    (when no two values are closer than its 1e-7 tie limit): the same leaves for every row,
+    its thresholds at the same midpoints, pruned the same way."""
+    rng = np.random.default_rng(4)
+    X = rng.uniform(1, 5, size=(400, 3))
+    y = ((X[:, 0] > 2.5) & (X[:, 1] < 4)) ^ (rng.uniform(size=400) < 0.1)
+    m = _one_tree(ccp_alpha=ccp_alpha, min_samples_leaf=2, min_samples_split=4).fit(X, y)
+    rows = m.estimators_samples_[0]
+    ref = DecisionTreeClassifier(
+        criterion="entropy", min_samples_leaf=2, min_samples_split=4, max_depth=20,
+        ccp_alpha=ccp_alpha, random_state=int(m._seeds[0]), class_weight="balanced",
+    ).fit(X[rows], y[rows])  # fmt: skip
+    ours = m.trees_[0]
+    probe = rng.uniform(1, 5, size=(2000, 3))
+    a, b = m.apply(probe)[:, 0], ref.apply(probe)
+    # the same partition of the rows into leaves (node ids differ after pruning)
+    pairs = set(zip(a.tolist(), b.tolist(), strict=True))
+    assert len(pairs) == len(set(a.tolist())) == len(set(b.tolist()))
+    if ccp_alpha:  # pruning cut branches, the same ones
+        assert ref.get_n_leaves() < m.estimators_[0].get_n_leaves()
+    assert np.count_nonzero(ours.left >= 0) == ref.get_n_leaves() - 1
+    ref_thr = np.sort(ref.tree_.threshold[ref.tree_.children_left >= 0])
+    np.testing.assert_allclose(np.sort(ours.threshold[ours.left >= 0]), ref_thr, rtol=1e-7)
 
 
 def test_forest_boxes_match_path_walk():
@@ -132,24 +159,23 @@ def test_forest_boxes_match_path_walk():
     X = rng.uniform(size=(400, 4))
     y = (X[:, 0] > X[:, 1]).astype(int)
     m = ForestRuleMiner(n_estimators=5, random_state=2, max_depth=6).fit(X, y)
-    forest = stack_trees(m.estimators_)
+    forest = stack_trees(m.trees_)
     lower, upper = forest_boxes(forest, 4)
-    for k, t in enumerate(m.estimators_):
-        tr = t.tree_
+    for k, tr in enumerate(m.trees_):
         stack = [(0, np.full(4, -np.inf), np.full(4, np.inf))]
         while stack:  # a plain recursive walk, node by node
             i, lo, hi = stack.pop()
             g = forest.offsets[k] + i
             np.testing.assert_array_equal(lower[g], lo)
             np.testing.assert_array_equal(upper[g], hi)
-            if tr.children_left[i] >= 0:
+            if tr.left[i] >= 0:
                 f, th = tr.feature[i], tr.threshold[i]
                 hi2 = hi.copy()
                 hi2[f] = min(hi2[f], th)
                 lo2 = lo.copy()
                 lo2[f] = max(lo2[f], th)
-                stack.append((tr.children_left[i], lo, hi2))
-                stack.append((tr.children_right[i], lo2, hi))
+                stack.append((tr.left[i], lo, hi2))
+                stack.append((tr.right[i], lo2, hi))
 
 
 def test_scores_are_exact_and_boxes_unique():
@@ -306,8 +332,8 @@ def test_first_trees_are_the_smaller_forest_and_depth_reuse_is_exact():
     pd.testing.assert_frame_equal(sub.candidate_rules_, small.candidate_rules_)
     pd.testing.assert_frame_equal(deeper.candidate_rules_, deep.candidate_rules_)
     assert 0 < deeper.n_retrained_ <= 40
-    for a, b in zip(deeper.estimators_, deep.estimators_, strict=True):
-        np.testing.assert_array_equal(a.tree_.threshold, b.tree_.threshold)
+    for a, b in zip(deeper.trees_, deep.trees_, strict=True):
+        np.testing.assert_array_equal(a.threshold, b.threshold)
 
 
 @pytest.mark.filterwarnings("ignore::holofold.design.rules.FewRulesWarning")

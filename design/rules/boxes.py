@@ -9,7 +9,8 @@ __all__ = ["boxes_contain", "tighten", "simplify_boxes", "drop_idle_conditions"]
 
 
 def boxes_contain(lower: np.ndarray, upper: np.ndarray, Z: np.ndarray) -> np.ndarray:
-    """Which rows lie in which boxes, with scikit-learn's float32 semantics.
+    """Which rows lie in which boxes: ``lower < x <= upper`` on every feature, in float64 on
+    the table's values (the one semantics of a rule, as :meth:`Rule.mask`).
 
     Parameters
     ----------
@@ -20,7 +21,7 @@ def boxes_contain(lower: np.ndarray, upper: np.ndarray, Z: np.ndarray) -> np.nda
     -------
     ndarray of bool, shape (n_boxes, n_rows)
     """
-    Zf = np.asarray(Z, dtype=np.float32).astype(np.float64)
+    Zf = np.asarray(Z, dtype=np.float64)
     out = np.ones((lower.shape[0], Zf.shape[0]), dtype=bool)
     for r in range(lower.shape[0]):  # a handful of kept rules; features vectorised
         cols = np.flatnonzero(np.isfinite(lower[r]) | np.isfinite(upper[r]))
@@ -30,7 +31,7 @@ def boxes_contain(lower: np.ndarray, upper: np.ndarray, Z: np.ndarray) -> np.nda
     return out
 
 
-def tighten(lower, upper, Z32, y_pos, numeric):
+def tighten(lower, upper, Z, y_pos, numeric):
     """Move each finite numeric bound of each box inward to its outermost target training row.
 
     A leaf's bound lies halfway between two values of the rows its tree trained on, so the
@@ -38,15 +39,15 @@ def tighten(lower, upper, Z32, y_pos, numeric):
     is a guess. Categorical columns (``numeric`` False) keep their bounds; so does a side that
     is open (no new condition is added).
     """
-    Zf = np.asarray(Z32, dtype=np.float32)
-    inside = boxes_contain(lower, upper, Z32) & (y_pos == 1)
+    Zf = np.asarray(Z, dtype=np.float64)
+    inside = boxes_contain(lower, upper, Zf) & (y_pos == 1)
     lower, upper = lower.copy(), upper.copy()
     for i in range(lower.shape[0]):
         z = Zf[inside[i]]
         if not z.shape[0]:
             continue
         for c in np.flatnonzero(np.isfinite(lower[i]) & numeric):
-            below = float(np.nextafter(z[:, c].min(), np.float32(-np.inf)))  # x > below: x >= min
+            below = float(np.nextafter(z[:, c].min(), -np.inf))  # x > below: x >= min
             lower[i, c] = max(lower[i, c], below)
         for c in np.flatnonzero(np.isfinite(upper[i]) & numeric):
             upper[i, c] = min(upper[i, c], float(z[:, c].max()))
@@ -71,7 +72,7 @@ def _open(lower, upper, i: int, cond) -> None:
         upper[i, c] = np.inf
 
 
-def simplify_boxes(lower, upper, Z32, y_pos, weight, prior, precision_min):
+def simplify_boxes(lower, upper, Z, y_pos, weight, prior, precision_min):
     """Drop conditions that do not raise the out-of-bag precision estimate.
 
     Greedy: repeatedly drop the condition whose removal gives the highest estimate, as long as
@@ -80,7 +81,7 @@ def simplify_boxes(lower, upper, Z32, y_pos, weight, prior, precision_min):
     found box ``i``; the estimate is the posterior mean under ``prior`` on those rows.
     """
     mu, k = prior
-    Zf = np.asarray(Z32, dtype=np.float32).astype(np.float64)
+    Zf = np.asarray(Z, dtype=np.float64)
     pos = y_pos == 1
     lower, upper = lower.copy(), upper.copy()
     for i in range(lower.shape[0]):
@@ -117,13 +118,13 @@ def simplify_boxes(lower, upper, Z32, y_pos, weight, prior, precision_min):
     return lower, upper
 
 
-def drop_idle_conditions(lower, upper, Z32):
+def drop_idle_conditions(lower, upper, Z):
     """Drop the conditions of each box that no training row depends on.
 
     A condition is idle when no row violates it alone: without it the box holds the same
     rows. Conditions are tried in column order and dropped one at a time.
     """
-    Zf = np.asarray(Z32, dtype=np.float32).astype(np.float64)
+    Zf = np.asarray(Z, dtype=np.float64)
     lower, upper = lower.copy(), upper.copy()
     for i in range(lower.shape[0]):
         conds, viol = _conditions(lower[i], upper[i], Zf)

@@ -1,5 +1,6 @@
-"""How a table's features map to the encoded columns the trees see (categorical levels one-hot
-or ordinal)."""
+"""How a table's features map to the columns the trees see: categorical levels one-hot or
+ordinal (:class:`Encoding`), then every column as the rank of its value (:class:`RankCodes`), so
+that mining does not depend on units."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 
 from holofold.design.rules.text import fmt_level
 
-__all__ = ["Encoding"]
+__all__ = ["Encoding", "RankCodes"]
 
 
 @dataclass(frozen=True)
@@ -107,3 +108,33 @@ class Encoding:
             d[n][0] if self.categorical[j] else (float(d[n][0][0]), float(d[n][1][0]))
             for j, n in enumerate(self.names)
         ]
+
+
+@dataclass(frozen=True)
+class RankCodes:
+    """The rank of each value among a column's distinct training values: what the trees see.
+
+    scikit-learn's splitter treats feature values closer than 1e-7 as equal, so a feature in
+    metres that lives at the micrometre scale cannot be split; the order of the values is all a
+    tree's split search uses, so trees grown on ranks are the trees grown on any well-scaled
+    copy of the table, and the same whether it is in m, mm or um. ``values[j]`` maps a code of
+    encoded column ``j`` back to its value in the table's units
+    (:func:`~holofold.design.rules.forest.tree_arrays` places every threshold there).
+    """
+
+    values: tuple  # per encoded column: sorted distinct training values (float64)
+
+    @classmethod
+    def fit(cls, Z: np.ndarray) -> RankCodes:
+        Z = np.asarray(Z, dtype=np.float64)
+        return cls(tuple(np.unique(Z[:, j]) for j in range(Z.shape[1])))
+
+    def codes(self, Z: np.ndarray) -> np.ndarray:
+        """(n, d) float32 codes of rows whose values were all seen in :meth:`fit`."""
+        Z = np.asarray(Z, dtype=np.float64)
+        out = np.empty(Z.shape, dtype=np.float32)
+        for j, v in enumerate(self.values):
+            out[:, j] = np.searchsorted(v, Z[:, j])
+        if max((len(v) for v in self.values), default=0) > 2**24:
+            raise ValueError("more than 2^24 distinct values in one feature")
+        return out

@@ -5,15 +5,15 @@ from __future__ import annotations
 
 import logging
 import warnings
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
-from sklearn.base import BaseEstimator, ClassifierMixin, _fit_context
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.model_selection import train_test_split
 from sklearn.tree import DecisionTreeClassifier
 from sklearn.utils import check_random_state
-from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
@@ -23,8 +23,9 @@ from holofold.design.rules.boxes import (
     simplify_boxes,
     tighten,
 )
-from holofold.design.rules.encoding import Encoding
-from holofold.design.rules.forest import forest_boxes, stack_trees
+from holofold.design.rules.encoding import Encoding, RankCodes
+from holofold.design.rules.forest import forest_apply, forest_boxes, stack_trees, tree_arrays
+from holofold.design.rules.params import check_params
 from holofold.design.rules.statistics import (
     box_counts,
     box_stats,
@@ -59,20 +60,35 @@ class FewRulesWarning(UserWarning):
     """Fewer rules than requested passed the precision and support filters."""
 
 
-def fit_one_tree(params, ccp_alpha, class_weight, Z32, y, n_sub, seed):
-    """Fit one tree on ``n_sub`` rows drawn without replacement.
+def tree_rows(n: int, n_sub: int, seed: int, scheme: str) -> np.ndarray:
+    """The ``n_sub`` of ``n`` training rows a tree grows on, drawn without replacement.
+
+    ``"random"``: sorted rows of ``RandomState(seed).permutation(n)[:n_sub]``; ``"index"``: the
+    rows ``train_test_split(rows, train_size=n_sub, random_state=seed)`` keeps, in its order
+    (the paper's scripts: tree ``i`` on the half of the rows kept with ``random_state=i``).
+    """
+    if scheme == "index":
+        if n_sub >= n:
+            return np.arange(n)
+        return train_test_split(np.arange(n), train_size=n_sub, random_state=int(seed))[0]
+    return np.sort(np.random.RandomState(seed).permutation(n)[:n_sub])
+
+
+def fit_one_tree(params, ccp_alpha, class_weight, codes, values, y, n_sub, seed, scheme):
+    """Grow one tree on ``n_sub`` rows (:func:`tree_rows`) of the rank ``codes``.
+
+    The tree is grown unpruned; :func:`~holofold.design.rules.forest.tree_arrays` places its
+    thresholds in the table's units (``values``) and prunes it with ``ccp_alpha``.
 
     Returns
     -------
     tree : DecisionTreeClassifier
+        Grown on rank codes, before pruning.
     rows : ndarray of int
         The training rows it saw.
-    grown_depth : int
-        Depth of the tree *before* cost-complexity pruning (-1 if unknown). A tree whose grown
-        depth is below a depth limit is exactly the same under any larger limit.
+    arrays : TreeArrays
     """
-    rng = np.random.RandomState(seed)
-    idx = np.sort(rng.permutation(Z32.shape[0])[:n_sub])
+    idx = tree_rows(codes.shape[0], n_sub, seed, scheme)
     ys = y[idx]
     # class weights computed here on the tree's own rows, exactly as class_weight="balanced"
     # would (sklearn's own computation costs more than the tree itself on small data)
@@ -85,19 +101,9 @@ def fit_one_tree(params, ccp_alpha, class_weight, Z32, y, n_sub, seed):
         w = np.array([class_weight.get(0, 1.0), class_weight.get(1, 1.0)], dtype=np.float64)
     else:
         w = np.ones(2)
-    prune = getattr(DecisionTreeClassifier, "_prune_tree", None)
-    if ccp_alpha > 0 and prune is not None:
-        # grow unpruned, note the depth, then prune exactly as fit() itself does at its end
-        tree = DecisionTreeClassifier(**params, ccp_alpha=0.0, random_state=seed)
-        tree.fit(Z32[idx], ys, sample_weight=w[ys], check_input=False)
-        grown = int(tree.get_depth())
-        tree.set_params(ccp_alpha=ccp_alpha)
-        tree._prune_tree()
-    else:
-        tree = DecisionTreeClassifier(**params, ccp_alpha=ccp_alpha, random_state=seed)
-        tree.fit(Z32[idx], ys, sample_weight=w[ys], check_input=False)
-        grown = int(tree.get_depth()) if ccp_alpha == 0 else -1
-    return tree, idx, grown
+    tree = DecisionTreeClassifier(**params, ccp_alpha=0.0, random_state=int(seed))
+    tree.fit(codes[idx], ys, sample_weight=w[ys], check_input=False)
+    return tree, idx, tree_arrays(tree, codes, idx, values, ccp_alpha)
 
 
 class ForestRuleMiner(ClassifierMixin, BaseEstimator):
@@ -160,6 +166,11 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         Features to treat as categorical; they are one-hot (or ordinal) encoded for the trees
         and rules read ``pattern = 2`` or ``m in {16, 24}``.
     categorical_encoding : {"onehot", "ordinal"}, default="onehot"
+    tree_seeds : {"random", "index"}, default="random"
+        ``"random"``: tree ``i``'s seed is drawn from ``random_state``; ``"index"``: tree ``i``
+        is seeded with ``i`` and grows on the rows ``train_test_split(rows,
+        train_size=max_samples, random_state=i)`` keeps, as the paper's scripts do
+        (``random_state`` is then unused).
     random_state : int, RandomState or None, default=None
         Seeds the per-tree subsets and trees; tree ``i`` of an ``n``-tree forest is the same as
         tree ``i`` of a larger forest with the same seed.
@@ -176,8 +187,16 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
     feature_names_ : list of str
         Names used in the rules.
     estimators_ : list of DecisionTreeClassifier
+        The trees as scikit-learn grew them: on the rank codes of the (encoded) features and
+        before cost-complexity pruning. The miner's own node arrays hold each tree pruned
+        (``ccp_alpha``) with its thresholds in the table's units; rules, ``predict`` and
+        ``forest_probability`` use those.
     estimators_samples_ : list of ndarray of int
         Training rows of each tree.
+    trees_ : list of TreeArrays
+        Each tree as node arrays (:class:`~holofold.design.rules.forest.TreeArrays`): pruned,
+        with its thresholds in the table's units (encoded columns); ``apply``, the rules and
+        ``forest_probability`` walk these in float64.
     rules_ : pandas.DataFrame
         The kept rules, best first: ``rule`` (text), per numeric feature ``<name>_gt`` and
         ``<name>_le`` (the rule is ``gt < x <= le``, +-inf when unbounded), per categorical
@@ -198,41 +217,6 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
     feature_importances_ : ndarray of shape (n_features_in_,)
         Mean impurity importance of the trees, summed over the encoded columns of a feature.
     """
-
-    _parameter_constraints: dict = {
-        "n_estimators": [Interval(Integral, 1, None, closed="left")],
-        "criterion": [StrOptions({"entropy", "gini", "log_loss"})],
-        "max_depth": [Interval(Integral, 1, None, closed="left"), None],
-        "ccp_alpha": [Interval(Real, 0, None, closed="left")],
-        "min_samples_leaf": [Interval(Integral, 1, None, closed="left")],
-        "min_samples_split": [Interval(Integral, 2, None, closed="left")],
-        "max_features": [
-            Interval(Integral, 1, None, closed="left"),
-            Interval(Real, 0, 1, closed="right"),
-            StrOptions({"sqrt", "log2"}),
-            None,
-        ],
-        "max_samples": [
-            Interval(Integral, 1, None, closed="left"),
-            Interval(Real, 0, 1, closed="right"),
-        ],
-        "class_weight": [StrOptions({"balanced"}), dict, None],
-        "precision_min": [Interval(Real, 0, 1, closed="both")],
-        "recall_min": [Interval(Real, 0, 1, closed="both")],
-        "min_support": [Interval(Integral, 1, None, closed="left")],
-        "beta": [Interval(Real, 0, None, closed="neither")],
-        "n_rules": [Interval(Integral, 1, None, closed="left")],
-        "max_overlap": [Interval(Real, 0, 1, closed="right"), None],
-        "scoring": [StrOptions({"train", "oob", "estimate"})],
-        "ranking": [StrOptions({"fbeta", "lcb"})],
-        "prior_strength": [StrOptions({"auto"}), Interval(Real, 0, None, closed="left"), None],
-        "simplify": [StrOptions({"none", "idle", "estimate"})],
-        "tighten": ["boolean"],
-        "categorical_features": ["array-like", None],
-        "categorical_encoding": [StrOptions({"onehot", "ordinal"})],
-        "random_state": ["random_state"],
-        "n_jobs": [Integral, None],
-    }
 
     def __init__(
         self,
@@ -259,6 +243,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         tighten=True,
         categorical_features=None,
         categorical_encoding="onehot",
+        tree_seeds="random",
         random_state=None,
         n_jobs=None,
     ):
@@ -284,6 +269,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         self.tighten = tighten
         self.categorical_features = categorical_features
         self.categorical_encoding = categorical_encoding
+        self.tree_seeds = tree_seeds
         self.random_state = random_state
         self.n_jobs = n_jobs
 
@@ -362,7 +348,10 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
 
     # -- fitting ---------------------------------------------------------------------------
 
-    @_fit_context(prefer_skip_nested_validation=True)
+    def _validate_params(self) -> None:
+        """Refuse an invalid parameter value in one line (:func:`.params.check_params`)."""
+        check_params(self)
+
     def fit(self, X, y, feature_names=None):
         """Train the forest and mine the rules.
 
@@ -379,6 +368,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         -------
         self
         """
+        self._validate_params()
         X, y = self._validate_X(X, y=y, reset=True)
         check_classification_targets(y)
         self.classes_, y_codes = np.unique(y, return_inverse=True)
@@ -404,18 +394,23 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         Z = self._encoding.encode(X)
         y_pos = (y_codes == 1).astype(np.intp)
 
-        rng = check_random_state(self.random_state)
-        self._seeds = rng.randint(_MAX_SEED, size=self.n_estimators)
-        Z32 = np.ascontiguousarray(Z, dtype=np.float32)
-        fitted = self._grow(Z32, y_pos, self._seeds)
+        if self.tree_seeds == "index":
+            self._seeds = np.arange(self.n_estimators)
+        else:
+            rng = check_random_state(self.random_state)
+            self._seeds = rng.randint(_MAX_SEED, size=self.n_estimators)
+        self._codes = RankCodes.fit(Z)
+        fitted = self._grow(Z, y_pos, self._seeds)
         self.estimators_ = [t for t, _, _ in fitted]
         self.estimators_samples_ = [i for _, i, _ in fitted]
-        self._grown_depth = np.array([g for _, _, g in fitted], dtype=np.intp)
-        self._mine(Z32, y_pos, len(self.estimators_))
+        self.trees_ = [a for _, _, a in fitted]
+        self._mine(Z, y_pos, len(self.estimators_))
         return self
 
-    def _grow(self, Z32, y_pos, seeds):
-        n = Z32.shape[0]
+    def _grow(self, Z, y_pos, seeds):
+        """Grow a tree per seed on the rank codes of ``Z`` (:class:`.encoding.RankCodes`)."""
+        codes = np.ascontiguousarray(self._codes.codes(Z))
+        n = codes.shape[0]
         if isinstance(self.max_samples, Integral):
             n_sub = min(int(self.max_samples), n)
         else:
@@ -434,7 +429,17 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
                 for code, label in enumerate(self.classes_.tolist())
             }
         return Parallel(n_jobs=self.n_jobs, prefer="threads")(
-            delayed(fit_one_tree)(params, self.ccp_alpha, class_weight, Z32, y_pos, n_sub, s)
+            delayed(fit_one_tree)(
+                params,
+                self.ccp_alpha,
+                class_weight,
+                codes,
+                self._codes.values,
+                y_pos,
+                n_sub,
+                s,
+                self.tree_seeds,
+            )  # fmt: skip
             for s in seeds
         )
 
@@ -463,14 +468,13 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             self.categorical_encoding,
         )
 
-    def _mine(self, Z32: np.ndarray, y_pos: np.ndarray, n_trees: int) -> None:
-        trees = self.estimators_[:n_trees]
-        forest = stack_trees(trees, positive_label=1)
-        lower, upper = forest_boxes(forest, Z32.shape[1])
-        n, T = Z32.shape[0], len(trees)
-        leaves = np.empty((n, T), dtype=np.intp)
-        for k, t in enumerate(trees):
-            leaves[:, k] = t.tree_.apply(Z32) + forest.offsets[k]
+    def _mine(self, Z: np.ndarray, y_pos: np.ndarray, n_trees: int) -> None:
+        """Rules from the first ``n_trees`` trees, on the training rows ``Z`` (the table's
+        units, encoded) with target indicator ``y_pos``."""
+        forest = stack_trees(self.trees_[:n_trees])
+        lower, upper = forest_boxes(forest, Z.shape[1])
+        n, T = Z.shape[0], forest.n_trees
+        leaves = forest_apply(forest, Z)
         N = forest.left.shape[0]
         support = np.bincount(leaves.ravel(), minlength=N)
 
@@ -547,9 +551,9 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             f_top = finders[stats["_box"][:top]]
             weight = f_top @ (~in_bag).T.astype(float)  # (top, n) out-of-bag pairs per row
             new_lo, new_up = simplify_boxes(
-                lo_all[:top], up_all[:top], Z32, y_pos, weight, prior, self.precision_min
+                lo_all[:top], up_all[:top], Z, y_pos, weight, prior, self.precision_min
             )
-            simplified = box_stats(new_lo, new_up, Z32, y_pos, weight, f_top @ in_bag.T > 0)
+            simplified = box_stats(new_lo, new_up, Z, y_pos, weight, f_top @ in_bag.T > 0)
             simplified["n_trees"] = stats["n_trees"][:top]
             simplified["_box"] = stats["_box"][:top]
             self._score(simplified, n_pos)
@@ -576,14 +580,14 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         numeric = np.array([not self._encoding.categorical[j] for j, _ in self._encoding.columns])
 
         def shape(lo, up):  # what a kept rule becomes: tightened to its target rows, or as is
-            return tighten(lo, up, Z32, y_pos, numeric) if self.tighten else (lo, up)
+            return tighten(lo, up, Z, y_pos, numeric) if self.tighten else (lo, up)
 
-        pick, self._lower, self._upper = self._pick(Z32, k, shape)
+        pick, self._lower, self._upper = self._pick(Z, k, shape)
         kept = {key: v[pick] for key, v in self._all_stats.items()}
         if self.tighten and len(pick):
             f_kept = finders[kept["_box"]]
             weight = f_kept @ (~in_bag).T.astype(float)
-            new = box_stats(self._lower, self._upper, Z32, y_pos, weight, f_kept @ in_bag.T > 0)
+            new = box_stats(self._lower, self._upper, Z, y_pos, weight, f_kept @ in_bag.T > 0)
             kept.update(new)
             self._score(kept, n_pos)
             for key in (
@@ -595,7 +599,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             ):
                 kept[key] = kept[key].astype(np.intp)
         if self.simplify != "none":
-            self._lower, self._upper = drop_idle_conditions(self._lower, self._upper, Z32)
+            self._lower, self._upper = drop_idle_conditions(self._lower, self._upper, Z)
         kept.pop("_box")
         self.rules_ = self._rules_frame(self._lower, self._upper, kept)
         if len(self.rules_) < k:
@@ -632,7 +636,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         stats["f_score"] = fbeta(stats["precision"], stats["recall"], self.beta)
         stats["score"] = fbeta(p_rank, stats["recall"], self.beta)
 
-    def _pick(self, Z32: np.ndarray, k: int, shape):
+    def _pick(self, Z: np.ndarray, k: int, shape):
         """The rules to keep: positions in the ranking and their (shaped) boxes.
 
         Walking down the ranking, each candidate is shaped (``shape(lower, upper)``, e.g.
@@ -648,7 +652,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             lo, up = shape(
                 self._all_lower[start : start + block], self._all_upper[start : start + block]
             )
-            rows_of = boxes_contain(lo, up, Z32) if self.max_overlap is not None else None
+            rows_of = boxes_contain(lo, up, Z) if self.max_overlap is not None else None
             for j in range(lo.shape[0]):
                 if any(np.array_equal(lo[j], a) and np.array_equal(up[j], b) for a, b in boxes):
                     continue
@@ -796,6 +800,23 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             }
         )
 
+    #: fitted state that is not a public attribute: what the ``with_*`` copies share
+    _STATE = ("_encoding", "_codes", "_seeds")
+
+    def _copy_with(self, **params) -> ForestRuleMiner:
+        """An unfitted-parameter copy with ``params`` set, sharing this one's fitted state."""
+        new = self.__class__(**{**self.get_params(), **params})
+        new._validate_params()
+        for key, val in self.__dict__.items():
+            if key.endswith("_") and not key.startswith("__") or key in self._STATE:
+                setattr(new, key, val)
+        return new
+
+    def _training(self, X, y) -> tuple[np.ndarray, np.ndarray]:
+        """(encoded rows, target indicator) of the training data ``X, y``."""
+        Z = self._encode_new(X)
+        return Z, (np.asarray(y) == self.classes_[1]).astype(np.intp)
+
     def with_selection(self, X, y, **params) -> ForestRuleMiner:
         """A copy that chooses its rules with other selection parameters, reusing the trees.
 
@@ -809,14 +830,8 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             raise ValueError(
                 f"with_selection sets only {', '.join(SELECTION_PARAMS)}; got {', '.join(bad)}"
             )
-        new = self.__class__(**{**self.get_params(), **params})
-        new._validate_params()
-        for key, val in self.__dict__.items():
-            if key.endswith("_") and not key.startswith("__") or key in ("_encoding", "_seeds"):
-                setattr(new, key, val)
-        new._grown_depth = self._grown_depth
-        Z = np.ascontiguousarray(self._encode_new(X), dtype=np.float32)
-        y_pos = (np.asarray(y) == self.classes_[1]).astype(np.intp)
+        new = self._copy_with(**params)
+        Z, y_pos = self._training(X, y)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FewRulesWarning)
             new._mine(Z, y_pos, len(new.estimators_))
@@ -833,20 +848,15 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
             raise ValueError(
                 f"n_estimators must be in [1, {len(self.estimators_)}], got {n_estimators}"
             )
-        new = self.__class__(**{**self.get_params(), "n_estimators": n_estimators})
-        for key, val in self.__dict__.items():
-            if key.endswith("_") and not key.startswith("__") or key == "_encoding":
-                setattr(new, key, val)
+        new = self._copy_with(n_estimators=n_estimators)
         new.estimators_ = self.estimators_[:n_estimators]
         new.estimators_samples_ = self.estimators_samples_[:n_estimators]
         new._seeds = self._seeds[:n_estimators]
-        new._grown_depth = self._grown_depth[:n_estimators]
-        Z = self._encode_new(X)
-        y = np.asarray(y)
-        y_pos = (y == self.classes_[1]).astype(np.intp)
+        new.trees_ = self.trees_[:n_estimators]
+        Z, y_pos = self._training(X, y)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FewRulesWarning)
-            new._mine(np.ascontiguousarray(Z, dtype=np.float32), y_pos, n_estimators)
+            new._mine(Z, y_pos, n_estimators)
         return new
 
     def with_max_depth(self, max_depth, X, y) -> ForestRuleMiner:
@@ -860,51 +870,67 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         if max_depth is not None and (not isinstance(max_depth, Integral) or max_depth < 1):
             raise ValueError(f"max_depth must be a positive integer or None, got {max_depth!r}")
-        new = self.__class__(**{**self.get_params(), "max_depth": max_depth})
-        for key, val in self.__dict__.items():
-            if key.endswith("_") and not key.startswith("__") or key in ("_encoding", "_seeds"):
-                setattr(new, key, val)
-        Z = np.ascontiguousarray(self._encode_new(X), dtype=np.float32)
-        y_pos = (np.asarray(y) == self.classes_[1]).astype(np.intp)
+        new = self._copy_with(max_depth=max_depth)
+        Z, y_pos = self._training(X, y)
         limit = min(
             np.inf if self.max_depth is None else self.max_depth,
             np.inf if max_depth is None else max_depth,
         )
-        redo = np.flatnonzero((self._grown_depth < 0) | (self._grown_depth >= limit))
-        trees = list(self.estimators_)
-        rows = list(self.estimators_samples_)
-        grown = self._grown_depth.copy()
-        for i, (t, r, g) in zip(redo, new._grow(Z, y_pos, self._seeds[redo]), strict=True):
-            trees[i], rows[i], grown[i] = t, r, g
-        new.estimators_, new.estimators_samples_, new._grown_depth = trees, rows, grown
+        grown = np.array([a.grown_depth for a in self.trees_])
+        redo = np.flatnonzero(grown >= limit)
+        trees, rows, arrays = (
+            list(self.estimators_),
+            list(self.estimators_samples_),
+            list(self.trees_),
+        )
+        for i, (t, r, a) in zip(redo, new._grow(Z, y_pos, self._seeds[redo]), strict=True):
+            trees[i], rows[i], arrays[i] = t, r, a
+        new.estimators_, new.estimators_samples_, new.trees_ = trees, rows, arrays
         new.n_retrained_ = int(redo.size)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FewRulesWarning)
             new._mine(Z, y_pos, len(trees))
         return new
 
+    def apply(self, X) -> np.ndarray:
+        """The leaf each row reaches in each tree (node ids of that tree), walking the trees
+        in float64 in the table's units, as the rules are applied.
+
+        Returns
+        -------
+        ndarray of int, shape (n_samples, n_estimators)
+        """
+        forest = stack_trees(self.trees_)
+        return forest_apply(forest, self._encode_new(X)) - forest.offsets[:-1]
+
     def forest_probability(self, X) -> np.ndarray:
         """The forest's vote for the target class: the mean over trees of the leaf's share.
 
         Shares are class-weighted as the trees were trained (``class_weight``), so this ranks
-        rows but is not a calibrated probability; the rules never use it.
+        rows but is not a calibrated probability; the rules never use it. The trees are walked
+        in the table's units, as the rules are applied.
 
         Returns
         -------
         ndarray of float, shape (n_samples,)
         """
-        Z = np.ascontiguousarray(self._encode_new(X), dtype=np.float32)
-        out = np.zeros(Z.shape[0])
-        for t in self.estimators_:
-            if 1 in t.classes_:  # a tree whose rows held one class votes 0 or 1 everywhere
-                out += t.predict_proba(Z, check_input=False)[:, list(t.classes_).index(1)]
-        return out / max(len(self.estimators_), 1)
+        Z = self._encode_new(X)
+        forest = stack_trees(self.trees_)
+        return forest.share[forest_apply(forest, Z)].mean(axis=1)
 
     @property
     def feature_importances_(self) -> np.ndarray:
+        """Mean over trees of each tree's normalised impurity decrease (pruned trees), summed
+        over the encoded columns of a feature."""
         check_is_fitted(self)
         enc = self._encoding
-        imp = np.mean([t.feature_importances_ for t in self.estimators_], axis=0)
+        per_tree = []
+        for a in self.trees_:
+            imp = np.bincount(a.feature[a.gain > 0], weights=a.gain[a.gain > 0],
+                              minlength=enc.n_encoded).astype(float)  # fmt: skip
+            total = imp.sum()
+            per_tree.append(imp / total if total > 0 else imp)
+        imp = np.mean(per_tree, axis=0)
         owner = np.array([j for j, _ in enc.columns])
         out = np.bincount(owner, weights=imp, minlength=len(enc.names))
         total = out.sum()

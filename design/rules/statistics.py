@@ -123,13 +123,13 @@ def finder_matrix(inverse, tree_of_cand, m: int, T: int) -> np.ndarray:
     return out
 
 
-def box_stats(lower, upper, Z32, y_pos, oob_weight, bag_rows) -> dict:
+def box_stats(lower, upper, Z, y_pos, oob_weight, bag_rows) -> dict:
     """Training statistics of boxes that are not leaves (simplified or tightened ones).
 
     ``oob_weight`` (n_boxes, n): for each row, the trees that found the box's leaf and did not
     train on it; ``bag_rows`` (n_boxes, n): rows one of them trained on.
     """
-    inside = boxes_contain(lower, upper, Z32)
+    inside = boxes_contain(lower, upper, Z)
     pos = y_pos == 1
     in_oob = inside * oob_weight
     est_rows = in_oob > 0
