@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -57,7 +57,11 @@ __all__ = [
 ]
 
 #: constraint residual (rad, and relative warp) a fit must reach
-CONSTRAINT_TOL = 1e-10
+CONSTRAINT_TOL = 1e-9
+#: the smallest sector angle (and its supplement) a fitted panel may have, degrees
+MIN_SECTOR_DEG = 5.0
+#: restoration dampings tried in turn (the next only when the last cannot meet the constraints)
+RESTORATION_DAMPING = (1e-2, 1.0, 100.0)
 #: augmented-Lagrangian weight of the preconditioner (dimensionless units)
 _RHO = 1e6
 
@@ -366,8 +370,19 @@ class _KKT:
             raise AssertionError("band pattern wider than planned")
         ab = np.zeros((bw + 1, n))
         ab[bw + A.row[up] - A.col[up], A.col[up]] = A.data[up]
-        ab[bw] += mu
-        self.factor = sl.cholesky_banded(ab, lower=False, check_finite=False)
+        # the damping keeps the factorisation positive definite in floating point: at least
+        # 1e-11 of the largest diagonal entry, raised tenfold while Cholesky breaks down
+        mu = max(mu, 1e-11 * float(ab[bw].max()))
+        for _ in range(8):
+            trial = ab.copy()
+            trial[bw] += mu
+            try:
+                self.factor = sl.cholesky_banded(trial, lower=False, check_finite=False)
+                break
+            except np.linalg.LinAlgError:
+                mu *= 10
+        else:
+            raise SurfaceFitError("the fit's linear systems are singular (the pattern degenerated)")
         self.n_factor += 1
 
     def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
@@ -393,14 +408,18 @@ class _KKT:
 
         K = spla.LinearOperator((n + m, n + m), matvec=mv, dtype=float)
         M = spla.LinearOperator((n + m, n + m), matvec=prec, dtype=float)
-        sol, _ = spla.minres(K, np.concatenate([-g, -c]), M=M, rtol=tol, maxiter=300, callback=cb)
+        sol, info = spla.minres(K, np.concatenate([-g, -c]), M=M, rtol=tol, maxiter=300,
+                                callback=cb)  # fmt: skip
         self.minres_its.append(count[0])
-        return sol[:n], count[0]
+        d = sol[:n]
+        return (d if info == 0 and np.isfinite(d).all() else None), count[0]
 
 
 def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time_limit: float,
-           t0: float):  # fmt: skip
-    """Restoration, then feasible Gauss-Newton SQP steps.
+           t0: float, mu_r: float):  # fmt: skip
+    """Restoration, then feasible Gauss-Newton SQP steps. ``mu_r`` damps the restoration
+    steps (min |d|_H onto the constraints with H = J_s^T J_s + mu_r I: small keeps the fitted
+    side on the target and moves the other side freely, large moves every vertex alike).
 
     Returns X, ok (the constraints are met), a sentence on how the solve ended, the number of
     iterations and the KKT solver (for its statistics)."""
@@ -408,35 +427,74 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
     ndof = 3 * problem.grid.nv
     eye = sp.identity(ndof, format="csr")
     kkt = _KKT(problem.grid)
-    mu_p = 1e-2  # preconditioner damping
     refactor_after = 12  # MINRES iterations that call for a fresh factorisation
 
-    def fresh(Jo, Jc, mu):
-        kkt.refactor(Jo[problem.base_rows], Jc, mu)
-
-    ro, Jo = problem.objective(X)
-    c, Jc = problem.constraints(X)
-    fresh(Jo, Jc, mu_p)
-    # ---- phase 1: restoration (Newton steps onto the constraints, min |d|_H)
-    its = 0
-    H = (Jo.T @ Jo + 1e-2 * eye).tocsr()
-    for its in range(1, 31):
-        d, k = kkt.solve(H, Jc, np.zeros(ndof), c)
-        X = X + d.reshape(-1, 3) * h
-        c, Jc = problem.constraints(X)
+    def restore(X, c, Jc, steps: int):
+        """Newton steps onto the constraints from X; returns X, c, Jc, steps taken, message."""
+        ro, Jo = problem.objective(X)
+        H = (Jo.T @ Jo + mu_r * eye).tocsr()
+        kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
+        fresh = True
         cm = float(np.abs(c).max())
-        if not np.isfinite(cm):
-            return X, False, "the restoration diverged (non-finite constraints)", its, kkt
+        for k in range(1, steps + 1):
+            if cm < CONSTRAINT_TOL:
+                return X, c, Jc, k - 1, ""
+            d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c)
+            if d is None and not fresh:  # a stale factorisation: refresh it and retry
+                ro, Jo = problem.objective(X)
+                H = (Jo.T @ Jo + mu_r * eye).tocsr()
+                kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
+                d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c)
+            if d is None:
+                return X, c, Jc, k, "the linear systems of the restoration did not converge"
+            # damped Newton: halve the step until the constraint residual falls
+            c2 = float(c @ c)
+            for alpha in 0.5 ** np.arange(12):
+                Xt = X + alpha * d.reshape(-1, 3) * h
+                ct = problem.constraints(Xt, jacobian=False)
+                if float(ct @ ct) < c2:
+                    break
+            else:
+                return (
+                    X,
+                    c,
+                    Jc,
+                    k,
+                    (
+                        f"the constraints could not be met (no Newton step lowers the largest "
+                        f"residual {cm:.3g}): a less curved region, a smaller placement or more "
+                        "cells"
+                    ),
+                )
+            X = Xt
+            c, Jc = problem.constraints(X)
+            cm = float(np.abs(c).max())
+            if not np.isfinite(cm):
+                return X, c, Jc, k, "the restoration diverged (non-finite constraints)"
+            fresh = False
+            if n_it > refactor_after or cm > 1e-6:
+                ro, Jo = problem.objective(X)
+                H = (Jo.T @ Jo + mu_r * eye).tocsr()
+                kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
+                fresh = True
         if cm < CONSTRAINT_TOL:
-            break
-        if k > refactor_after or cm > 1e-6:
-            ro, Jo = problem.objective(X)
-            H = (Jo.T @ Jo + 1e-2 * eye).tocsr()
-            fresh(Jo, Jc, mu_p)
-    else:
-        return X, False, (f"the constraints could not be met from the starting tiling (largest "
-                          f"residual {cm:.3g} after {its} Newton steps): a smaller placement, "
-                          f"more cells or a less curved region"), its, kkt  # fmt: skip
+            return X, c, Jc, steps, ""
+        return (
+            X,
+            c,
+            Jc,
+            steps,
+            (
+                f"the constraints could not be met (largest residual {cm:.3g} after {steps} Newton "
+                "steps): a smaller placement, more cells or a less curved region"
+            ),
+        )
+
+    c, Jc = problem.constraints(X)
+    # ---- phase 1: restoration from the starting tiling
+    X, c, Jc, its, why = restore(X, c, Jc, 30)
+    if why:
+        return X, False, why, its, kkt
     ro, Jo = problem.objective(X)
     # ---- phase 2: feasible Gauss-Newton with second-order corrections
     mu = 1e-4
@@ -452,21 +510,26 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
         cm = float(np.abs(c).max())
         accepted = False
         while mu <= 1e6:
-            fresh(Jo, Jc, mu)
+            kkt.refactor(Jo[problem.base_rows], Jc, mu)
             H = JtJ + mu * eye
             d, _ = kkt.solve(H, Jc, g, c)
+            if d is None:
+                mu *= 10
+                continue
             Xn = X + d.reshape(-1, 3) * h
             cn = problem.constraints(Xn, jacobian=False)
             for _ in range(3):  # second-order corrections onto the constraints
-                if np.abs(cn).max() < CONSTRAINT_TOL:
+                if not np.abs(cn).max() >= CONSTRAINT_TOL:
                     break
                 dc, _ = kkt.solve(H, Jc, np.zeros(ndof), cn)
+                if dc is None:
+                    break
                 Xn = Xn + dc.reshape(-1, 3) * h
                 cn = problem.constraints(Xn, jacobian=False)
             ron, Jon = problem.objective(Xn)
             Fn = float(ron @ ron)
             cnm = float(np.abs(cn).max())
-            if np.isfinite(Fn) and Fn <= F and cnm <= max(10 * cm, 1e-8):
+            if np.isfinite(Fn) and np.isfinite(cnm) and Fn <= F and cnm <= max(10 * cm, 1e-8):
                 accepted = True
                 break
             mu *= 10
@@ -481,24 +544,11 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
         if gain < ftol:
             message = f"converged (the last step lowered the squared distance by {gain:.2g})"
             break
-    cm = float(np.abs(c).max())
     # ---- polish the constraints to the tolerance
-    for _ in range(10):
-        if cm < CONSTRAINT_TOL:
-            break
-        H = (Jo.T @ Jo + 1e-2 * eye).tocsr()
-        d, _ = kkt.solve(H, Jc, np.zeros(ndof), c)
-        X = X + d.reshape(-1, 3) * h
-        c, Jc = problem.constraints(X)
-        cm = float(np.abs(c).max())
-    if cm >= CONSTRAINT_TOL:
-        return (
-            X,
-            False,
-            f"the constraints are met only to {cm:.3g} (tolerance {CONSTRAINT_TOL:g})",
-            its,
-            kkt,
-        )
+    X, c, Jc, k, why = restore(X, c, Jc, 10)
+    its += k
+    if why:
+        return X, False, why, its, kkt
     return X, True, message, its, kkt
 
 
@@ -557,10 +607,16 @@ def fit_surface(
     grid = QuadGrid(m, n)
     X0 = starting_tiling(target, m, n, placement, gamma, ext, side)
     problem = _Problem(grid, target, X0, fairness)
+    first = None
     with threadpool_limits(1):  # one core: BLAS threads only contend on these small vectors
-        X, ok, message, its, kkt = _solve(
-            problem, X0.copy(), max_iter=max_iter, ftol=ftol, time_limit=time_limit, t0=t0
-        )
+        for mu_r in RESTORATION_DAMPING:  # the next only where the last could not restore
+            X, ok, message, its, kkt = _solve(problem, X0.copy(), max_iter=max_iter, ftol=ftol,
+                                              time_limit=time_limit, t0=t0, mu_r=mu_r)  # fmt: skip
+            first = first or message
+            if ok and np.isfinite(X).all():
+                break
+        else:
+            message = first
     if not np.isfinite(X).all():
         raise SurfaceFitError(f"the {m}x{n} fit diverged: {message}")
     c, s, a = placement.resolved(target)
@@ -570,14 +626,31 @@ def fit_surface(
         "side": side,
         "fairness": fairness,
         "placement": {"centre": c.tolist(), "size": s.tolist(), "angle_deg": math.degrees(a)},
+        "restoration_damping": mu_r,
         "factorisations": kkt.n_factor,
         "minres_iterations": int(sum(kkt.minres_its)),
     }
     flat = develop(X, grid)
     residuals = _residuals(X, flat, grid)
     dist = target.distance(X[grid.side])
-    return SurfaceFit(target, m, n, X, flat, grid.side, dist, residuals, ok, message,
-                      its, time.perf_counter() - t0, options)  # fmt: skip
+    if ok and not (residuals["sector_angle_min_deg"] > MIN_SECTOR_DEG
+                   and residuals["sector_angle_max_deg"] < 180 - MIN_SECTOR_DEG):  # fmt: skip
+        ok, message = (
+            False,
+            (
+                f"the panels degenerated (sector angles "
+                f"{residuals['sector_angle_min_deg']:.3g} to "
+                f"{residuals['sector_angle_max_deg']:.3g} deg): a less curved region or more cells"
+            ),
+        )
+    fit = SurfaceFit(target, m, n, X, flat, grid.side, dist, residuals, ok, message,
+                     its, time.perf_counter() - t0, options)  # fmt: skip
+    if ok:
+        try:
+            fit.pattern  # noqa: B018 - validates the flat pattern (simple, counter-clockwise)
+        except ValueError as exc:
+            fit = replace(fit, ok=False, message=f"the flat pattern is not valid: {exc}")
+    return fit
 
 
 def _residuals(X: np.ndarray, flat: np.ndarray, grid: QuadGrid) -> dict[str, float]:

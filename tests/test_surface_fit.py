@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -119,7 +120,7 @@ def test_a_fit_that_does_not_fold_is_reported():
     fit = fit_surface(CAP, (6, 6), placement=Placement(size=(0.6, 0.6)))
     bad = fit.coords.copy()
     bad[fit.grid.vid(3, 3)] += [0, 0, 0.02]  # one vertex out of its quads' planes
-    broken = type(fit)(**{**fit.__dict__, "coords": bad})
+    broken = replace(fit, coords=bad)
     assert quad_warp(bad, fit.grid.quads).max() > 1e-3
     fc = check_fold(broken)
     assert not fc.reached and "from the fitted one" in fc.reason
@@ -135,3 +136,12 @@ def test_inputs_are_checked_before_work():
         fit_surface(CAP, (8, 8), placement=Placement(size=(2.0, 2.0)))
     with pytest.raises(ParameterError, match="side"):
         fit_surface(CAP, (8, 8), side="left")
+
+
+def test_too_curved_a_target_fails_with_the_reason():
+    """A saddle curved as tightly as the cells (radius 0.4 m, cells 0.045 m) cannot be met:
+    the fit says so, it does not return a broken pattern or raise from the linear algebra."""
+    saddle = builtin_surface("saddle", radius=0.4, width=0.8, depth=0.8)
+    fit = fit_surface(saddle, (10, 10), placement=Placement(size=(0.73, 0.73)))
+    assert not fit.ok and fit.message
+    assert any(w in fit.message for w in ("constraints", "linear systems", "degenerated", "flat"))
