@@ -167,56 +167,37 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
 
 
 @njit(**_OPTS)
-def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest, acc, out):
-    """``out[dest[p]] = (A_p + B_p) + C_p`` for every listed target p, where ``A_p`` is the
-    sum of the values ``val_a[src_a[q]]`` with ``pos_a[q] == p`` (likewise B, C), the values
-    read in the order they lie in memory (a gather target by target read them scattered and
-    took 1.2-1.6x as long). ``acc`` holds the sums (3 ``dest.size`` floats); ``out`` must
-    start as zeros where nothing is listed."""
-    n = dest.shape[0]
-    for p in range(3 * n):
-        acc[p] = 0.0
-    # unsigned indices: numba then skips its negative-index wrap-around (a fifth of the time)
+def scatter(src_a, tgt_a, val_a, src_b, tgt_b, val_b, src_c, tgt_c, val_c, out):
+    """``out[tgt_a[q]] += val_a[src_a[q]]`` for every q (likewise b, c): each family's values
+    read in the order they lie in memory, added straight into their targets (``out`` starts as
+    zeros where it is to hold only these sums)."""
+    # unsigned indices: numba then skips its negative-index wrap-around
     for q in range(src_a.shape[0]):
-        acc[np.uintp(pos_a[q])] += val_a[np.uintp(src_a[q])]
+        out[np.uintp(tgt_a[q])] += val_a[np.uintp(src_a[q])]
     for q in range(src_b.shape[0]):
-        acc[np.uintp(n + pos_b[q])] += val_b[np.uintp(src_b[q])]
+        out[np.uintp(tgt_b[q])] += val_b[np.uintp(src_b[q])]
     for q in range(src_c.shape[0]):
-        acc[np.uintp(2 * n + pos_c[q])] += val_c[np.uintp(src_c[q])]
-    for p in range(n):
-        out[np.uintp(dest[p])] = (acc[p] + acc[n + p]) + acc[2 * n + p]
-
-
-@njit(**_OPTS)
-def _acc_size(force_lists, tangent_lists) -> int:
-    """Length of the ``acc`` memory that :func:`_assemble_sample`'s scatters need."""
-    return 3 * max(force_lists[6].shape[0], tangent_lists[6].shape[0])
-
-
-# ------------------------------------------------------------------------ batches
-# A batch is S designs of one size: the arrays gain a leading sample axis and each listed
-# sample runs the single-design code above on one scratch set of element arrays, which stays
-# in cache between the kernels and the sums.
+        out[np.uintp(tgt_c[q])] += val_c[np.uintp(src_c[q])]
 
 
 @njit(**_OPTS)
 def _assemble_sample(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-    views, flats, f, K, acc,
+    views, flats, f, K,
 ):  # fmt: skip
     """Sample ``s``'s kernels into ``views`` (memory ``flats``), its internal force into ``f``
     and its tangent into ``K`` by the scatter lists (both zeroed first: the scatters write
-    only the entries that receive something; ``acc``: :func:`_acc_size` floats)."""
+    only the entries that receive something)."""
     eb, fb, Kb, es, fs, Ks, th = views
     f[:] = 0.0
     K[:] = 0.0
     _, vfb, vkb, _, vfs, vks, _ = flats
-    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
-    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
+    fa, fsa, fb_, fsb, fc, fsc = force_lists
+    ka, ksa, kb_, ksb, kc, ksc = tangent_lists
     bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
     spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
-    scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, acc, f)
-    scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, acc, K)
+    scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, f)
+    scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, K)
 
 
 @njit(**_OPTS)
@@ -226,14 +207,13 @@ def assemble_batch(
 ):  # fmt: skip
     """For each sample ``s = idx[j]``: the kernels into the element arrays ``views`` (the
     seven of one sample, in the kernels' layouts), then ``f_out[j]`` by the ``force_lists``
-    and ``k_out[j]`` by the ``tangent_lists`` (each the seven lists of :func:`scatter`, without
-    the values and ``acc``), whose sources index the memory of the views, ``flats`` (``f_out`` and
+    and ``k_out[j]`` by the ``tangent_lists`` (each the six lists of :func:`scatter`, without
+    the values), whose sources index the memory of the views, ``flats`` (``f_out`` and
     ``k_out`` need not start as zeros)."""
-    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
-            tangent_lists, views, flats, f_out[j], k_out[j], acc,
+            tangent_lists, views, flats, f_out[j], k_out[j],
         )  # fmt: skip
 
 
@@ -295,13 +275,12 @@ def band_newton_step(
     inf_ = np.zeros(1, np.int32)
     ab = np.empty((bw + 1) * nf)
     y = np.empty(nf)
-    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         s = idx[j]
         f = f_out[j]
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, ab, acc,
+            views, flats, f, ab,
         )  # fmt: skip
         _fcall(addrs[0], (uplo, n_, kd_, ab, ld_, inf_))
         if inf_[0] != 0:
@@ -347,12 +326,11 @@ def dense_newton_step(
     piv = np.empty(nf, np.int32)
     a = np.empty(nf * nf)
     f = np.empty(Uflat.shape[1])
-    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         s = idx[j]
         _assemble_sample(
             X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, a, acc,
+            views, flats, f, a,
         )  # fmt: skip
         _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
         if inf_[0] > 0:
@@ -371,8 +349,8 @@ def dense_newton_step(
 @njit(**_OPTS)
 def newton_increments(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol, max_iter,
-    U_hist, conv, iters, res, moved, failed,
+    full_lists, views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol,
+    max_iter, U_hist, conv, iters, res, moved, failed,
 ):  # fmt: skip
     """Newton-Raphson load control of each sample ``s = idx[j]``, every increment and
     iteration in this one call (:func:`holofold.mechanics.solvers.solve_newton`'s semantics).
@@ -381,11 +359,13 @@ def newton_increments(
     ``U[free] += K_ff^-1 (F - f_int)[free]`` while ``step < max_iter`` and ``||dU|| > tol``.
     Records per increment (row ``i - 1``): ``U_hist[j]`` (ndof), ``conv[j]`` (R <= tol),
     ``iters[j]`` (steps - 1), ``res[j]`` (the last R) and ``moved[j]`` (max |U - U at the
-    increment's start|). A failed step (``banded``: the band's Cholesky; otherwise dense LU)
-    stops the sample: ``failed[j] = (code, increment, step)`` with code 1 (singular, or not
-    positive definite on the banded path: the caller solves that sample another way) or 2 (a
-    non-finite solution), the failing increment recorded with the last U and R, not
-    converged."""
+    increment's start|). The dense path factorises the upper triangle (``tangent_lists``) by
+    Cholesky, and the whole matrix (``full_lists``) by LU where that fails (``addrs``: dgetrf,
+    dgetrs, dpotrf, dpotrs); the banded one the band (``tangent_lists``) by Cholesky (dpbtrf,
+    dpbtrs). A failed step stops the sample: ``failed[j] = (code, increment, step)`` with code
+    1 (singular, or not positive definite on the banded path: the caller solves that sample
+    another way) or 2 (a non-finite solution), the failing increment recorded with the last U
+    and R, not converged."""
     nf = free.shape[0]
     nd = Uflat.shape[1]
     c_u = np.array([ord("U")], np.uint8)
@@ -402,7 +382,6 @@ def newton_increments(
     start = np.empty(nd)
     x = np.empty(nf)
     y = np.empty(nf)
-    acc = np.empty(_acc_size(force_lists, tangent_lists))
     for j in range(idx.shape[0]):
         s = idx[j]
         failed[j, 0] = 0
@@ -416,7 +395,7 @@ def newton_increments(
             while step < max_iter and R > tol:
                 _assemble_sample(
                     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    tangent_lists, views, flats, f, a, acc,
+                    tangent_lists, views, flats, f, a,
                 )  # fmt: skip
                 if banded:
                     _fcall(addrs[0], (c_u, n_, kd_, a, ld_, inf_))
@@ -429,15 +408,23 @@ def newton_increments(
                     _fcall(addrs[1], (c_u, n_, kd_, one, a, ld_, y, n_, inf_))
                     for q in range(nf):
                         x[perm[q]] = y[q]
-                else:
-                    _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
-                    if inf_[0] > 0:
-                        code = 1
-                        break
+                else:  # Cholesky of the upper triangle; LU where it is not definite
                     for q in range(nf):
                         d = free[q]
                         x[q] = Fi[d] - f[d]
-                    _fcall(addrs[1], (c_n, n_, one, a, n_, piv, x, n_, inf_))
+                    _fcall(addrs[2], (c_u, n_, a, n_, inf_))
+                    if inf_[0] == 0:
+                        _fcall(addrs[3], (c_u, n_, one, a, n_, x, n_, inf_))
+                    else:  # the whole matrix this time
+                        _assemble_sample(
+                            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s,
+                            force_lists, full_lists, views, flats, f, a,
+                        )  # fmt: skip
+                        _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
+                        if inf_[0] > 0:
+                            code = 1
+                            break
+                        _fcall(addrs[1], (c_n, n_, one, a, n_, piv, x, n_, inf_))
                 code = _accept(x, Uflat, s, free)
                 if code:
                     break

@@ -12,7 +12,7 @@ Python loop. About 3-5x the compiled assembly time (benchmarks/bench_kernels.py)
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.lapack import dgetrf, dgetrs, dpbtrf, dpbtrs
+from scipy.linalg.lapack import dgetrf, dgetrs, dpbtrf, dpbtrs, dpotrf, dpotrs
 
 from holofold.mechanics.bars import bar_kernel
 from holofold.mechanics.springs import spring_kernel
@@ -51,16 +51,12 @@ def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, th
         K[...] = res.tangent
 
 
-def scatter(src_a, pos_a, val_a, src_b, pos_b, val_b, src_c, pos_c, val_c, dest, acc, out):
-    """``out[dest[p]] = A_p + B_p + C_p``, ``A_p`` the sum of ``val_a[src_a[q]]`` over the q
-    with ``pos_a[q] == p`` (likewise B, C); ``acc`` is unused (the compiled twin's scratch)."""
-    n = dest.shape[0]
-    s = np.bincount(pos_a, weights=val_a[src_a], minlength=n)
-    if src_b.size:
-        s += np.bincount(pos_b, weights=val_b[src_b], minlength=n)
-    if src_c.size:
-        s += np.bincount(pos_c, weights=val_c[src_c], minlength=n)
-    out[dest] = s
+def scatter(src_a, tgt_a, val_a, src_b, tgt_b, val_b, src_c, tgt_c, val_c, out):
+    """``out[tgt[q]] += val[src[q]]`` for every entry of each family (``np.bincount``)."""
+    n = out.shape[0]
+    for src, tgt, val in ((src_a, tgt_a, val_a), (src_b, tgt_b, val_b), (src_c, tgt_c, val_c)):
+        if src.size:
+            out += np.bincount(tgt, weights=val[src], minlength=n)
 
 
 def _assemble_sample(
@@ -71,12 +67,12 @@ def _assemble_sample(
     f[:] = 0.0
     K[:] = 0.0
     _, vfb, vkb, _, vfs, vks, _ = flats
-    fa, fsa, fb_, fsb, fc, fsc, fdest = force_lists
-    ka, ksa, kb_, ksb, kc, ksc, kdest = tangent_lists
+    fa, fsa, fb_, fsb, fc, fsc = force_lists
+    ka, ksa, kb_, ksb, kc, ksc = tangent_lists
     bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
     spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
-    scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, fdest, None, f)
-    scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, kdest, None, K)
+    scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, f)
+    scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, K)
 
 
 def assemble_batch(
@@ -151,8 +147,8 @@ def dense_newton_step(
 
 def newton_increments(
     X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol, max_iter,
-    U_hist, conv, iters, res, moved, failed,
+    full_lists, views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol,
+    max_iter, U_hist, conv, iters, res, moved, failed,
 ):  # fmt: skip
     """Newton-Raphson load control of each sample, every increment in this call (the
     compiled twin's semantics and records; see ``_compiled.newton_increments``)."""
@@ -179,12 +175,20 @@ def newton_increments(
                         break
                     x = np.empty(nf)
                     x[perm] = dpbtrs(c, r[perm], lower=0)[0]
-                else:
-                    lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
-                    if inf > 0:
-                        code = 1
-                        break
-                    x = dgetrs(lu, piv, r)[0]
+                else:  # Cholesky of the upper triangle; LU where it is not definite
+                    c, inf = dpotrf(a.reshape(nf, nf).T, lower=0, clean=0)
+                    if inf == 0:
+                        x = dpotrs(c, r, lower=0)[0]
+                    else:
+                        _assemble_sample(
+                            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s,
+                            force_lists, full_lists, views, flats, f, a,
+                        )  # fmt: skip
+                        lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
+                        if inf > 0:
+                            code = 1
+                            break
+                        x = dgetrs(lu, piv, r)[0]
                 code = _accept(x, Uflat, s, free)
                 if code:
                     break

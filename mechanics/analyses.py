@@ -175,7 +175,8 @@ def _stiffness(
     group: LoadGroup, res: SolveResult, force_per_increment: float, U0=None
 ) -> StiffnessResult:
     U = res.U if U0 is None else res.U - np.asarray(U0, float).reshape(res.U.shape)
-    u = float(np.mean(np.abs(group.displacements(U))))
+    d = np.abs(group.displacements(U))
+    u = float(np.add.reduce(d) / d.size) if d.size else float("nan")
     total = force_per_increment * len(res.load_factor)
     k = total / u if u > 0 else float("inf")
     return StiffnessResult(stiffness=k, displacement=u, result=res)
@@ -197,9 +198,14 @@ def secant_stiffness_batch(
     :class:`LoadGroup` per structure); each result is bit for bit the one-at-a-time one."""
     structures = list(structures)
     groups = list(groups)
-    loads = [
-        g.load(s.n_nodes, force_per_increment) for s, g in zip(structures, groups, strict=True)
-    ]
+    if len(groups) != len(structures):
+        raise ValueError(f"{len(groups)} load groups for {len(structures)} structures")
+    nn = structures[0].n_nodes if structures else 0
+    made: dict = {}  # the designs of a batch share few load groups: one load array each
+    for g in groups:
+        if id(g) not in made:
+            made[id(g)] = g.load(nn, force_per_increment)
+    loads = np.stack([made[id(g)] for g in groups]) if groups else np.zeros((0, nn, 3))
     runs = solve_newton_batch(
         structures, loads, increments=increments, tol=tol, max_iter=max_iter, batch=batch
     )

@@ -147,10 +147,9 @@ def sum_into(lists: SumLists, bar_values, spring_values, out) -> np.ndarray:
     springs, spring mirrors) from the element arrays."""
     vb = bar_values.reshape(-1)
     vs = spring_values.reshape(-1)
-    acc = np.empty(3 * lists.dest.size)
     kernels.active().module.scatter(
-        lists.bar_src, lists.bar_pos, vb, lists.spring_src, lists.spring_pos, vs,
-        lists.mirror_src, lists.mirror_pos, vs, lists.dest, acc, out,
+        lists.bar_src, lists.bar_tgt, vb, lists.spring_src, lists.spring_tgt, vs,
+        lists.mirror_src, lists.mirror_tgt, vs, out,
     )  # fmt: skip
     return out
 

@@ -24,6 +24,8 @@ if TYPE_CHECKING:
 __all__ = ["DenseStepper", "NewtonRecords", "batch_newton_step", "batch_newton_increments"]
 
 _LAPACK = {"banded": ("dpbtrf", "dpbtrs"), "dense": ("dgetrf", "dgetrs")}
+#: the LAPACK routines of the whole-solve call (dense: LU's for the fallback, Cholesky's)
+_SOLVE = {"banded": _LAPACK["banded"], "dense": (*_LAPACK["dense"], "dpotrf", "dpotrs")}
 
 
 def _error(code: int) -> SingularSystemError:
@@ -178,9 +180,10 @@ def batch_newton_increments(batch: BatchAssembler, U, F0, P, increments, tol, ma
                np.zeros((n, increments)), np.zeros((n, 3), np.int64))  # fmt: skip
         ck.newton_increments(
             *batch.inputs.with_displacements(U3), batch.theta0, batch.k_nonneg, idx,
-            pat.force_sums, red.tangent_sums("banded" if banded else "dense_cm"),
-            batch.scratch, flats, F0, P, red.free, banded, perm, bw,
-            ck.lapack_addresses(*_LAPACK[kind]), U, int(increments), float(tol),
+            pat.force_sums, red.tangent_sums("banded" if banded else "dense_upper"),
+            red.tangent_sums("banded" if banded else "dense_cm"), batch.scratch, flats, F0, P,
+            red.free, banded, perm, bw,
+            ck.lapack_addresses(*_SOLVE[kind]), U, int(increments), float(tol),
             int(max_iter), *out,
         )  # fmt: skip
         for field, values in zip(rec[:6], out, strict=True):

@@ -11,7 +11,8 @@ reference's "zero the row and column, keep the diagonal, zero the residual" (the
 increments are 0 either way).
 
 Storages of the free-free tangent (:data:`STORAGES`): ``"dense"`` (row-major nf x nf),
-``"dense_cm"`` (column-major: the Fortran copy LAPACK factorises), ``"banded"`` (LAPACK upper
+``"dense_cm"`` (column-major: the Fortran copy LAPACK factorises), ``"dense_upper"`` (its upper
+triangle only, for a Cholesky factorisation; the rest stays zero), ``"banded"`` (LAPACK upper
 band, column-major) and ``"csr"`` (the full CSR data; the reduction keeps :attr:`ReducedPattern.
 keep`).
 """
@@ -40,7 +41,7 @@ __all__ = [
     "sum_lists",
 ]
 
-STORAGES = ("dense", "dense_cm", "banded", "csr")
+STORAGES = ("dense", "dense_cm", "dense_upper", "banded", "csr")
 _PATTERN_CACHE: OrderedDict[bytes, AssemblyPattern] = OrderedDict()
 _PATTERN_CACHE_SIZE = 8
 
@@ -49,41 +50,34 @@ class SumLists(NamedTuple):
     """How one target array is summed from the element arrays (the kernels' layouts, flat).
 
     For each family (bars, springs, the mirrors of the off-diagonal spring blocks): ``*_src``
-    the flat index of every entry that has a target, in flat order, and ``*_pos`` its target's
-    position among the targets that receive something; ``dest`` those targets in the output
-    array (which must start as zeros). int32 arrays (half the index traffic of intp).
+    the flat index of every entry that has a target, in flat order (the order the values lie
+    in memory), and ``*_tgt`` its target in the output array, which must start as zeros; the
+    sum of a target is ``out[t] += value`` over its entries, in any order. int32 arrays (half
+    the index traffic of intp).
     """
 
     bar_src: np.ndarray
-    bar_pos: np.ndarray
+    bar_tgt: np.ndarray
     spring_src: np.ndarray
-    spring_pos: np.ndarray
+    spring_tgt: np.ndarray
     mirror_src: np.ndarray
-    mirror_pos: np.ndarray
-    dest: np.ndarray
+    mirror_tgt: np.ndarray
 
 
 def sum_lists(families, n: int, dest=None) -> SumLists:
     """The :class:`SumLists` of up to three families of targets ``pos`` (entries outside
-    ``0..n-1`` are dropped), written to ``out[dest[t]]`` (default ``out[t]``)."""
-    counts = np.zeros(n, np.intp)
-    kept = []
+    ``0..n-1`` are dropped), written to ``out[dest[pos]]`` (default ``out[pos]``)."""
+    i4 = lambda x: np.ascontiguousarray(x, np.int32)  # noqa: E731
+    dest = None if dest is None else np.asarray(dest, np.intp)
+    out = []
     for pos in families:
         pos = np.asarray(pos).ravel()
         src = np.flatnonzero((pos >= 0) & (pos < n))
-        kept.append((src, pos[src]))
-        counts += np.bincount(pos[src], minlength=n)
-    hit = np.flatnonzero(counts > 0)
-    where = np.full(n, -1, np.intp)
-    where[hit] = np.arange(hit.size)
-    i4 = lambda x: np.ascontiguousarray(x, np.int32)  # noqa: E731
-    out = []
-    for src, tgt in kept:
-        out += [i4(src), i4(where[tgt])]
+        tgt = pos[src] if dest is None else dest[pos[src]]
+        out += [i4(src), i4(tgt)]
     while len(out) < 6:
         out += [np.zeros(0, np.int32), np.zeros(0, np.int32)]
-    targets = hit if dest is None else np.asarray(dest, np.intp)[hit]
-    return SumLists(*out, i4(targets))
+    return SumLists(*out)
 
 
 class Band(NamedTuple):
@@ -204,7 +198,7 @@ class ReducedPattern:
 
     def storage_size(self, storage: str) -> int:
         """Entries of the flat tangent in ``storage`` (one of :data:`STORAGES`)."""
-        if storage in ("dense", "dense_cm"):
+        if storage in ("dense", "dense_cm", "dense_upper"):
             return self.n_free**2
         if storage == "banded":
             return self.band.size
@@ -217,14 +211,17 @@ class ReducedPattern:
         key = f"sums:{storage}"
         if key not in self._symbolic:
             pat, nf = self.pattern, self.n_free
-            if storage in ("dense", "dense_cm"):
+            if storage in ("dense", "dense_cm", "dense_upper"):
                 kidx = np.full(pat.nnz + 1, -1, np.intp)
-                kidx[self.keep] = np.arange(self.keep.size)
+                kept = np.arange(self.keep.size)
+                if storage == "dense_upper":
+                    kept[self.rows > self.cols] = -1
+                kidx[self.keep] = kept
                 fams = (kidx[pat.bar_slot], kidx[pat.spring_slot], kidx[pat.spring_slot_mirror])
-                lists = sum_lists(fams, self.keep.size, self.dense)
-                if storage == "dense_cm":
-                    d = lists.dest
-                    lists = lists._replace(dest=((d % nf) * nf + d // nf).astype(np.int32))
+                dest = self.dense
+                if storage != "dense":  # column-major: the Fortran order LAPACK reads
+                    dest = (dest % nf) * nf + dest // nf
+                lists = sum_lists(fams, self.keep.size, dest)
             elif storage == "banded":
                 lists = sum_lists(self._band_slots, self.band.size)
             elif storage == "csr":

@@ -245,7 +245,7 @@ def test_evaluate_command_flags(tmp_path, capsys, miura):
     res = pd.read_csv(out)
     assert len(res) == 6 and failed_mask(res["status"]).tolist() == [0, 1, 0, 1, 1, 0]
     assert main(["evaluate", "single-miura", str(src), "-o", str(out), "--on-invalid", "skip",
-                 "--row-timeout", "0.001", "--workers", "2"]) == 0  # fmt: skip
+                 "--row-timeout", "1e-7", "--workers", "2"]) == 0  # fmt: skip
     assert pd.read_csv(out)["status"].str.startswith("failed:").all()
     for bad in ("-3", "soon"):
         assert main(["evaluate", "single-miura", str(src), "-o", str(out),

@@ -143,7 +143,7 @@ def solve_newton_batch(
     Parameters
     ----------
     structures : sequence of Structure
-    loads : sequence of (nn, 3) float
+    loads : sequence of (nn, 3) float, or (S, nn, 3) float
         Per-sample load per increment, N.
     increments, tol, max_iter
         As for :func:`solve_newton` (shared).
@@ -165,7 +165,10 @@ def solve_newton_batch(
     nn = structures[0].n_nodes
     if len(loads) != S:
         raise ParameterError(f"loads: {len(loads)} given for {S} structures")
-    P = np.stack([nodal_array("load", ld, nn).ravel() for ld in loads])
+    if isinstance(loads, np.ndarray) and loads.shape == (S, nn, 3):  # one check for all
+        P = nodal_array("loads", loads.reshape(S * nn, 3), S * nn).reshape(S, 3 * nn)
+    else:
+        P = np.stack([nodal_array("load", ld, nn).ravel() for ld in loads])
     F0v = _stacked("F0", F0, S, nn)
     U = _stacked("U0", U0, S, nn)
     free = B.free_dofs
@@ -242,17 +245,18 @@ def _from_records(rec, s, structure, tol, floor, F0, P) -> SolveResult:
     failure = None
     if code:
         failure = f"increment {at}, iteration {step}: {SINGULAR if code == 1 else NON_FINITE}"
-    iters, res = rec.iterations[s, :count].copy(), rec.residual[s, :count].copy()
+    # views of this call's own records (no other reference to them is kept)
+    iters, res = rec.iterations[s, :count], rec.residual[s, :count]
     status = describe(conv, iters, res, tol, "||dU||", failure, unresolved)
     if not status.converged:
         logger.info("solve_newton: %s", status)
     return SolveResult(
-        U_history=rec.U[s, :count].reshape(count, -1, 3).copy(),
+        U_history=rec.U[s, :count].reshape(count, -1, 3),
         load_factor=np.arange(1, count + 1, dtype=float),
         converged=conv,
         iterations=iters,
         residual=res,
         status=status,
         applied_force=(F0 + count * P).reshape(-1, 3),
-        spring_rest=np.asarray(structure.spring_rest, float).copy(),
+        spring_rest=np.array(structure.spring_rest, float),
     )
