@@ -555,6 +555,8 @@ def _write_files(
     if sc.write_files is not None:
         fab = sc.write_files(design, out / "files", units=mesh_units, cutter=cutter)
         files = fab.record(out)  # stable key -> {"path", "label"}
+        for note in fab.notes:  # the report's notes on the files (the loop records warnings)
+            warnings.warn(note, UserWarning, stacklevel=2)
     if sc.shape is not None:
         pat = sc.shape(design)
         creases = pat.edges[pat.interior] if hasattr(pat, "interior") else None

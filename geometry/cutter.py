@@ -96,21 +96,17 @@ class CutterProfile:
         object.__setattr__(self, "layers", tuple(order))
 
 
-def _same(colour: str, width: float, layer: str) -> Stroke:
-    return Stroke(colour, width, layer)
-
-
 PROFILES: dict[str, CutterProfile] = {
     "origami-simulator": CutterProfile(
         "origami-simulator",
         {
-            "boundary": _same("#000000", 0.2, "cut"),
-            "cut": _same("#00ff00", 0.2, "cut"),
-            "mountain": _same("#ff0000", 0.2, "score"),
-            "valley": _same("#0000ff", 0.2, "score"),
-            "flat": _same("#ffff00", 0.2, "score"),
-            "unassigned": _same("#ff00ff", 0.2, "score"),
-            "registration": _same("#000000", 0.2, "registration"),
+            "boundary": Stroke("#000000", 0.2, "cut"),
+            "cut": Stroke("#00ff00", 0.2, "cut"),
+            "mountain": Stroke("#ff0000", 0.2, "score"),
+            "valley": Stroke("#0000ff", 0.2, "score"),
+            "flat": Stroke("#ffff00", 0.2, "score"),
+            "unassigned": Stroke("#ff00ff", 0.2, "score"),
+            "registration": Stroke("#000000", 0.2, "registration"),
         },
         legend=True,
         opacity=True,
@@ -119,13 +115,13 @@ PROFILES: dict[str, CutterProfile] = {
     "laser": CutterProfile(
         "laser",
         {
-            "boundary": _same("#ff0000", 0.01, "cut"),
-            "cut": _same("#ff0000", 0.01, "cut"),
-            "mountain": _same("#0000ff", 0.01, "score-mountain"),
-            "valley": _same("#00ff00", 0.01, "score-valley"),
-            "flat": _same("#ff00ff", 0.01, "score-other"),
-            "unassigned": _same("#ff00ff", 0.01, "score-other"),
-            "registration": _same("#ff0000", 0.01, "registration"),
+            "boundary": Stroke("#ff0000", 0.01, "cut"),
+            "cut": Stroke("#ff0000", 0.01, "cut"),
+            "mountain": Stroke("#0000ff", 0.01, "score-mountain"),
+            "valley": Stroke("#00ff00", 0.01, "score-valley"),
+            "flat": Stroke("#ff00ff", 0.01, "score-other"),
+            "unassigned": Stroke("#ff00ff", 0.01, "score-other"),
+            "registration": Stroke("#ff0000", 0.01, "registration"),
         },
         dash=3.0,
         gap=1.5,
@@ -136,13 +132,13 @@ PROFILES: dict[str, CutterProfile] = {
     "cricut": CutterProfile(
         "cricut",
         {
-            "boundary": _same("#000000", 0.25, "cut"),
-            "cut": _same("#000000", 0.25, "cut"),
-            "mountain": _same("#ff0000", 0.25, "score-mountain"),
-            "valley": _same("#0000ff", 0.25, "score-valley"),
-            "flat": _same("#ff00ff", 0.25, "score-other"),
-            "unassigned": _same("#ff00ff", 0.25, "score-other"),
-            "registration": _same("#000000", 0.25, "registration"),
+            "boundary": Stroke("#000000", 0.25, "cut"),
+            "cut": Stroke("#000000", 0.25, "cut"),
+            "mountain": Stroke("#ff0000", 0.25, "score-mountain"),
+            "valley": Stroke("#0000ff", 0.25, "score-valley"),
+            "flat": Stroke("#ff00ff", 0.25, "score-other"),
+            "unassigned": Stroke("#ff00ff", 0.25, "score-other"),
+            "registration": Stroke("#000000", 0.25, "registration"),
         },
         vertex_gap=1.0,
         suits="Cricut Design Space (Maker, Explore), Silhouette Studio (Cameo), Brother "

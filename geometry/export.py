@@ -116,7 +116,7 @@ for _fmt in (
 ):
     register_format(_fmt)
 
-#: the suffixes :func:`export` knows (the keys of :data:`FORMATS`)
+#: the built-in suffixes (:data:`FORMATS` holds any registered later too)
 EXPORT_TYPES = tuple(FORMATS)
 
 

@@ -366,11 +366,10 @@ def segment_part(
         return Segmentation(bed, whole, (seg,), none)
     flat = pattern.flat * _MM
     margin = float(W.max()) / 2 * _MM + rim_mm + 3.0 + c
-    planner_bed = bed
 
     def cell_fits(poly):
         grown = np.vstack([poly + [dx, dy] for dx in (-margin, margin) for dy in (-margin, margin)])
-        return math.isfinite(footprint_turns(grown / _MM, planner_bed)[1])
+        return math.isfinite(footprint_turns(grown / _MM, bed)[1])
 
     cells, chords = [], []
     for f, loop in enumerate(pattern.faces):

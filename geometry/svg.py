@@ -1,21 +1,23 @@
-"""SVG crease patterns for Origami Simulator, laser cutters and plotters.
+"""SVG crease patterns for Origami Simulator, laser cutters, Cricut-type cutters and plotters.
 
-Colours follow Origami Simulator's import convention: mountain red ``#ff0000``, valley blue
-``#0000ff``, border black, flat and join (facet) yellow ``#ffff00``, cut green ``#00ff00``,
-unassigned magenta ``#ff00ff``; ``stroke-opacity`` = |fold angle| / 180 for M and V, but at
-least ``min_opacity`` (default 0.3, so that shallow creases stay visible; 1 when a crease's fold
-angle is 0, i.e. a flat pattern whose M/V is known but not its target angle). Origami Simulator
-reads fold angles from the opacity: the exact angle of every line is its ``data-foldAngle``
-(and the FOLD file's), and ``min_opacity=0`` writes the plain encoding. A legend (mountain,
-valley, cut, boundary, as short ``<path>`` samples with labels, ``<g id="legend">``) sits above
-the pattern, outside it; ``legend=False`` leaves it out (e.g. for a cutter that cuts every
-black line).
+:func:`export_svg` draws the flat layout for a cutter profile (:mod:`holofold.geometry.cutter`).
+The default, ``origami-simulator``, follows Origami Simulator's import convention: mountain red
+``#ff0000``, valley blue ``#0000ff``, border black, flat and join (facet) yellow ``#ffff00``,
+cut green ``#00ff00``, unassigned magenta ``#ff00ff``; ``stroke-opacity`` = |fold angle| / 180
+for M and V, but at least ``min_opacity`` (default 0.3, so that shallow creases stay visible; 1
+when a crease's fold angle is 0, i.e. a flat pattern whose M/V is known but not its target
+angle). Origami Simulator reads fold angles from the opacity: the exact angle of every line is
+its ``data-foldAngle`` (and the FOLD file's), and ``min_opacity=0`` writes the plain encoding. A
+legend (mountain, valley, cut, boundary, as short ``<path>`` samples with labels,
+``<g id="legend">``) sits above the pattern, outside it; ``legend=False`` leaves it out. Lines
+are grouped: ``<g id="cut">`` holds border and cut lines, ``<g id="score">`` the creases, one
+``<line>`` per edge. The ``laser`` and ``cricut`` profiles draw one ``<path>`` per edge (its
+dashes as subpaths) in an Inkscape layer per role, with no text.
 
-Lines are grouped for fabrication: ``<g id="cut">`` holds border and cut lines (to cut
-through), ``<g id="score">`` the creases (to score, perforate or plot). Coordinates are in
-millimetres (``width``/``height`` in mm, ``viewBox`` in mm), and the y axis is flipped (SVG's y
-points down) so that the drawing is not mirrored: a mirrored crease pattern swaps M and V.
-:func:`load_svg` reads such files back (with :mod:`xml.etree`, nothing evaluated).
+Coordinates are in millimetres (``width``/``height`` in mm, ``viewBox`` in mm), and the y axis is
+flipped (SVG's y points down) so that the drawing is not mirrored: a mirrored crease pattern
+swaps M and V (the back face of a two-pass job is mirrored on purpose). :func:`load_svg` reads
+the origami-simulator files back (with :mod:`xml.etree`, nothing evaluated).
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ from holofold.geometry import (
     segment_part,
     write_segments,
 )
-from holofold.geometry.bed import PRINT_RATE
+from holofold.geometry.bed import PRINT_RATE, deposited_volume
 
 
 def _box(x, y, z=0.002):
@@ -60,9 +60,13 @@ def test_fit_straight_turned_and_diagonal():
 
 
 def test_print_time_class():
-    fit = bed_fit(_box(0.1, 0.1, 0.002))  # 20 cm^3
-    assert fit.print_hours == pytest.approx(2e-5 / PRINT_RATE / 3600)
+    """Solid over the first 1.2 mm from the base, 15 % infill above: a 100 x 100 x 2 mm plate
+    deposits 12 + 0.15 x 8 = 13.2 cm^3; a 10 mm block of the same base 12 + 0.15 x 88."""
+    fit = bed_fit(_box(0.1, 0.1, 0.002))
+    assert deposited_volume(_box(0.1, 0.1, 0.002)) == pytest.approx(13.2e-6, rel=1e-9)
+    assert fit.print_hours == pytest.approx(13.2e-6 / PRINT_RATE / 3600, rel=1e-9)
     assert fit.time_class == "1-4 h"
+    assert deposited_volume(_box(0.1, 0.1, 0.01)) == pytest.approx(25.2e-6, rel=1e-9)
     assert bed_fit(_box(0.02, 0.02, 0.002)).time_class == "under 1 h"
 
 
