@@ -531,23 +531,15 @@ def write_segments(seg: Segmentation, folder, units: str = "mm") -> list:
     than one piece, ``assembly.svg`` into ``folder`` (created if needed); returns the paths."""
     from pathlib import Path
 
-    from holofold.geometry.mesh import export_mesh
-    from holofold.geometry.outputs import atomic_write, write_text
+    from holofold.geometry.export import export
+    from holofold.geometry.outputs import write_text
 
     if not seg.segments:
         raise ValueError(seg.problem or "no pieces to write")
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for s in seg.segments:
-        data = export_mesh(s.mesh, "stl", units)
-        path = out / f"segment_{s.index:02d}.stl"
-
-        def write(tmp, data=data):
-            with open(tmp, "wb") as fh:
-                fh.write(data)
-
-        written.append(atomic_write(path, write))
+    written = [export(s.mesh, out / f"segment_{s.index:02d}.stl", units=units)
+               for s in seg.segments]  # fmt: skip
     if len(seg.segments) > 1:
         written.append(write_text(out / "assembly.svg", assembly_sheet(seg)))
     return written
