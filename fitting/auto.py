@@ -37,6 +37,7 @@ from holofold.fitting.strip import (
 from holofold.fitting.strip_fit import StripFit, fit_strip
 from holofold.geometry.clearance import printability
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
+from holofold.geometry.thick import TECHNIQUES, path_overlap, thick_panels
 
 __all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE", "PUBLISHED_MAX_WARP"]
 
@@ -81,6 +82,7 @@ def fit_auto(
     panel_thickness: float | None = None,
     crease_width: float | None = None,
     require_no_overlap: bool = False,
+    thick: str = "centred",
 ) -> AutoFit:
     """Smallest m (and an offset) whose strip's closest-point error meets ``tolerance``.
 
@@ -110,6 +112,10 @@ def fit_auto(
         reported for the candidates built.
     require_no_overlap : bool
         Refuse candidates whose thick panels overlap (needs both of the above).
+    thick : str
+        The thick panels' technique (:data:`~holofold.geometry.thick.TECHNIQUES`): the
+        ``overlap`` is that of these panels (:func:`~holofold.geometry.thick.path_overlap` in
+        the folded state); ``clearance`` stays that of centred slabs.
 
     Returns
     -------
@@ -150,12 +156,16 @@ def fit_auto(
     col = "closest_max" if metric == "max" else "closest_mean"
     if max_warp is not None:
         max_warp = check_range("max_warp", max_warp, 0.0, None, low_open=True)
-    thick = (panel_thickness, crease_width)
-    if any(v is not None for v in thick):
-        if any(v is None for v in thick):
+    pair = (panel_thickness, crease_width)
+    if any(v is not None for v in pair):
+        if any(v is None for v in pair):
             raise ParameterError("overlap needs both a panel thickness and a crease width")
         panel_thickness = check_range("panel_thickness", panel_thickness, 0.0, None, low_open=True)
         crease_width = check_range("crease_width", crease_width, 0.0, None)
+    if thick not in TECHNIQUES:
+        raise ParameterError(
+            f"unknown thickness technique {thick!r}; known: {', '.join(TECHNIQUES)}"
+        )
     if require_no_overlap and panel_thickness is None:
         raise ParameterError("require_no_overlap needs a panel thickness and a crease width")
 
@@ -206,9 +216,14 @@ def fit_auto(
                 continue
             if panel_thickness is not None:
                 pr = printability(fit.pattern, panel_thickness, crease_width)
-                r.update(overlap=pr.overlap, clearance=pr.clearance)
-                if require_no_overlap and pr.overlap > 0:
-                    r.update(meets=False, reason=f"thick panels overlap ({pr.overlap:.3g} m^3)")
+                overlap = pr.overlap
+                if thick != "centred":
+                    geo = fit.flat_pattern if fit.flat_pattern is not None else fit.pattern
+                    panels = thick_panels(geo, panel_thickness, crease_width, thick)
+                    overlap = float(path_overlap([geo], panels).volume[0])
+                r.update(overlap=overlap, clearance=pr.clearance)
+                if require_no_overlap and overlap > 0:
+                    r.update(meets=False, reason=f"thick panels overlap ({overlap:.3g} m^3)")
                     continue
             r["chosen"] = True
             log.info("fit_auto: m=%d offset=%.4g %s=%.4g warp=%.3g", m, r["offset"], col, r[col],

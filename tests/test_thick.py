@@ -120,3 +120,18 @@ def test_demo_strip_overlap_shrinks_with_offset_panels():
     after = path_overlap([fp], thick_panels(fp, 0.00564, 0.001379, "offset")).volume[0]
     assert before == pytest.approx(7.2e-7, rel=0.02)
     assert after < before / 50
+
+
+def test_fit_auto_reports_the_overlap_of_the_chosen_technique():
+    """The demo's arch design as an automatic fit: the candidates' overlap is that of the
+    technique's panels (centred 7.2e-7 m^3, offset < 1/50 of it)."""
+    from holofold.fitting import fit_auto
+
+    kw = dict(m_range=[8], offsets=[0.1], strip_width=0.01136, extrude=0.1417,
+              panel_thickness=0.00564, crease_width=0.001379, max_warp=None)  # fmt: skip
+    centred = fit_auto("half-circle", 0.5, **kw).candidates
+    offset = fit_auto("half-circle", 0.5, thick="offset", **kw).candidates
+    assert centred["overlap"].iloc[0] == pytest.approx(7.2e-7, rel=0.02)
+    assert 0 < offset["overlap"].iloc[0] < centred["overlap"].iloc[0] / 50
+    with pytest.raises(ParameterError, match="unknown thickness technique 'thin'"):
+        fit_auto("half-circle", 0.5, thick="thin", **kw)

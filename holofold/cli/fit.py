@@ -248,6 +248,7 @@ def run(args) -> int:
             metric=args.metric,
             max_warp=args.max_warp,
             require_no_overlap=args.no_overlap,
+            thick=args.thick,
             **(thick if opts.get("solid") else {}),
         )
         fit, table = res.strip, res.candidates
