@@ -23,7 +23,8 @@ The tangents are the actual ones: every ``Assembler.evaluate_factorized`` call o
 captured; each captured tangent is factorised and solved (one right-hand side) by every
 applicable LAPACK/SuperLU path called directly (dense Cholesky dpotrf/dpotrs, dense LU
 dgetrf/dgetrs, banded Cholesky dpbtrf/dpbtrs on the reverse Cuthill-McKee ordering, SuperLU
-with the cached minimum-degree ordering), the best of the rounds' timings each. A
+with the cached minimum-degree ordering, and CHOLMOD's supernodal sparse Cholesky where cvxopt
+is installed), the best of the rounds' timings each. A
 structure's floor per iteration is the cheapest path's best timing over its captured
 tangents (one size and sparsity: a busy machine only adds to a timing), so a sample's floor
 is sum(iterations x that cost). ``solver`` names the path the assembler takes; the gripper
@@ -58,7 +59,7 @@ from threadpoolctl import threadpool_limits
 import holofold.mechanics.assembly as assembly
 from holofold import mechanics as threads
 from holofold.design.scenarios import arch, canopy, gripper, single_miura
-from holofold.mechanics import linear
+from holofold.mechanics import linear, sparse_cholesky
 from holofold.mechanics.solvers import newton as newton_solvers
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -304,10 +305,29 @@ def path_fns(K: sp.csr_matrix, red) -> dict:
         lu_.solve(b)
 
     out["SuperLU"] = slu
+    if sparse_cholesky.available():  # CHOLMOD, the reduction's pattern analysed once
+        chol = red.symbolic(
+            "cholesky_reduced", lambda r: sparse_cholesky.SparseCholesky(r.indptr, r.indices)
+        )
+
+        def cholesky():
+            f = chol.factor(K.data)
+            if f is None:
+                raise np.linalg.LinAlgError
+            f.solve(b)
+
+        try:
+            cholesky()
+            out["sparse Cholesky"] = cholesky
+        except np.linalg.LinAlgError:
+            pass
     return out
 
 
-_PATHS = {"dense": "dense LU", "banded": "banded Cholesky", "superlu": "SuperLU", "none": "none"}
+_PATHS = {
+    "dense": "dense LU", "banded": "banded Cholesky", "cholesky": "sparse Cholesky",
+    "superlu": "SuperLU", "none": "none",
+}  # fmt: skip
 
 
 def solver_path(red) -> str:

@@ -7,10 +7,10 @@ definite), every path factorises the same free-free tangent and solves one right
     banded Cholesky  LAPACK dpbtrf/dpbtrs on the reverse Cuthill-McKee band (the assembler's)
     SuperLU          scipy's LU, minimum-degree ordering once, natural order at factorisation
                      time, the assembler's options
-    sparse Cholesky  CHOLMOD, supernodal (mechanics.sparse_cholesky; AMD ordering and
-                     symbolic analysis once per pattern)
-    ... METIS order  the same with METIS's nested dissection (pymetis, where installed): a
-                     reference for the ordering, not a path holofold takes
+    sparse Cholesky  CHOLMOD, supernodal (mechanics.sparse_cholesky; ordering and symbolic
+                     analysis once per pattern: AMD, and from 10,000 DOFs METIS's nested
+                     dissection where pymetis is installed, CHOLMOD keeping the cheaper)
+    ... AMD only     the same with CHOLMOD's AMD alone, as where pymetis is missing (aarch64)
 
 Rounds interleave the paths (each round times every path once, in a rotating order) so that a
 machine whose speed drifts with other jobs slows them alike. Times are the CPU time of this
@@ -23,7 +23,7 @@ memory while the path is set up afresh and factorises and solves once (the facto
 workspace and the path's cached ordering; /proc/self/clear_refs resets the peak first).
 ``setup`` is the path's one-time CPU cost per topology (ordering, symbolic analysis, band
 layout). ``ratio`` is the path's min over the best min at that size; ``*`` marks the path the
-proposed choice takes (``--band-max-work``), ``c`` the current assembler's where it differs.
+assembler takes (``mechanics.linear.solver_path``), ``+`` the one it takes without cvxopt.
 
     python benchmarks/bench_large_solvers.py [--rounds 5] [--sizes 12x4 100x100] [--out F.md]
 """
@@ -50,13 +50,14 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 from holofold.geometry.miura import miura_sheet  # noqa: E402
 from holofold.mechanics import sparse_cholesky  # noqa: E402
-from holofold.mechanics.assembly import Assembler, solver_path  # noqa: E402
+from holofold.mechanics.assembly import Assembler  # noqa: E402
 from holofold.mechanics.hinges import build_concentrated  # noqa: E402
+from holofold.mechanics.linear import BANDED_MAX_WORK, CHOLESKY_MIN_WORK, solver_path  # noqa: E402
 
 SIZES = ["12x4", "24x8", "36x12", "48x16", "72x24", "100x30", "120x40", "100x50", "150x50",
          "100x75", "100x100"]  # fmt: skip
-METIS = "sparse Cholesky, METIS order (ref.)"
-PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", METIS]
+AMD = "sparse Cholesky, AMD order only"
+PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD]
 _LIBC = ctypes.CDLL("libc.so.6")
 
 
@@ -78,20 +79,17 @@ def band_work(K: sp.csr_matrix) -> tuple[np.ndarray, int, float]:
     return perm, bw, K.shape[0] * (bw + 1) ** 2
 
 
-def proposed_path(nf: int, work: float, cholmod: bool, args) -> str:
-    """The choice these measurements support: dense up to ``--dense-max`` free DOFs, the band
-    up to ``--band-max-work``, then the sparse Cholesky (SuperLU where cvxopt is missing)."""
+def fallback_path(nf: int, work: float) -> str:
+    """The path the assembler takes without cvxopt (mechanics.linear's thresholds)."""
     if nf <= 200:
         return "dense LU"
-    if work <= args.band_max_work:
-        return "banded Cholesky"
-    return "sparse Cholesky" if cholmod else "SuperLU"
+    return "banded Cholesky" if work <= max(CHOLESKY_MIN_WORK, BANDED_MAX_WORK) else "SuperLU"
 
 
-def current_path(asm: Assembler) -> str:
-    return {"dense": "dense LU", "banded": "banded Cholesky", "superlu": "SuperLU"}[
-        solver_path(asm.reduction)
-    ]
+def assembler_path(asm: Assembler) -> str:
+    """The path the assembler takes here (mechanics.linear.solver_path)."""
+    return {"dense": "dense LU", "banded": "banded Cholesky", "cholesky": "sparse Cholesky",
+            "superlu": "SuperLU"}[solver_path(asm.reduction)]  # fmt: skip
 
 
 def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
@@ -176,19 +174,11 @@ def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
 
     if sparse_cholesky.available():
         makers["sparse Cholesky"] = make_cholesky
-        try:  # reference only: METIS's nested dissection (pymetis, where it is installed)
-            import pymetis
-        except ImportError:
-            pass
-        else:
 
-            def make_metis():
-                G = (K - sp.diags(K.diagonal())).tocsr()  # METIS takes no self-loops
-                G.eliminate_zeros()
-                order, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr, G.indices))
-                return make_cholesky(np.asarray(order, dtype=np.int64))
+        def make_amd():  # CHOLMOD's AMD alone: the ordering where pymetis is missing (aarch64)
+            return make_cholesky("amd")
 
-            makers[METIS] = make_metis
+        makers[AMD] = make_amd
     return makers
 
 
@@ -258,13 +248,13 @@ def measure(size: str, args) -> list[dict]:
             wall[p].append(time.perf_counter() - w0)
     best = min(min(cpu[p]) for p in names)
     t_asm = min(asm_cpu)
-    chosen = proposed_path(K.shape[0], work, sparse_cholesky.available(), args)
-    now = current_path(asm)
+    chosen = assembler_path(asm)
+    without = fallback_path(K.shape[0], work)
     rows = []
     for p in PATHS:
         if p not in calls:
             continue
-        mark = "*" if p == chosen else ("c" if p == now else "")
+        mark = ("*" if p == chosen else "") + ("+" if p == without else "")
         t = min(cpu[p])
         rows.append(
             dict(size=size, nf=K.shape[0], nnz=K.nnz, bw=bw, work=work, path=p, mark=mark,
@@ -298,8 +288,6 @@ def main(argv=None) -> None:
     ap.add_argument("--dense-max", type=int, default=1500, help="dense LU up to this many DOFs")
     ap.add_argument("--band-limit", type=float, default=1e11, help="skip the band above this")
     ap.add_argument("--band-slow", type=float, default=2e10, help="band work timed twice only")
-    ap.add_argument("--band-max-work", type=float, default=3e7,
-                    help="the proposed choice's largest band work")  # fmt: skip
     ap.add_argument("--out", help="also write the table (markdown) to this file")
     args = ap.parse_args(argv)
     rows = []

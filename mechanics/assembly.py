@@ -320,7 +320,13 @@ class Assembler:
             if solve is not None:
                 return solve
             # not positive definite: LU below
-        return linear.lu_solver(self._tangent(a, "csr"), red)
+        data = self._tangent(a, "csr")
+        if path == "cholesky":
+            solve = linear.cholesky_solver(data, red)
+            if solve is not None:
+                return solve
+            # not positive definite: LU on the same data
+        return linear.lu_solver(data, red)
 
     def dense_stepper(self, U, F, spring_rest=None, r=None):
         """A :class:`~holofold.mechanics.newton_step.DenseStepper`: ``step()`` does
@@ -498,6 +504,11 @@ class BatchAssembler:
             # not positive definite: LU on the CSR data of this sample alone
             a = self.assemblers[s]
             values = a._tangent(a._kernels(U, rest, True, a._buffers()), "csr")
+        elif path == "cholesky":
+            solve = linear.cholesky_solver(values, red)
+            if solve is not None:
+                return solve
+            # not positive definite: LU on the same CSR data
         try:
             return linear.lu_solver(values, red)
         except SingularSystemError as exc:

@@ -24,12 +24,14 @@ __all__ = [
     "SingularSystemError",
     "DENSE_MAX_DOF",
     "BANDED_MAX_WORK",
+    "CHOLESKY_MIN_WORK",
     "SOLVER_PATHS",
     "solver_path",
     "storage_of",
     "dense_solver",
     "band_solver",
     "lu_solver",
+    "cholesky_solver",
     "zero_solver",
     "finite",
 ]
@@ -38,13 +40,20 @@ __all__ = [
 #: larger ones sparsely (crossover measured at ~200 DOFs).
 DENSE_MAX_DOF = 200
 #: Sparse systems whose reverse Cuthill-McKee band costs at most this many flops
-#: (n * (bandwidth + 1)^2) first try a banded Cholesky factorisation; SuperLU handles the rest
-#: and every matrix that is not positive definite. Measured (benchmarks/bench_solvers.py, Miura
-#: sheets 24 x 8 to 96 x 32, work 1.3e7 to 2.8e9): banded Cholesky + solve is 1.6-3.9x faster
-#: than SuperLU at every size (72 x 24: 120 ms against 186 ms).
-BANDED_MAX_WORK = 3e9
+#: (n * (bandwidth + 1)^2) use the banded Cholesky; above it the supernodal sparse Cholesky
+#: where cvxopt is installed. Measured (benchmarks/bench_large_solvers.py, CPU time, Miura
+#: sheets at rest): band / sparse Cholesky 0.9 / 1.0 ms at 24 x 8 (work 1.2e7), 3.0 / 2.5 ms at
+#: 36 x 12 (6.1e7), 7.7 / 5.4 at 48 x 16 (1.9e8), 33 / 17 at 72 x 24, 221 / 68 at 120 x 40,
+#: 3972 / 235 at 100 x 100.
+CHOLESKY_MIN_WORK = 3e7
+#: Without the sparse Cholesky: band work up to which the banded Cholesky beats SuperLU
+#: (measured as above, band / SuperLU: 221 / 305 ms at 120 x 40 (work 6.9e9), 453 / 369 at
+#: 100 x 50 (1.1e10), 525 / 794 at 150 x 50 (1.7e10), 1766 / 936 at 100 x 75 (3.7e10)).
+BANDED_MAX_WORK = 2e10
 #: the solver paths, by the storage of the tangent each factorises
-SOLVER_PATHS = {"none": None, "dense": "dense", "banded": "banded", "superlu": "csr"}
+SOLVER_PATHS = {
+    "none": None, "dense": "dense", "banded": "banded", "cholesky": "csr", "superlu": "csr",
+}  # fmt: skip
 
 NON_FINITE = "non-finite solution of the linear system (singular stiffness)"
 SINGULAR = "singular stiffness matrix (Singular matrix)"
@@ -55,15 +64,21 @@ class SingularSystemError(RuntimeError):
 
 
 def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:
-    """The solver path of a reduction: ``"none"`` (no free DOF), ``"dense"``, ``"banded"``
-    (SuperLU if the tangent is not positive definite) or ``"superlu"``."""
+    """The solver path of a reduction: ``"none"`` (no free DOF), ``"dense"``, ``"banded"`` or
+    ``"cholesky"`` (both SuperLU if the tangent is not positive definite) or ``"superlu"``."""
     nf = red.n_free
     if nf == 0:
         return "none"
     if nf <= dense_max:
         return "dense"
-    bw = red.band.bandwidth
-    return "banded" if nf * (bw + 1) ** 2 <= BANDED_MAX_WORK else "superlu"
+    work = nf * (red.band.bandwidth + 1) ** 2
+    if work <= CHOLESKY_MIN_WORK:
+        return "banded"
+    from holofold.mechanics import sparse_cholesky
+
+    if sparse_cholesky.available():
+        return "cholesky"
+    return "banded" if work <= BANDED_MAX_WORK else "superlu"
 
 
 def storage_of(path: str) -> str | None:
@@ -186,3 +201,18 @@ def lu_solver(data: np.ndarray, red: ReducedPattern):
         return finite(x)
 
     return solve
+
+
+def _cholesky_analysis(red: ReducedPattern):
+    """The reduction's :class:`~holofold.mechanics.sparse_cholesky.SparseCholesky` (AMD
+    ordering and symbolic analysis of the free-free pattern), reading the full CSR data."""
+    from holofold.mechanics.sparse_cholesky import SparseCholesky
+
+    return SparseCholesky(red.indptr, red.indices, data_slots=red.keep)
+
+
+def cholesky_solver(data: np.ndarray, red: ReducedPattern):
+    """``solve(rhs)`` by the supernodal sparse Cholesky of the free-free block of the full CSR
+    ``data`` (the reduction's cached analysis), or None if the block is not positive
+    definite."""
+    return red.symbolic("cholesky", _cholesky_analysis).factor(data)

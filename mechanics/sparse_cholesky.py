@@ -2,17 +2,21 @@
 
 CHOLMOD (SuiteSparse; supernodal, BLAS-3 on dense blocks), reached through cvxopt's wheels
 (``cvxopt.cholmod``; x86_64 and aarch64, the BLAS they bundle), factorises the symmetric positive
-definite free-free tangent of a Miura sheet of 100 x 100 panels (60,300 DOFs) in about 0.5-0.7 s,
-where SuperLU (scipy's LU, the fallback) takes 1.3-5 s and the banded Cholesky of the reverse
-Cuthill-McKee band 4-12 s (``benchmarks/bench_large_solvers.py``).
+definite free-free tangent of a Miura sheet of 100 x 100 panels (60,300 DOFs) in about 0.24 s of
+CPU, where SuperLU (scipy's LU, the fallback) takes 1.4 s and the banded Cholesky of the reverse
+Cuthill-McKee band 4 s (``benchmarks/bench_large_solvers.py``). The solver choice
+(:func:`holofold.mechanics.linear.solver_path`) takes it above a band work of
+:data:`~holofold.mechanics.linear.CHOLESKY_MIN_WORK` (about 2,000 free DOFs on Miura sheets).
 
-A :class:`SparseCholesky` is built once per sparsity pattern (one topology and support mask):
-it keeps the slots of the upper triangle and computes the fill-reducing ordering (approximate
-minimum degree) and the symbolic factorisation. Each :meth:`SparseCholesky.factor` then does
-only the numeric factorisation of new values on that pattern and returns a
+A :class:`SparseCholesky` is built once per sparsity pattern (one topology and support mask;
+:func:`holofold.mechanics.linear.cholesky_solver` caches it on the reduction): it keeps the
+slots of the upper triangle and computes the fill-reducing ordering (approximate minimum
+degree; on large patterns also METIS's nested dissection where pymetis is installed, CHOLMOD
+keeping the better) and the symbolic factorisation. Each :meth:`SparseCholesky.factor` then
+does only the numeric factorisation of new values on that pattern and returns a
 :class:`CholeskyFactor` (``solve(rhs)``), or None when the matrix is not positive definite,
 so that the caller falls back to LU. Factors are independent: several may be alive at once
-(a batch keeps one per sample); their symbolic storage is recycled when they are dropped.
+(a batch keeps one per sample); their CHOLMOD storage is recycled when they are dropped.
 
 cvxopt is an optional dependency (``pip install 'holofold[cholmod]'``: cvxopt and CHOLMOD's
 supernodal module are GPL); :func:`available` says whether it imports, and constructing a
@@ -33,14 +37,15 @@ import weakref
 import numpy as np
 
 from holofold.geometry.errors import EnvironmentFault
-from holofold.mechanics.assembly import SingularSystemError
+from holofold.mechanics.linear import SingularSystemError
 
-__all__ = ["SparseCholesky", "CholeskyFactor", "available", "INSTALL_HINT"]
+__all__ = ["SparseCholesky", "CholeskyFactor", "available", "INSTALL_HINT", "METIS_MIN_DOF"]
 
 #: How to install the optional CHOLMOD path.
 INSTALL_HINT = "pip install 'holofold[cholmod]' (cvxopt >= 1.3.2, which bundles CHOLMOD)"
 
 _CVXOPT = None
+_AVAILABLE: bool | None = None
 
 
 def _cvxopt():
@@ -58,12 +63,42 @@ def _cvxopt():
 
 
 def available() -> bool:
-    """True if cvxopt's CHOLMOD imports (the sparse Cholesky path can be used)."""
+    """True if cvxopt's CHOLMOD imports (the sparse Cholesky path can be used); the answer is
+    kept for the process."""
+    global _AVAILABLE
+    if _AVAILABLE is None:
+        try:
+            _cvxopt()
+            _AVAILABLE = True
+        except EnvironmentFault:
+            _AVAILABLE = False
+    return _AVAILABLE
+
+
+#: Patterns of at least this many rows get METIS's nested dissection as a candidate ordering
+#: where pymetis is installed (x86_64 wheels; the `cholmod` extra brings it there): on Miura
+#: sheets of 120 x 40 panels and more it saves 20-30 % of the factorisation against AMD
+#: (bench_large_solvers), below about 10,000 DOFs the two are alike.
+METIS_MIN_DOF = 10_000
+
+
+def _nested_dissection(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray | None:
+    """METIS's nested-dissection order of the symmetric pattern with lower-triangle entries
+    (rows, cols), or None where pymetis is not installed."""
     try:
-        _cvxopt()
-    except EnvironmentFault:
-        return False
-    return True
+        import pymetis
+    except ImportError:
+        return None
+    import scipy.sparse as sp
+
+    off = rows != cols
+    r, c = rows[off], cols[off]
+    G = sp.csr_matrix(
+        (np.ones(2 * r.size, np.int8), (np.concatenate([r, c]), np.concatenate([c, r]))),
+        shape=(n, n),
+    )
+    order, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr, G.indices))
+    return np.array(order).astype(np.int64)  # a copy in numpy's own buffer format
 
 
 def _with_options(cholmod, options: dict, fn, *args):
@@ -91,21 +126,26 @@ class SparseCholesky:
         CSR column indices, sorted or not; the pattern must hold every diagonal entry and
         be structurally symmetric (both triangles, as the assembler's reduced pattern), or
         hold the upper triangle only.
-    ordering : (n,) int, optional
-        A fill-reducing elimination order (the matrix is factorised as ``K[o][:, o]``);
-        default: CHOLMOD's approximate minimum degree (AMD) of the pattern.
+    ordering : (n,) int or "amd", optional
+        A fill-reducing elimination order (the matrix is factorised as ``K[o][:, o]``), used
+        as given, or ``"amd"``: CHOLMOD's approximate minimum degree (AMD) alone. Default: AMD;
+        from :data:`METIS_MIN_DOF` rows, where pymetis is installed, CHOLMOD compares METIS's
+        nested dissection with its AMD and keeps the one with fewer flops.
+    data_slots : (nnz,) int, optional
+        Where each pattern entry lies in the ``data`` arrays given to :meth:`factor` (default:
+        ``data`` is the CSR data itself), e.g. the slots of a larger matrix's CSR data.
 
     Attributes
     ----------
     n : int
     order : (n,) int
-        The elimination order used.
+        The elimination order given to CHOLMOD (AMD's, the caller's, or METIS's candidate).
     upper : (nnz_u,) int
-        Slots of the CSR data that lie in the upper triangle (column >= row), the entries
-        factorised (the lower triangle is taken as their mirror).
+        Slots of ``data`` that hold the upper triangle (column >= row), the entries factorised
+        (the lower triangle is taken as their mirror).
     """
 
-    def __init__(self, indptr, indices, *, ordering=None):
+    def __init__(self, indptr, indices, *, ordering=None, data_slots=None):
         matrix, spmatrix, cholmod, amd = _cvxopt()
         indptr = np.asarray(indptr, dtype=np.int64)
         indices = np.asarray(indices, dtype=np.int64)
@@ -122,13 +162,19 @@ class SparseCholesky:
         srt = np.argsort(key, kind="stable")
         if np.any(np.diff(key[srt]) == 0):
             raise ValueError("the pattern has duplicate entries")
-        self.upper = up[srt]
-        r_low = indices[self.upper]  # row in the lower triangle of the transpose
-        c_low = rows[self.upper]
+        upper = up[srt]
+        r_low = indices[upper]  # row in the lower triangle of the transpose
+        c_low = rows[upper]
         if np.count_nonzero(r_low == c_low) != n:
             raise ValueError("the pattern must hold every diagonal entry")
+        if data_slots is not None:
+            data_slots = np.asarray(data_slots, dtype=np.intp).ravel()
+            if data_slots.size != indices.size:
+                raise ValueError(f"data_slots must have {indices.size} entries")
+            upper = data_slots[upper]
+        self.upper = upper
         self.n = int(n)
-        self.nnz_upper = int(self.upper.size)
+        self.nnz_upper = int(upper.size)
         self._A = spmatrix(
             matrix(np.ones(self.upper.size)),
             matrix(r_low),
@@ -138,8 +184,16 @@ class SparseCholesky:
         stored = np.asarray(self._A.I, dtype=np.int64).ravel()
         if not np.array_equal(stored, r_low):  # pragma: no cover - cvxopt's storage order
             raise RuntimeError("cvxopt stored the pattern in an unexpected order")
-        if ordering is None:
-            p = amd.order(self._A)  # AMD of the pattern (lower triangle + mirror)
+        self._nmethods = 1  # CHOLMOD takes the ordering as given
+        if isinstance(ordering, str) and ordering != "amd":
+            raise ValueError(f"ordering must be 'amd' or a permutation, got {ordering!r}")
+        if ordering is None or isinstance(ordering, str):
+            auto = ordering is None and n >= METIS_MIN_DOF
+            nd = _nested_dissection(r_low, c_low, n) if auto else None
+            if nd is None:
+                p = amd.order(self._A)  # AMD of the pattern (lower triangle + mirror)
+            else:  # CHOLMOD keeps the better of METIS's and its own AMD
+                p, self._nmethods = matrix(nd), 0
         else:
             o = np.asarray(ordering, dtype=np.int64).ravel()
             if o.size != n or not np.array_equal(np.sort(o), np.arange(n)):
@@ -154,13 +208,14 @@ class SparseCholesky:
         """A new CHOLMOD symbolic factorisation with :attr:`order` (no ordering search)."""
         _, _, cholmod, _ = _cvxopt()
         return _with_options(
-            cholmod, {"supernodal": 2, "nmethods": 1, "postorder": True},
+            cholmod, {"supernodal": 2, "nmethods": self._nmethods, "postorder": True},
             cholmod.symbolic, self._A, self._p,
         )  # fmt: skip
 
     def factor(self, data) -> CholeskyFactor | None:
         """Numeric Cholesky factorisation of the matrix with CSR ``data`` (nnz,) on the pattern
-        (only the upper-triangle slots are read).
+        (or the larger array ``data_slots`` points into; only the upper-triangle slots are
+        read).
 
         Returns
         -------

@@ -171,6 +171,27 @@ def test_given_ordering_and_upper_pattern(tangents):
     assert _rel(SparseCholesky(U.indptr, U.indices).factor(U.data).solve(b), ref) < 1e-9
 
 
+def test_nested_dissection_candidate(monkeypatch):
+    """On large patterns METIS's nested dissection (pymetis, where installed) is offered to
+    CHOLMOD beside its AMD; without pymetis AMD alone. Both solve to 1e-12 of spsolve."""
+    K = _laplacian_spd(20)
+    b = np.random.default_rng(8).standard_normal(K.shape[0])
+    ref = spla.spsolve(K.tocsc(), b)
+    monkeypatch.setattr(sparse_cholesky, "METIS_MIN_DOF", 100)
+    metis = SparseCholesky(K.indptr, K.indices)
+    if sparse_cholesky._nested_dissection(np.array([1]), np.array([0]), 2) is None:
+        assert metis._nmethods == 1  # no pymetis: AMD as given
+    else:
+        assert metis._nmethods == 0  # METIS's order and CHOLMOD's AMD compared
+        assert sorted(metis.order.tolist()) == list(range(K.shape[0]))
+    assert _rel(metis.factor(K.data).solve(b), ref) < 1e-12
+    amd = SparseCholesky(K.indptr, K.indices, ordering="amd")
+    assert amd._nmethods == 1
+    assert _rel(amd.factor(K.data).solve(b), ref) < 1e-12
+    monkeypatch.setitem(sys.modules, "pymetis", None)
+    assert SparseCholesky(K.indptr, K.indices)._nmethods == 1
+
+
 @pytest.mark.parametrize(
     "case, message",
     [
@@ -178,6 +199,7 @@ def test_given_ordering_and_upper_pattern(tangents):
         ("bad indptr", "CSR row pointer"),
         ("index out of range", "column indices"),
         ("bad ordering", "permutation"),
+        ("unknown ordering", "'amd' or a permutation"),
     ],
 )
 def test_bad_input_is_one_clear_error(case, message):
@@ -192,8 +214,10 @@ def test_bad_input_is_one_clear_error(case, message):
         indptr = indptr[::-1]
     elif case == "index out of range":
         indices = indices + 1
-    else:
+    elif case == "bad ordering":
         ordering = np.zeros(K.shape[0], int)
+    else:
+        ordering = "metis"
     with pytest.raises(ValueError, match=message):
         SparseCholesky(indptr, indices, ordering=ordering)
     if case == "no diagonal":
@@ -206,8 +230,81 @@ def test_missing_cvxopt_is_an_environment_fault(monkeypatch):
     """Without cvxopt, available() is False and building the solver stops in one line that
     names the fix."""
     monkeypatch.setattr(sparse_cholesky, "_CVXOPT", None)
+    monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", None)
     monkeypatch.setitem(sys.modules, "cvxopt", None)
     assert not sparse_cholesky.available()
     K = _laplacian_spd(3)
     with pytest.raises(EnvironmentFault, match=r"holofold\[cholmod\]"):
         SparseCholesky(K.indptr, K.indices)
+
+
+# ---------------------------------------------------------------- the solver choice (linear)
+@pytest.fixture(scope="module")
+def canopy_sheet():
+    """A 36 x 12 sheet: 2700 free DOFs, band work 6.1e7 > CHOLESKY_MIN_WORK."""
+    return _sheet(36, 12)
+
+
+def test_solver_path_takes_the_sparse_cholesky_by_band_work(canopy_sheet, monkeypatch):
+    """Above CHOLESKY_MIN_WORK the assembler takes the sparse Cholesky; without cvxopt the
+    band up to BANDED_MAX_WORK; small models stay on the band."""
+    from holofold.mechanics import linear
+
+    red = Assembler(canopy_sheet).reduction
+    work = red.n_free * (red.band.bandwidth + 1) ** 2
+    assert linear.CHOLESKY_MIN_WORK < work <= linear.BANDED_MAX_WORK
+    assert linear.solver_path(red) == "cholesky"
+    assert Assembler(_sheet(12, 4)).solver == "banded"
+    monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
+    assert linear.solver_path(red) == "banded"
+    monkeypatch.setattr(linear, "BANDED_MAX_WORK", work / 2)
+    assert linear.solver_path(red) == "superlu"
+
+
+def test_assembler_on_the_cholesky_path_matches_superlu(canopy_sheet):
+    """evaluate_factorized on the sparse Cholesky path solves as SuperLU does (1e-6 relative,
+    the tangent's condition ~1e7 x eps with margin), one and several right-hand sides; at an
+    indefinite state it falls back to LU and still solves."""
+    from holofold.mechanics import linear
+
+    asm = Assembler(canopy_sheet)
+    assert asm.solver == "cholesky"
+    rng = np.random.default_rng(5)
+    for scale in (0.0, 1e-4):  # at rest (SPD) and displaced at random (indefinite)
+        U = scale * rng.standard_normal((canopy_sheet.n_nodes, 3))
+        U[canopy_sheet.supports] = 0.0
+        _, _, solve = asm.evaluate_factorized(U)
+        _, _, K = asm.evaluate_reduced(U, dense=False)
+        B = rng.standard_normal((K.shape[0], 2))
+        ref = spla.splu(K.tocsc()).solve(B)
+        assert _rel(solve(B[:, 0]), ref[:, 0]) < 1e-6
+        assert _rel(solve(B), ref) < 1e-6
+        on_cholesky = isinstance(solve, sparse_cholesky.CholeskyFactor)
+        assert on_cholesky == (scale == 0.0)
+    data = asm._tangent(asm._elements(np.zeros((canopy_sheet.n_nodes, 3)), None)[2], "csr")
+    assert linear.cholesky_solver(data, asm.reduction) is not None
+
+
+def test_batch_newton_step_on_the_cholesky_path(canopy_sheet):
+    """BatchAssembler.newton_step of three samples on the sparse Cholesky path (one at an
+    indefinite state: LU) gives each sample's own Assembler increment to 1e-9 relative."""
+    from holofold.mechanics.assembly import BatchAssembler
+
+    s = canopy_sheet
+    batch = BatchAssembler([s, s, s])
+    rng = np.random.default_rng(6)
+    U = np.zeros((3, s.n_dof))
+    U[2] = 1e-4 * rng.standard_normal(s.n_dof) * ~s.supports.ravel()
+    F = np.zeros((3, s.n_dof))
+    F[:, 2::3] = -1e-3 * np.arange(1, 4)[:, None]  # a small load along -z, one per sample
+    F[:, s.supports.ravel()] = 0.0
+    expected = []
+    asm = Assembler(s)
+    free = asm.free_dofs
+    for i in range(3):
+        _, f, solve = asm.evaluate_factorized(U[i].reshape(-1, 3))
+        expected.append(solve((F[i] - f)[free]))
+    dU, errors = batch.newton_step(U, F, np.ones(3, bool))
+    assert not errors
+    for i in range(3):
+        assert _rel(dU[i], expected[i]) < 1e-9
