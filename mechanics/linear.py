@@ -41,14 +41,17 @@ __all__ = [
 DENSE_MAX_DOF = 200
 #: Sparse systems whose reverse Cuthill-McKee band costs at most this many flops
 #: (n * (bandwidth + 1)^2) use the banded Cholesky; above it the supernodal sparse Cholesky
-#: where cvxopt is installed. Measured (benchmarks/bench_large_solvers.py, CPU time, Miura
-#: sheets at rest): band / sparse Cholesky 0.9 / 1.0 ms at 24 x 8 (work 1.2e7), 3.0 / 2.5 ms at
-#: 36 x 12 (6.1e7), 7.7 / 5.4 at 48 x 16 (1.9e8), 33 / 17 at 72 x 24, 221 / 68 at 120 x 40,
-#: 3972 / 235 at 100 x 100.
-CHOLESKY_MIN_WORK = 3e7
+#: where cvxopt is installed. Measured on Miura sheets (CPU time): a whole solve_newton_batch
+#: per sample, band (its compiled whole-solve kernel) / sparse Cholesky, 6.0 / 7.5 ms at 24 x 8
+#: (work 1.2e7), 12.7 / 13.9 at 30 x 10 (3.0e7), 37.5 / 34.1 at 36 x 12 (6.1e7), 57.8 / 50.0
+#: at 48 x 16; the factorisation + solve alone (benchmarks/bench_large_solvers.py) 3.3 / 2.4
+#: ms at 36 x 12, 32 / 14 at 72 x 24, 505 / 56 at 120 x 40, 3334 / 167 at 100 x 100.
+CHOLESKY_MIN_WORK = 4e7
 #: Without the sparse Cholesky: band work up to which the banded Cholesky beats SuperLU
-#: (measured as above, band / SuperLU: 221 / 305 ms at 120 x 40 (work 6.9e9), 453 / 369 at
-#: 100 x 50 (1.1e10), 525 / 794 at 150 x 50 (1.7e10), 1766 / 936 at 100 x 75 (3.7e10)).
+#: (bench_large_solvers, band / SuperLU, two runs at load 13-20: 195-505 / 282-314 ms at
+#: 120 x 40 (work 6.9e9), 291-453 / 359-382 at 100 x 50 (1.1e10), 506-921 / 573-794 at
+#: 150 x 50 (1.7e10), 922-1780 / 747-936 at 100 x 75 (3.7e10); the band's streaming suffers
+#: most from other jobs).
 BANDED_MAX_WORK = 2e10
 #: the solver paths, by the storage of the tangent each factorises
 SOLVER_PATHS = {

@@ -2,10 +2,10 @@
 
 CHOLMOD (SuiteSparse; supernodal, BLAS-3 on dense blocks), reached through cvxopt's wheels
 (``cvxopt.cholmod``; x86_64 and aarch64, the BLAS they bundle), factorises the symmetric positive
-definite free-free tangent of a Miura sheet of 100 x 100 panels (60,300 DOFs) in about 0.24 s of
-CPU, where SuperLU (scipy's LU, the fallback) takes 1.4 s and the banded Cholesky of the reverse
-Cuthill-McKee band 4 s (``benchmarks/bench_large_solvers.py``). The solver choice
-(:func:`holofold.mechanics.linear.solver_path`) takes it above a band work of
+definite free-free tangent of a Miura sheet of 100 x 100 panels (60,300 DOFs) in about 0.17 s of
+CPU (0.23 s on AMD's ordering alone), where SuperLU (scipy's LU, the fallback) takes 1.3 s and
+the banded Cholesky of the reverse Cuthill-McKee band 3.3 s (``benchmarks/large_solvers.md``).
+The solver choice (:func:`holofold.mechanics.linear.solver_path`) takes it above a band work of
 :data:`~holofold.mechanics.linear.CHOLESKY_MIN_WORK` (about 2,000 free DOFs on Miura sheets).
 
 A :class:`SparseCholesky` is built once per sparsity pattern (one topology and support mask;
