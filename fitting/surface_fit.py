@@ -630,7 +630,7 @@ def fit_surface(
         "factorisations": kkt.n_factor,
         "minres_iterations": int(sum(kkt.minres_its)),
     }
-    flat = develop(X, grid)
+    flat = _orient_flat(develop(X, grid), grid)
     residuals = _residuals(X, flat, grid)
     dist = target.distance(X[grid.side])
     if ok and not (residuals["sector_angle_min_deg"] > MIN_SECTOR_DEG
@@ -651,6 +651,16 @@ def fit_surface(
         except ValueError as exc:
             fit = replace(fit, ok=False, message=f"the flat pattern is not valid: {exc}")
     return fit
+
+
+def _orient_flat(Y: np.ndarray, grid: QuadGrid) -> np.ndarray:
+    """The flat layout turned so that the lines of constant i (the straight creases of a
+    Miura-ori) run along +y on average and moved to start at the origin (i along +x)."""
+    v = Y[grid.vid(np.arange(grid.m + 1), grid.n)] - Y[grid.vid(np.arange(grid.m + 1), 0)]
+    a = math.atan2(v[:, 0].sum(), v[:, 1].sum())  # rotate by +a: the mean direction to +y
+    R = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    Z = Y @ R.T
+    return Z - Z.min(axis=0)
 
 
 def _residuals(X: np.ndarray, flat: np.ndarray, grid: QuadGrid) -> dict[str, float]:

@@ -22,7 +22,7 @@ import numpy as np
 from holofold.geometry.errors import check_range
 from holofold.mechanics.folding import fold_pattern
 
-__all__ = ["FoldCheck", "check_fold", "FOLD_TOLERANCE"]
+__all__ = ["FoldCheck", "check_fold", "aligned_deviation", "FOLD_TOLERANCE"]
 
 #: the largest vertex distance (relative to the target's size) between the simulated and the
 #: fitted folded state for a fit to count as folded
@@ -70,6 +70,14 @@ def _kabsch(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     d = np.sign(np.linalg.det(U @ Vt))
     R = U @ np.diag([1.0, 1.0, d]) @ Vt
     return (A - ca) @ R + cb
+
+
+def aligned_deviation(simulated, fitted) -> np.ndarray:
+    """(nv,) distances (m) between the vertices ``simulated`` (nv, 3) moved by the rotation and
+    translation that bring them closest to ``fitted`` (nv, 3), and ``fitted``."""
+    A = np.asarray(simulated, float)
+    B = np.asarray(fitted, float)
+    return np.linalg.norm(_kabsch(A, B) - B, axis=1)
 
 
 def check_fold(

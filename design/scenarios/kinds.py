@@ -1,5 +1,5 @@
 """The registry of scenario-file kinds: ``kind = "strip"``, ``"sheet"``, ``"gripper"``,
-``"pattern"`` and any kind another package adds.
+``"pattern"``, ``"surface"`` and any kind another package adds.
 
 A kind is a :class:`ScenarioKind`: a name, one line of description and
 ``from_config(doc, name, description) -> Scenario``, which reads the file's tables through
@@ -75,6 +75,10 @@ BUILTIN_KINDS = {
     "pattern": (
         "holofold.design.scenarios.pattern_kind",
         "any crease pattern file (FOLD, SVG, DXF, ORIPA), folded, then loaded",
+    ),
+    "surface": (
+        "holofold.design.scenarios.surface_kind",
+        "a generalised Miura-ori fitted to a target surface, folded, then loaded",
     ),
 }
 _REGISTERED: dict[str, ScenarioKind] = {}
