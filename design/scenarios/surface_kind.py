@@ -77,9 +77,9 @@ DESCRIPTION = "a generalised Miura-ori fitted to a target surface, folded, then 
 SURFACE_FEATURES = (
     Column("m", "-", "quads along the zig-zag direction", choices=(6.0, 8.0, 10.0)),
     Column("n", "-", "quads across the zig-zag direction", choices=(6.0, 8.0, 10.0)),
-    Column("tpanel", "m", "panel thickness", 1e-3, 3e-3),
-    Column("tcrease", "m", "crease thickness", 0.2e-3, 0.6e-3),
-    Column("W", "m", "crease width", 1e-3, 3e-3),
+    Column("tpanel", "m", "panel thickness", 1e-3, 3e-3, display="mm"),
+    Column("tcrease", "m", "crease thickness", 0.2e-3, 0.6e-3, display="mm"),
+    Column("W", "m", "crease width", 1e-3, 3e-3, display="mm"),
     Column("ext", "-", "how far the starting Miura-ori is folded (1 = flat)", 0.55, 0.85),
     Column("coverage", "-", "share of the target's chart the pattern covers", 0.7, 0.95),
 )
@@ -112,9 +112,16 @@ class SurfaceScenarioSetting:
 
 def surface_columns(setting: SurfaceScenarioSetting) -> tuple[Column, ...]:
     cols = [
-        Column("rms_error", "m", "RMS distance of the fitted side to the target"),
-        Column("max_error", "m", "largest distance of the fitted side to the target"),
-        Column("fold_error", "m", "largest distance between the simulated fold and the fit"),
+        Column("rms_error", "m", "RMS distance of the fitted side to the target", display="mm"),
+        Column(
+            "max_error", "m", "largest distance of the fitted side to the target", display="mm"
+        ),  # fmt: skip
+        Column(
+            "fold_error",
+            "m",
+            "largest distance between the simulated fold and the fit",
+            display="mm",
+        ),  # fmt: skip
     ]
     cols += [
         Column(f"{ld.name}stiff", "N/m", f"secant stiffness under {ld.force:g} N at {ld.at}")
@@ -307,15 +314,16 @@ def _read_target(sec: Section) -> tuple[TargetSurface, str, dict]:
     if bool(builtin) == sec.has("file"):
         raise sec.error("give either file = '...' (.stl .obj .ply .off) or builtin = '...' "
                         f"({', '.join(BUILTIN_SURFACES)})")  # fmt: skip
+    if not builtin:
+        path = sec.path("file")
+        if path.suffix.lower().lstrip(".") not in MESH_SURFACE_TYPES:
+            raise sec.error(f"file = {sec.raw('file')!r}: a surface is "
+                            f"{', '.join('.' + t for t in MESH_SURFACE_TYPES)}")  # fmt: skip
+        units = sec.choice("units", tuple(LENGTH_UNITS), "mm")
     try:
         if builtin:
             target, source = builtin_surface(builtin, **params), builtin
         else:
-            path = sec.path("file")
-            if path.suffix.lower().lstrip(".") not in MESH_SURFACE_TYPES:
-                raise sec.error(f"file = {sec.raw('file')!r}: a surface is "
-                                f"{', '.join('.' + t for t in MESH_SURFACE_TYPES)}")  # fmt: skip
-            units = sec.choice("units", tuple(LENGTH_UNITS), "mm")
             target, source = read_surface(path, units), path.name
     except ValueError as exc:
         raise sec.error(str(exc)) from None
