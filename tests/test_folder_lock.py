@@ -101,7 +101,8 @@ def test_two_design_runs_with_other_units_never_mix_files(tmp_path):
     import trimesh
 
     summary = json.loads((out / "design.json").read_text())
-    stls = [out / rel for rel in summary["files"].values() if rel.endswith(".stl")]
+    rels = [f["path"] for f in summary["files"].values()]
+    stls = [out / rel for rel in rels if rel.endswith(".stl")]
     # the 0.04 m cell in the first run's unit (m), every file: 0.0x, never 4x mm
     extents = [max(trimesh.load(p).extents) for p in stls]
     assert stls and all(0.01 < e < 0.2 for e in extents), extents
