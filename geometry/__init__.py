@@ -43,6 +43,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "thick_printable",
         ],
         "facets": ["split_faces", "nonconvex_faces", "SPLIT_MODES"],
+        "families": [
+            "Parameter",
+            "PatternFamily",
+            "pattern_families",
+            "family_names",
+            "get_family",
+            "register_family",
+        ],
         "fold_io": ["export_fold", "fold_dict", "load_fold", "read_fold", "FoldWarning"],
         "fold_frames": ["fold_path_dict", "export_fold_path"],
         "gripper": [

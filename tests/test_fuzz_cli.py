@@ -218,6 +218,8 @@ def _check(argv, code, err):
     assert "Traceback" not in err, (argv, err[-2000:])
     if code == 2:
         heads = (f"holofold {argv[0]}: error: ", "holofold: error: ")
+        if len(argv) > 1:  # a command with sub-commands (pattern KIND)
+            heads += (f"holofold {argv[0]} {argv[1]}: error: ",)
         assert any(line.startswith(heads) for line in err.splitlines()), (argv, err[-2000:])
 
 

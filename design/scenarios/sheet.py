@@ -55,18 +55,17 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.plausible import FORCE, check_lengths, check_plausible
+from holofold.design.scenarios.sheet_families import (
+    MIURA_SHEET,
+    SHEET_FAMILIES,
+    TMP_SHEET,
+    miura_sides,
+    sheet_family,
+)
 from holofold.geometry import MAX_PANELS
 from holofold.geometry import TECHNIQUES as THICK_TECHNIQUES
 from holofold.geometry.errors import DegenerateGeometryError
-from holofold.geometry.miura import (
-    miura_faces,
-    miura_nodes,
-    miura_nodes_batch,
-    miura_sheet,
-    rigid_fold_pattern,
-)
 from holofold.geometry.pattern import CreasePattern
-from holofold.geometry.tmp import tmp_faces, tmp_nodes
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
 from holofold.mechanics.compat import PAPER
@@ -100,9 +99,9 @@ __all__ = [
     "from_config",
 ]
 
-MIURA, TMP = 1, 2
-#: pattern names of scenario files -> the feature's codes
-PATTERNS = {"miura": MIURA, "tmp": TMP}
+MIURA, TMP = MIURA_SHEET.code, TMP_SHEET.code
+#: pattern names of scenario files -> the feature's codes (the sheet families)
+PATTERNS = {f.name: code for code, f in SHEET_FAMILIES.items()}
 GAMMA_70 = 70.0 / 180.0 * math.pi  #: the canopy's Miura sector angle, rad
 
 #: every feature a sheet can have, with the paper's ranges (canopy; ``gama`` from data0).
@@ -221,7 +220,8 @@ def sheet_features(setting: SheetSetting, moduli: bool = True) -> tuple[Column, 
     with ``moduli``, the optional ``creaseE``/``panelE`` defaulting to its E over the data4
     range scaled to it, [E/2, 5E/2]."""
     fixed = {k for k in ("pattern", "m", "n") if getattr(setting, k) is not None}
-    if setting.gamma is not None or setting.pattern == TMP:
+    fam = sheet_family(setting.pattern)
+    if setting.gamma is not None or (fam is not None and not fam.has_gamma):
         fixed.add("gama")
     if not moduli:
         fixed.update(_OPTIONAL_E)
@@ -265,41 +265,25 @@ def _design(setting: SheetSetting, row) -> tuple[int, int, int, float | None]:
     pat = setting.pattern if setting.pattern is not None else int(row["pattern"])
     m = setting.m if setting.m is not None else int(row["m"])
     n = setting.n if setting.n is not None else int(row["n"])
-    gamma = setting.gamma if setting.gamma is not None or pat == TMP else float(row["gama"])
+    has_gamma = SHEET_FAMILIES[pat].has_gamma
+    gamma = setting.gamma if setting.gamma is not None or not has_gamma else float(row["gama"])
     return pat, m, n, gamma
 
 
 @lru_cache(maxsize=32)
 def _topology(pattern: int, m: int, n: int) -> CreasePattern:
     """A sheet with the right faces (coordinates are replaced per design)."""
-    if pattern == MIURA:
-        faces = miura_faces(m, n)
-        X = miura_nodes(m, n, 1.0, 1.0, 1.0, 0.5)
-    else:
-        faces = tmp_faces(m, n)
-        X = tmp_nodes(m, n, 1.0, 0.5)
-    return CreasePattern.from_faces(X, faces)
+    fam = SHEET_FAMILIES[pattern]
+    return CreasePattern.from_faces(fam.topology_nodes(m, n), fam.faces(m, n))
 
 
-def _tmp_nodes(m: int, n: int, size_x: float, size_y: float, ext: float) -> np.ndarray:
-    """TMP nodes with b = size_x/m, a = size_y/n, (nv, 3) m: those of
-    :func:`holofold.geometry.tmp.tmp_nodes` (with its ``L_y`` for a rectangle)."""
-    return tmp_nodes(m, n, size_x, ext, None if size_x == size_y else size_y)
-
-
-def _miura_sides(setting: SheetSetting, m: int, n: int, gamma: float) -> tuple[float, float]:
-    """Panel sides (a, b) of a Miura sheet, m."""
-    b = setting.size_x / m
-    return (setting.size_y - b / math.tan(gamma)) / n, b
+_miura_sides = miura_sides  # the footprint's Miura panel sides (a, b)
 
 
 def sheet_nodes(setting: SheetSetting, row, ext: float) -> np.ndarray:
     """Node coordinates of the design's sheet folded to ``ext``, (nv, 3) m."""
     pat, m, n, gamma = _design(setting, row)
-    if pat == MIURA:
-        a, b = _miura_sides(setting, m, n, gamma)
-        return miura_nodes(m, n, a, b, gamma, ext)
-    return _tmp_nodes(m, n, setting.size_x, setting.size_y, ext)
+    return SHEET_FAMILIES[pat].nodes(setting, m, n, gamma, ext)
 
 
 def _modulus(row, key: str, default: float) -> float:
@@ -331,15 +315,10 @@ def sheet_models_batch(setting: SheetSetting, rows, *, profile=PAPER, extensions
     for (pat, m, n), idx in groups.items():
         topo = _topology(pat, m, n)
         items = [(i, e) for i in idx for e in range(len(exts))]
-        if pat == MIURA:  # every sheet's nodes at once (bit for bit sheet_nodes)
-            gammas = [_design(setting, rows[i])[3] for i, _ in items]
-            sides = [_miura_sides(setting, m, n, g) for g in gammas]
-            X = miura_nodes_batch(
-                m, n, [a for a, _ in sides], [b for _, b in sides], gammas,
-                [exts[e] for _, e in items],
-            )  # fmt: skip
-        else:
-            X = np.stack([sheet_nodes(setting, rows[i], exts[e]) for i, e in items])
+        gammas = [_design(setting, rows[i])[3] for i, _ in items]
+        X = SHEET_FAMILIES[pat].nodes_batch(  # every sheet's nodes at once (bit for bit)
+            setting, m, n, gammas, [exts[e] for _, e in items]
+        )
         masks: dict = {}  # one support mask (and load group) per set of nodes
         groups_of: dict = {}
         sups = []
@@ -400,8 +379,10 @@ def check_sheet(setting: SheetSetting, row) -> list[str]:
         if getattr(setting, k) is not None:
             d[k] = getattr(setting, k)
     p = d.get("pattern")
-    if p not in (MIURA, TMP):
-        errs.append(f"pattern = {p!r} must be 1 (Miura) or 2 (TMP)")
+    fam = sheet_family(p)
+    if fam is None:
+        codes = " or ".join(f"{c} ({f.label})" for c, f in SHEET_FAMILIES.items())
+        errs.append(f"pattern = {p!r} must be {codes}")
     ok_m, ok_n = not integer(d, "m", 1), not integer(d, "n", 1)
     errs += integer(d, "m", 1) + integer(d, "n", 1)
     if ok_m and ok_n and d["m"] * d["n"] > MAX_PANELS:
@@ -410,27 +391,11 @@ def check_sheet(setting: SheetSetting, row) -> list[str]:
             f"over the limit of {MAX_PANELS} (docs/limits.md)"
         )
         ok_m = ok_n = False  # no geometry checks on a sheet too large to build
-    if p == TMP and ok_m and d["m"] % 2:
-        errs.append(f"m = {d['m']:g} must be even for a TMP sheet")
-    if p == TMP and ok_n and d["n"] % 3:
-        errs.append(f"n = {d['n']:g} must be a multiple of 3 for a TMP sheet")
-    if p == TMP and ok_m and ok_n and not d["n"] % 3:
-        ext = min(setting.extensions)
-        b, a = setting.size_x / d["m"], setting.size_y / d["n"]
-        if 2 * b * math.sqrt(1 - ext**2) > a:
-            errs.append(
-                f"m = {d['m']:g}, n = {d['n']:g}: the TMP tubes overlap at Ext = {ext:g} "
-                f"(2 b sqrt(1 - Ext^2) = {2 * b * math.sqrt(1 - ext**2):.4g} m > a = {a:.4g} m)"
-            )
-    if p == MIURA:
-        g = setting.gamma if setting.gamma is not None else row.get("gama")
-        if g is None or not math.isfinite(g) or not 0 < g < math.pi / 2:
-            errs.append(f"gama = {g!r} rad must lie in (0, pi/2)")
-        elif ok_m and ok_n and not _miura_sides(setting, int(d["m"]), int(d["n"]), g)[0] > 0:
-            errs.append(
-                f"m = {d['m']:g} is too small for the Miura sheet with gamma = {g:.6g} rad: "
-                f"a = (size_y - b cot gamma)/n must be > 0 (m tan(gamma) > size_x/size_y)"
-            )
+    if fam is not None:
+        g = None
+        if fam.has_gamma:
+            g = setting.gamma if setting.gamma is not None else row.get("gama")
+        errs += fam.check(setting, d, ok_m, ok_n, g)
     return errs
 
 
@@ -485,18 +450,7 @@ def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreaseP
     extensions: the least folded modelled state), with its flat layout and M/V assignment, m."""
     ext = max(setting.extensions) if ext is None else ext
     pat, m, n, gamma = _design(setting, row)
-    if pat == MIURA:
-        a, b = _miura_sides(setting, m, n, gamma)
-        return miura_sheet(m, n, a, b, gamma, ext)
-    lx, ly = setting.size_x, setting.size_y
-    meta = {"kind": "tmp", "m": m, "n": n, "size_x": lx, "size_y": ly, "ext": ext}
-    return rigid_fold_pattern(
-        _tmp_nodes(m, n, lx, ly, ext),
-        tmp_faces(m, n),
-        _tmp_nodes(m, n, lx, ly, 1.0)[:, :2],
-        _tmp_nodes(m, n, lx, ly, 0.5),
-        meta | {"a": ly / n, "b": lx / m},
-    )
+    return SHEET_FAMILIES[pat].shape(setting, m, n, gamma, ext)
 
 
 def write_sheet_files(
@@ -536,7 +490,11 @@ def sheet_scenario(
     default to :func:`sheet_features`."""
     features = sheet_features(setting) if features is None else features
     perf = sheet_columns(setting, extras)
-    pattern = {None: "feature pattern (1 Miura-ori, 2 TMP)", MIURA: "Miura-ori", TMP: "TMP"}
+    codes = ", ".join(f"{c} {f.label}" for c, f in SHEET_FAMILIES.items())
+    pattern = {
+        None: f"feature pattern ({codes})",
+        **{c: f.label for c, f in SHEET_FAMILIES.items()},
+    }
     words = {
         "footprint (m)": f"{setting.size_x:g} x {setting.size_y:g}",
         "pattern": pattern[setting.pattern],
@@ -643,13 +601,10 @@ def _read_sheet(sec: Section) -> dict:
     out["pattern"] = None if pat is None else PATTERNS[pat]
     for k in ("m", "n"):
         out[k] = sec.number(k, low=1, high=10000, integer=True)
-    if out["pattern"] == TMP:
-        if out["gamma"] is not None:
-            raise sec.error("gamma/gamma_deg is the Miura sector angle; pattern = 'tmp' has none")
-        if out["m"] is not None and out["m"] % 2:
-            raise sec.error(f"m = {out['m']} must be even for pattern = 'tmp'")
-        if out["n"] is not None and out["n"] % 3:
-            raise sec.error(f"n = {out['n']} must be a multiple of 3 for pattern = 'tmp'")
+    if out["pattern"] is not None:
+        problem = SHEET_FAMILIES[out["pattern"]].check_setting(out)
+        if problem:
+            raise sec.error(problem)
     return out
 
 
@@ -661,10 +616,12 @@ def _check_features(doc: Section, sheet: dict, features: tuple[Column, ...]) -> 
     """Refuse feature levels that no design could use (before anything is simulated)."""
     by = {c.name: c for c in features}
     pats = (sheet["pattern"],) if sheet["pattern"] is not None else _values(by["pattern"])
-    if not set(pats) <= {MIURA, TMP}:
+    if not set(pats) <= set(SHEET_FAMILIES):
+        codes = ", ".join(f"{c} ({f.label})" for c, f in SHEET_FAMILIES.items())
+        names = " | ".join(f"'{f.name}'" for f in SHEET_FAMILIES.values())
         raise doc.error(
-            f"[features] pattern = {pats}: allowed: 1 (Miura-ori), 2 (TMP), or fix one with "
-            "[sheet] pattern = 'miura' | 'tmp'"
+            f"[features] pattern = {pats}: allowed: {codes}, or fix one with "
+            f"[sheet] pattern = {names}"
         )
     counts, where = {}, {}
     for k in ("m", "n"):
@@ -678,24 +635,16 @@ def _check_features(doc: Section, sheet: dict, features: tuple[Column, ...]) -> 
             f"{where['m']} = {counts['m']} x {where['n']} = {counts['n']}: the largest sheet has "
             f"{largest} panels; at most {MAX_PANELS} (docs/limits.md)"
         )
-    if TMP in pats:
-        if any(int(v) % 2 for v in counts["m"]):
-            raise doc.error(f"{where['m']} = {counts['m']}: TMP sheets (pattern 2) need even m")
-        if any(int(v) % 3 for v in counts["n"]):
-            raise doc.error(
-                f"{where['n']} = {counts['n']}: TMP sheets (pattern 2) need multiples of 3"
-            )
-    if MIURA in pats:
-        gammas = (sheet["gamma"],) if sheet["gamma"] is not None else _values(by["gama"])
-        if not all(0 < g < math.pi / 2 for g in gammas):
-            raise doc.error(f"[features] gama = {gammas} rad must lie in (0, pi/2)")
-        m, g = min(counts["m"]), min(gammas)
-        if not sheet["size_y"] * m * math.tan(g) > sheet["size_x"]:
-            raise doc.error(
-                f"{where['m']} = {m:g} with the sector angle {math.degrees(g):.6g} deg gives Miura "
-                f"panels of side a <= 0; allowed: m tan(gamma) > size_x/size_y = "
-                f"{sheet['size_x'] / sheet['size_y']:.6g}"
-            )
+    for code in sorted(SHEET_FAMILIES, reverse=True):  # TMP's parity, then Miura's angle
+        if code not in pats:
+            continue
+        fam = SHEET_FAMILIES[code]
+        gammas = ()
+        if fam.has_gamma:
+            gammas = (sheet["gamma"],) if sheet["gamma"] is not None else _values(by["gama"])
+        problem = fam.check_levels(sheet, counts, where, gammas)
+        if problem:
+            raise doc.error(problem)
 
 
 def from_config(doc: Section, name: str, description: str) -> Scenario:
@@ -712,11 +661,13 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
         if sheet[k] is not None and fsec.has(k):
             raise fsec.error(f"{k} is fixed in [sheet]; remove it there or here")
     gama_feature = fsec.has("gama")
-    if gama_feature and (sheet["gamma"] is not None or sheet["pattern"] == TMP):
-        why = "pattern = 'tmp' has no sector angle" if sheet["pattern"] == TMP else (
+    fixed = sheet_family(sheet["pattern"])
+    no_gamma = fixed is not None and not fixed.has_gamma
+    if gama_feature and (sheet["gamma"] is not None or no_gamma):
+        why = f"pattern = '{fixed.name}' has no sector angle" if no_gamma else (
             "the sector angle is fixed in [sheet]; remove it there or here")  # fmt: skip
         raise fsec.error(f"gama: {why}")
-    if sheet["gamma"] is None and not gama_feature and sheet["pattern"] != TMP:
+    if sheet["gamma"] is None and not gama_feature and not no_gamma:
         sheet["gamma"] = GAMMA_70
     setting = SheetSetting(
         size_x=sheet["size_x"],

@@ -1,4 +1,8 @@
-"""``holofold pattern``: generate a Miura or Tachi-Miura polyhedron sheet and export it.
+"""``holofold pattern KIND``: generate a crease pattern of any registered family and export it.
+
+The kinds are the pattern families of :mod:`holofold.geometry.families` (``miura``, ``tmp``,
+``gripper``, ``strip``, ``file``, and any a package adds); each kind's options are its
+parameters (``holofold pattern miura --help``).
 
 Examples::
 
@@ -6,6 +10,9 @@ Examples::
     holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --size 0.2 \\
         --thickness 0.5e-3 --crease-width 2e-3 -o out/
     holofold pattern tmp --m 6 --n 6 --size 0.2 --ext 0.6 -o out/
+    holofold pattern strip --curve half-circle:radius=2 --m 12 --offset 0.2 \\
+        --strip-width 0.02 --extrude 0.1 -o out/
+    holofold pattern gripper --kind 3 --L1 0.02 --L2 0.01 --rate 0.5 -o out/
     holofold pattern miura --m 4 --n 4 --gamma 60 --ext 0.6 --size 0.1 --printable \
         --panel-thickness 2e-3 --crease-thickness 0.6e-3 --crease-width 2e-3 -o out/
 
@@ -21,28 +28,15 @@ read). Angles in degrees here, lengths in metres.
 from __future__ import annotations
 
 import argparse
-import math
 
 from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "pattern",
-        help="generate a Miura or TMP sheet folded to an extension, and export it",
-        description=__doc__.split("\n\n")[0],
-        epilog="Lengths in metres, angles in degrees.",
-    )
-    p.add_argument("kind", choices=["miura", "tmp"], help="pattern type")
-    p.add_argument("--m", type=int, required=True, help="panels along x (TMP: even)")
-    p.add_argument("--n", type=int, required=True, help="panels along y (TMP: multiple of 3)")
-    p.add_argument("--ext", type=float, required=True, help="extension ratio in (0, 1]")
-    p.add_argument("--gamma", type=float, help="Miura sector angle, degrees in (0, 90)")
-    p.add_argument("--a", type=float, help="Miura panel side a, m")
-    p.add_argument("--b", type=float, help="Miura panel side b, m")
-    p.add_argument(
-        "--size", type=float, help="sheet size L, m (Miura: b = L/m, a = (L - b cot g)/n)"
-    )
+def _option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def _fabrication_arguments(p) -> None:
     p.add_argument(
         "--thickness", "--panel-thickness", dest="thickness", type=float,
         help="panel thickness t_p for thick.stl and printable.stl, m",
@@ -63,38 +57,41 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, help="output folder")
     add_thick_argument(p)
     add_cutter_arguments(p)
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    from holofold.geometry import pattern_families
+
+    p = subparsers.add_parser(
+        "pattern",
+        help="generate a crease pattern (miura, tmp, gripper, strip, file, ...) and export it",
+        description=__doc__.split("\n\n")[0],
+        epilog="Lengths in metres, angles in degrees.",
+    )
+    kinds = p.add_subparsers(dest="kind", metavar="KIND")
+    kinds.required = True
+    for name, fam in pattern_families().items():
+        k = kinds.add_parser(name, help=fam.description, description=fam.description,
+                             epilog="Lengths in metres, angles in degrees.")  # fmt: skip
+        for par in fam.parameters:
+            unit = par.given_in or par.unit
+            unit = "" if unit in ("-", "text") else f", {unit}"
+            kind = str if par.unit == "text" else (int if par.integer else float)
+            k.add_argument(_option(par.name), dest=f"p_{par.name}", type=kind,
+                           required=par.required, help=f"{par.description}{unit}")  # fmt: skip
+        _fabrication_arguments(k)
+        k.set_defaults(_family=name)
     return p
 
 
 def _build(args):
-    """The pattern the arguments describe (checked in the options' own terms and units)."""
-    from holofold.geometry import MAX_PANELS, ParameterError, check_range, miura_sheet, tmp_sheet
+    """The family and the pattern the arguments describe (checked in the options' terms)."""
+    from holofold.geometry import get_family
 
-    # the largest sheet the command writes (geometry.MAX_PANELS): larger ones take minutes
-    if args.m > 0 and args.n > 0 and args.m * args.n > MAX_PANELS:
-        raise ParameterError(
-            f"--m {args.m} x --n {args.n} = {args.m * args.n} panels; at most {MAX_PANELS} "
-            "(a 100 x 100 sheet takes 2 s; use the Python API for larger ones)"
-        )
-    check_range("--ext", args.ext, 0.0, 1.0, low_open=True)
-    if args.kind == "miura":
-        if args.gamma is None:
-            raise ParameterError("--gamma is required for a Miura sheet (degrees in (0, 90))")
-        check_range("--gamma", args.gamma, 0.0, 90.0, low_open=True, high_open=True)
-        if args.size is None and (args.a is None or args.b is None):
-            raise ParameterError("give --size, or both --a and --b, for a Miura sheet")
-        for name in ("a", "b", "size"):
-            v = getattr(args, name)
-            if v is not None:
-                check_range(f"--{name}", v, 0.0, None, low_open=True)
-        return miura_sheet(
-            args.m, args.n, a=args.a, b=args.b, gamma=math.radians(args.gamma), ext=args.ext,
-            size=args.size,
-        )  # fmt: skip
-    if args.size is None:
-        raise ParameterError("--size (sheet size L, m) is required for a TMP sheet")
-    check_range("--size", args.size, 0.0, None, low_open=True)
-    return tmp_sheet(args.m, args.n, args.size, args.ext)
+    fam = get_family(args._family)
+    given = {par.name: getattr(args, f"p_{par.name}", None) for par in fam.parameters}
+    values = fam.values(given, _option)
+    return fam, values, fam.build(values, _option)
 
 
 def run(args) -> int:
@@ -103,7 +100,7 @@ def run(args) -> int:
     from holofold.geometry import ParameterError, check_range, write_fabrication_set
 
     cutter = cutter_options(args)
-    pattern = _build(args)
+    fam, values, pattern = _build(args)
     check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:
         check_range("--thickness", args.thickness, 0.0, None, low_open=True)
@@ -128,8 +125,9 @@ def run(args) -> int:
         thick=args.thick,
     )
     ext = np.ptp(pattern.coords, axis=0)
+    label = fam.describe(values) if fam.describe else fam.name
     print(
-        f"{args.kind} {args.m}x{args.n} at ext {args.ext:g}: {pattern.n_vertices} vertices, "
+        f"{label}: {pattern.n_vertices} vertices, "
         f"{int(pattern.interior.sum())} creases, {pattern.n_faces} panels, extent "
         f"{ext[0]:.4g} x {ext[1]:.4g} x {ext[2]:.4g} m; wrote "
         + ", ".join(f.path.name for f in written)
