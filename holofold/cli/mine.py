@@ -23,8 +23,25 @@ _MINER_ARGS = {
     "ranking": "ranking",
     "tighten": "tighten",
     "simplify": "simplify",
+    "ccp_alpha": "ccp_alpha",
+    "criterion": "criterion",
+    "max_samples": "max_samples",
     "n_jobs": "jobs",
 }
+
+
+def _fraction_or_count(text: str):
+    """--max-samples: a fraction of the training rows (0.5, 1.0) or a count of rows (300)."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is neither a fraction of the rows (0.5) nor a number of rows (300)"
+        ) from None
 
 
 def _names(text: str | None) -> list[str] | None:
@@ -124,6 +141,27 @@ def register(subparsers) -> argparse.ArgumentParser:
         default="idle",
         help="drop conditions that do not change the rule's rows (idle, default), also those "
         "that do not raise the estimate (estimate), or none",
+    )
+    p.add_argument(
+        "--ccp-alpha",
+        type=float,
+        default=None,
+        metavar="A",
+        help="minimal cost-complexity pruning of each tree (default 1e-4, as the paper)",
+    )
+    p.add_argument(
+        "--criterion",
+        choices=("entropy", "gini", "log_loss"),
+        default=None,
+        help="split criterion of the trees (default entropy, as the paper)",
+    )
+    p.add_argument(
+        "--max-samples",
+        type=_fraction_or_count,
+        default=None,
+        metavar="R",
+        help="rows per tree, drawn without replacement: a fraction of the training rows in "
+        "(0, 1] (default 0.5, as the paper) or a number of rows",
     )
     p.add_argument("--jobs", type=int, default=None, help="threads for training")
     p.add_argument("--json", metavar="PATH", help="write the rules (best first) as JSON")
