@@ -373,20 +373,20 @@ class _KKT:
         # the damping keeps the factorisation positive definite in floating point: at least
         # 1e-11 of the largest diagonal entry, raised tenfold while Cholesky breaks down
         mu = max(mu, 1e-11 * float(ab[bw].max()))
+        ab[bw] += mu
         for _ in range(8):
-            trial = ab.copy()
-            trial[bw] += mu
-            try:
-                self.factor = sl.cholesky_banded(trial, lower=False, check_finite=False)
+            try:  # ab itself is left untouched (overwrite_ab False)
+                self.factor = sl.cholesky_banded(ab, lower=False, check_finite=False)
                 break
             except np.linalg.LinAlgError:
+                ab[bw] += 9 * mu
                 mu *= 10
         else:
             raise SurfaceFitError("the fit's linear systems are singular (the pattern degenerated)")
         self.n_factor += 1
 
     def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
-              tol: float = 1e-10) -> tuple[np.ndarray, int]:  # fmt: skip
+              tol: float = 1e-9) -> tuple[np.ndarray, int]:  # fmt: skip
         n, m = H.shape[0], Jc.shape[0]
         JcT = Jc.T.tocsr()
         cf, order, inv = self.factor, self.order, self.inv
@@ -431,11 +431,13 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
 
     def restore(X, c, Jc, steps: int):
         """Newton steps onto the constraints from X; returns X, c, Jc, steps taken, message."""
+        cm = float(np.abs(c).max())
+        if cm < CONSTRAINT_TOL:
+            return X, c, Jc, 0, ""
         ro, Jo = problem.objective(X)
         H = (Jo.T @ Jo + mu_r * eye).tocsr()
         kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
         fresh = True
-        cm = float(np.abs(c).max())
         for k in range(1, steps + 1):
             if cm < CONSTRAINT_TOL:
                 return X, c, Jc, k - 1, ""
