@@ -303,3 +303,24 @@ def test_batch_newton_step_is_each_designs_own_step(path, dense_max):
             assert j in errors
         else:
             close(dU[j], d, rtol=1e-9)
+
+
+def test_a_broken_lapack_is_one_environment_line(monkeypatch):
+    import builtins
+
+    real = builtins.__import__
+
+    def broken(name, *args, **kwargs):
+        if name == "scipy.linalg.lapack":
+            raise ImportError("libopenblas.so.0: cannot open shared object file")
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", broken)
+    with pytest.raises(kernels.EnvironmentFault, match="scipy's LAPACK cannot be loaded.*reinstall"):
+        kernels.check_environment()
+
+
+def test_an_unknown_kernel_path_is_one_environment_line(monkeypatch):
+    monkeypatch.setenv(kernels.ENV, "fortran")
+    with pytest.raises(kernels.EnvironmentFault, match="use auto, numpy or compiled"):
+        kernels.active()
