@@ -412,28 +412,34 @@ def sheet_batch_key(setting: SheetSetting, row) -> tuple[int, int, int]:
 
 @single_threaded
 def evaluate_sheet_batch(setting: SheetSetting, columns: Sequence[str], rows) -> list[dict]:
-    """:func:`evaluate_sheet` of several designs of one pattern, m and n, their Newton solves
-    run in lockstep per extension and load (:func:`secant_stiffness_batch`); each output is
-    bit for bit the design's own."""
+    """:func:`evaluate_sheet` of several designs of one pattern, m and n: the models of every
+    design and extension that share a support mask are solved together, per load
+    (:func:`secant_stiffness_batch`); each output is the design's own."""
     models = sheet_models_batch(setting, rows)
     outs: list = [{} for _ in rows]
-    cases: list = [{} for _ in rows]
-    for e, ext in enumerate(setting.extensions):
-        tag = extension_tag(ext)
-        structures = [mod[e][0] for mod in models]
+    # each design's cases in the order its status lists them: by extension, then load
+    labels = [f"{ld.name} Ext {ext}" for ext in setting.extensions for ld in setting.loads]
+    cases: list = [dict.fromkeys(labels) for _ in rows]
+    together: dict = {}  # support mask -> the (design, extension) models that share it
+    for i, mod in enumerate(models):
+        for e in range(len(setting.extensions)):
+            together.setdefault(mod[e][0].supports.tobytes(), []).append((i, e))
+    for items in together.values():
+        structures = [models[i][e][0] for i, e in items]
         batch = BatchAssembler(structures)  # one pattern and reduction for every load case
         for k, ld in enumerate(setting.loads):
             runs = secant_stiffness_batch(
                 structures,
-                [mod[e][1][k] for mod in models],
+                [models[i][e][1][k] for i, e in items],
                 force_per_increment=ld.force / ld.increments,
                 increments=ld.increments,
                 tol=setting.tol,
                 max_iter=setting.max_iter,
                 batch=batch,
             )
-            for i, r in enumerate(runs):
-                outs[i][f"{ld.name}stiff{tag}"] = r.stiffness
+            for (i, e), r in zip(items, runs, strict=True):
+                ext = setting.extensions[e]
+                outs[i][f"{ld.name}stiff{extension_tag(ext)}"] = r.stiffness
                 cases[i][f"{ld.name} Ext {ext}"] = r.result.status
     result = []
     for row, out, case in zip(rows, outs, cases, strict=True):
