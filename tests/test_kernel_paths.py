@@ -316,7 +316,9 @@ def test_a_broken_lapack_is_one_environment_line(monkeypatch):
         return real(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", broken)
-    with pytest.raises(kernels.EnvironmentFault, match="scipy's LAPACK cannot be loaded.*reinstall"):
+    with pytest.raises(
+        kernels.EnvironmentFault, match="scipy's LAPACK cannot be loaded.*reinstall"
+    ):
         kernels.check_environment()
 
 
