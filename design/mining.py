@@ -25,6 +25,7 @@ from holofold.design.evaluation import (
 )
 from holofold.design.row_status import failed_rows
 from holofold.design.rules import ForestRuleMiner
+from holofold.design.rules.params import check_params
 from holofold.design.tables import ColumnRoles
 from holofold.design.targets import Target, parse_target
 
@@ -276,7 +277,7 @@ def mine_rules(
     tgt = target if isinstance(target, Target) else parse_target(target, columns=columns)
     feats, cats = select_features(columns, tgt, roles, features, categorical, source=source)
     miner = ForestRuleMiner(categorical_features=list(cats) or None, random_state=seed, **params)
-    miner._validate_params()  # an invalid parameter is refused before any work
+    check_params(miner)  # an invalid parameter is refused before any work
     y = tgt.evaluate(table)
     n_hit = int(y.sum())
     if n_hit == 0 or n_hit == y.size:

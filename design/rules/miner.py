@@ -17,24 +17,12 @@ from sklearn.utils import check_random_state
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from holofold.design.rules.boxes import (
-    boxes_contain,
-    drop_idle_conditions,
-    simplify_boxes,
-    tighten,
-)
+from holofold.design.rules.boxes import boxes_contain
 from holofold.design.rules.encoding import Encoding, RankCodes
-from holofold.design.rules.forest import forest_apply, forest_boxes, stack_trees, tree_arrays
+from holofold.design.rules.forest import forest_apply, stack_trees, tree_arrays
 from holofold.design.rules.params import check_params
-from holofold.design.rules.statistics import (
-    box_counts,
-    box_stats,
-    fbeta,
-    finder_matrix,
-    fit_prior,
-    posterior,
-    wilson_lower,
-)
+from holofold.design.rules.selection import Settings, select_rules
+from holofold.design.rules.statistics import posterior
 from holofold.design.rules.text import box_text
 
 __all__ = ["ForestRuleMiner", "FewRulesWarning", "SELECTION_PARAMS"]
@@ -42,7 +30,6 @@ __all__ = ["ForestRuleMiner", "FewRulesWarning", "SELECTION_PARAMS"]
 logger = logging.getLogger(__name__)
 
 _MAX_SEED = np.iinfo(np.int32).max
-LCB_Z = 1.6448536269514722  # one-sided 95 % normal quantile for the Wilson bound
 #: column order of the statistics in ``rules_``
 STAT_ORDER = (
     "precision", "recall", "support", "true_positives", "estimate", "estimate_low",
@@ -348,10 +335,6 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
 
     # -- fitting ---------------------------------------------------------------------------
 
-    def _validate_params(self) -> None:
-        """Refuse an invalid parameter value in one line (:func:`.params.check_params`)."""
-        check_params(self)
-
     def fit(self, X, y, feature_names=None):
         """Train the forest and mine the rules.
 
@@ -368,7 +351,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
         -------
         self
         """
-        self._validate_params()
+        check_params(self)
         X, y = self._validate_X(X, y=y, reset=True)
         check_classification_targets(y)
         self.classes_, y_codes = np.unique(y, return_inverse=True)
@@ -470,211 +453,21 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
 
     def _mine(self, Z: np.ndarray, y_pos: np.ndarray, n_trees: int) -> None:
         """Rules from the first ``n_trees`` trees, on the training rows ``Z`` (the table's
-        units, encoded) with target indicator ``y_pos``."""
-        forest = stack_trees(self.trees_[:n_trees])
-        lower, upper = forest_boxes(forest, Z.shape[1])
-        n, T = Z.shape[0], forest.n_trees
-        leaves = forest_apply(forest, Z)
-        N = forest.left.shape[0]
-        support = np.bincount(leaves.ravel(), minlength=N)
-
-        cand = np.flatnonzero(forest.is_leaf & forest.positive & (support > 0))
-        keys = np.concatenate([lower[cand], upper[cand]], axis=1)
-        if cand.size:
-            _, first, inverse, counts = np.unique(
-                keys, axis=0, return_index=True, return_inverse=True, return_counts=True
-            )
-            inverse = inverse.ravel()
-            uniq = cand[first]
-        else:
-            uniq = cand
-            inverse = np.zeros(0, dtype=np.intp)
-            counts = np.zeros(0, dtype=np.intp)
-        self.n_candidates_ = int(uniq.size)
-        m = uniq.size
-        n_pos = max(int(y_pos.sum()), 1)
-        lo_u, up_u = lower[uniq], upper[uniq]
-
-        # every (row, tree) pair whose row lies in one of the tree's candidate leaves, with the
-        # box it stands for and whether the tree trained on the row (in bag) or not (out of bag)
-        in_bag = np.zeros((n, T), dtype=bool)
-        for k, rows in enumerate(self.estimators_samples_[:T]):
-            in_bag[rows, k] = True
-        node_box = np.full(N, -1, dtype=np.intp)
-        node_box[cand] = inverse
-        box_of = node_box[leaves]
-        pair_row, pair_tree = np.nonzero(box_of >= 0)
-        pair_box = box_of[pair_row, pair_tree]
-        pair_bag = in_bag[pair_row, pair_tree]
-        c = box_counts(pair_box, pair_row, pair_bag, y_pos, m, n)
-        sup, tpu = c["support"], c["true_positives"]
-        prec = np.where(sup > 0, tpu / np.maximum(sup, 1), 0.0)
-        rec = tpu / n_pos
-        enough = (sup >= self.min_support) & (rec >= self.recall_min)
-        o_n, o_tp = c["estimate_support"], c["estimate_true_positives"]
-        b_n, b_tp = c["bag_support"], c["bag_true_positives"]
-        pooled_n, pooled_tp = c["oob_support"], c["oob_true_positives"]
-        # candidates are filtered on the training rows (the paper); the prior of the estimate is
-        # fitted to the leaves that pass the filter on the rows their trees trained on, a
-        # population chosen without looking at the out-of-bag rows
-        in_bag_ok = enough & (b_tp >= self.precision_min * np.maximum(b_n, 1))
-        keep = enough & (prec >= self.precision_min)
-
-        base_rate = float(y_pos.mean()) if n else 0.0
-        prior = fit_prior(self.prior_strength, o_tp[in_bag_ok], o_n[in_bag_ok], base_rate)
-        self.prior_ = {"mean": prior[0], "strength": prior[1], "base_rate": base_rate}
-        stats = {
-            "precision": prec,
-            "recall": rec,
-            "support": sup,
-            "true_positives": tpu,
-            "n_trees": counts.astype(np.intp),
-            "oob_precision": np.where(pooled_n > 0, pooled_tp / np.maximum(pooled_n, 1), 0.0),
-            "oob_support": pooled_n,
-            "estimate_true_positives": o_tp,
-            "estimate_support": o_n,
-            "bag_true_positives": b_tp,
-            "bag_support": b_n,
-            "_box": np.arange(m),
-        }
-        idx = np.flatnonzero(keep)
-        lo_all, up_all = lo_u[idx], up_u[idx]
-        stats = {key: v[idx] for key, v in stats.items()}
-        self._score(stats, n_pos)
-        order = np.lexsort((np.arange(idx.size), -stats["support"], -stats["score"]))
-        lo_all, up_all = lo_all[order], up_all[order]
-        stats = {key: v[order] for key, v in stats.items()}
-
-        finders = finder_matrix(inverse, forest.tree_of[cand], m, T)  # (m, T) 0/1
-        if self.simplify == "estimate" and idx.size:
-            top = min(idx.size, max(8 * self.n_rules, 32))
-            f_top = finders[stats["_box"][:top]]
-            weight = f_top @ (~in_bag).T.astype(float)  # (top, n) out-of-bag pairs per row
-            new_lo, new_up = simplify_boxes(
-                lo_all[:top], up_all[:top], Z, y_pos, weight, prior, self.precision_min
-            )
-            simplified = box_stats(new_lo, new_up, Z, y_pos, weight, f_top @ in_bag.T > 0)
-            simplified["n_trees"] = stats["n_trees"][:top]
-            simplified["_box"] = stats["_box"][:top]
-            self._score(simplified, n_pos)
-            lo_all = np.concatenate([new_lo, lo_all[top:]])
-            up_all = np.concatenate([new_up, up_all[top:]])
-            stats = {key: np.concatenate([simplified[key], v[top:]]) for key, v in stats.items()}
-            order = np.lexsort((np.arange(len(lo_all)), -stats["support"], -stats["score"]))
-            lo_all, up_all = lo_all[order], up_all[order]
-            stats = {key: v[order] for key, v in stats.items()}
-        if self.simplify == "estimate" and len(lo_all):
-            # boxes made identical by simplification: the best ranked one stays
-            _, first = np.unique(
-                np.concatenate([lo_all, up_all], axis=1), axis=0, return_index=True
-            )
-            first = np.sort(first)
-            lo_all, up_all = lo_all[first], up_all[first]
-            stats = {key: v[first] for key, v in stats.items()}
-
-        for key in ("support", "true_positives", "oob_support", "estimate_support", "bag_support"):
-            stats[key] = stats[key].astype(np.intp)
-        self._all_lower, self._all_upper, self._all_stats = lo_all, up_all, stats
+        units, encoded) with target indicator ``y_pos`` (:func:`.selection.select_rules`)."""
+        enc = self._encoding
+        numeric = np.array([not enc.categorical[j] for j, _ in enc.columns])
+        sel = select_rules(self.trees_[:n_trees], self.estimators_samples_, Z, y_pos, numeric,
+                           Settings.of(self))  # fmt: skip
+        self.n_candidates_ = sel.n_candidates
+        self.prior_ = sel.prior
+        self._all_lower, self._all_upper = sel.all_lower, sel.all_upper
+        self._all_stats = sel.all_stats
         self._candidate_frame = None
-        k = self.n_rules
-        numeric = np.array([not self._encoding.categorical[j] for j, _ in self._encoding.columns])
-
-        def shape(lo, up):  # what a kept rule becomes: tightened to its target rows, or as is
-            return tighten(lo, up, Z, y_pos, numeric) if self.tighten else (lo, up)
-
-        pick, self._lower, self._upper = self._pick(Z, k, shape)
-        kept = {key: v[pick] for key, v in self._all_stats.items()}
-        if self.tighten and len(pick):
-            f_kept = finders[kept["_box"]]
-            weight = f_kept @ (~in_bag).T.astype(float)
-            new = box_stats(self._lower, self._upper, Z, y_pos, weight, f_kept @ in_bag.T > 0)
-            kept.update(new)
-            self._score(kept, n_pos)
-            for key in (
-                "support",
-                "true_positives",
-                "oob_support",
-                "estimate_support",
-                "bag_support",
-            ):
-                kept[key] = kept[key].astype(np.intp)
-        if self.simplify != "none":
-            self._lower, self._upper = drop_idle_conditions(self._lower, self._upper, Z)
-        kept.pop("_box")
-        self.rules_ = self._rules_frame(self._lower, self._upper, kept)
-        if len(self.rules_) < k:
-            n_pass = len(self._all_lower)
-            msg = (
-                f"only {len(self.rules_)} of the {k} requested rules: {n_pass} reach precision "
-                f">= {self.precision_min} with support >= {self.min_support} "
-                f"({self.n_candidates_} distinct candidate boxes)"
-            )
-            if n_pass > len(self.rules_):
-                msg += (
-                    f"; the others copy a kept rule (overlap > {self.max_overlap})"
-                    if self.max_overlap is not None
-                    else "; the others are copies of a kept rule"
-                )
-            logger.info(msg)
-            warnings.warn(msg, FewRulesWarning, stacklevel=3)
-
-    def _score(self, stats: dict, n_pos: int) -> None:
-        """Add the estimate (mean and interval), ``f_score`` and the ranking ``score``."""
-        mu, k = self.prior_["mean"], self.prior_["strength"]
-        est, lo, hi, lcb = posterior(
-            stats["estimate_true_positives"], stats["estimate_support"], mu, k
-        )
-        stats["estimate"], stats["estimate_low"], stats["estimate_high"] = est, lo, hi
-        if self.scoring == "train":
-            p, n = stats["precision"], stats["support"]
-        elif self.scoring == "oob":
-            p, n = stats["oob_precision"], stats["oob_support"]
-        if self.scoring == "estimate":
-            p_rank = est if self.ranking == "fbeta" else lcb
-        else:
-            p_rank = p if self.ranking == "fbeta" else wilson_lower(p * n, n)
-        stats["f_score"] = fbeta(stats["precision"], stats["recall"], self.beta)
-        stats["score"] = fbeta(p_rank, stats["recall"], self.beta)
-
-    def _pick(self, Z: np.ndarray, k: int, shape):
-        """The rules to keep: positions in the ranking and their (shaped) boxes.
-
-        Walking down the ranking, each candidate is shaped (``shape(lower, upper)``, e.g.
-        tightened) and kept unless it equals a kept box or, with ``max_overlap``, the training
-        rows it covers overlap those of a kept rule by a Jaccard index above ``max_overlap``.
-        """
-        n = len(self._all_lower)
-        kept: list[int] = []
-        boxes: list[tuple[np.ndarray, np.ndarray]] = []
-        covered: list[np.ndarray] = []
-        block = 4 * k if self.max_overlap is None else 256
-        for start in range(0, n, block):  # a block of candidates at a time
-            lo, up = shape(
-                self._all_lower[start : start + block], self._all_upper[start : start + block]
-            )
-            rows_of = boxes_contain(lo, up, Z) if self.max_overlap is not None else None
-            for j in range(lo.shape[0]):
-                if any(np.array_equal(lo[j], a) and np.array_equal(up[j], b) for a, b in boxes):
-                    continue
-                if rows_of is not None:
-                    rows = rows_of[j]
-                    inter = [np.count_nonzero(rows & c) for c in covered]
-                    union = [np.count_nonzero(rows | c) for c in covered]
-                    if any(
-                        i > self.max_overlap * max(u, 1) for i, u in zip(inter, union, strict=True)
-                    ):
-                        continue
-                    covered.append(rows)
-                kept.append(start + j)
-                boxes.append((lo[j], up[j]))
-                if len(kept) == k:
-                    break
-            if len(kept) == k:
-                break
-        d = self._all_lower.shape[1]
-        lower = np.array([a for a, _ in boxes]).reshape(-1, d)
-        upper = np.array([b for _, b in boxes]).reshape(-1, d)
-        return np.asarray(kept, dtype=np.intp), lower, upper
+        self._lower, self._upper = sel.lower, sel.upper
+        self.rules_ = self._rules_frame(sel.lower, sel.upper, sel.kept)
+        if sel.short is not None:
+            logger.info(sel.short)
+            warnings.warn(sel.short, FewRulesWarning, stacklevel=3)
 
     @property
     def candidate_rules_(self) -> pd.DataFrame:
@@ -806,7 +599,7 @@ class ForestRuleMiner(ClassifierMixin, BaseEstimator):
     def _copy_with(self, **params) -> ForestRuleMiner:
         """An unfitted-parameter copy with ``params`` set, sharing this one's fitted state."""
         new = self.__class__(**{**self.get_params(), **params})
-        new._validate_params()
+        check_params(new)
         for key, val in self.__dict__.items():
             if key.endswith("_") and not key.startswith("__") or key in self._STATE:
                 setattr(new, key, val)
