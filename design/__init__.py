@@ -19,6 +19,19 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "demo": ["run_demo", "DEMO_TARGET"],
         "folder_lock": ["folder_lock", "FolderBusyError"],
         "loop": ["run_design", "DesignOutcome", "refine_designs", "choose_design"],
+        "objective": ["Objective", "parse_objective"],
+        "choice": ["choose", "Answer", "Candidate", "OVERLAP_TOLERANCE"],
+        "rounds": ["Round", "VerifiedRule", "Counts", "RULE_QUALIFIES"],
+        "summary": ["DesignSummary", "Pick", "Timings"],
+        "describe": [
+            "Distribution",
+            "distributions",
+            "distributions_text",
+            "describe_source",
+            "PILOT",
+        ],
+        "buildability": ["Bed", "DEFAULT_BED", "PartFit", "PrintablePart", "parse_bed", "part_fit"],
+        "batches": ["batch_spans"],
         "evaluation": [
             "holdout",
             "repeated_holdout",
@@ -115,6 +128,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "rule_mask",
             "rule_ranges",
             "as_rule",
+            "rule_key",
         ],
     },
 )

@@ -1,37 +1,52 @@
-"""The design loop: from a scenario and a target to one chosen, verified design and its files.
+"""The design loop: from a scenario and a target to the best design found, its files and report.
 
 :func:`run_design` is what ``holofold design`` runs (docs/scenarios.md §9):
 
-1. **database**: sample designs of the scenario and simulate them (resumable Parquet batches);
+1. **database**: sample designs of the scenario and simulate them (resumable Parquet batches),
+   a small **pilot** batch first: when no pilot design meets the target and one of its
+   conditions is met by none of them, the run stops there and says what the designs reach;
 2. **mine**: rules for the target (random forest), keeping distinct alternatives;
 3. **verify**: simulate fresh designs inside each top rule (95 % Wilson interval);
 4. **refine** (``rounds`` times): sample new designs inside and around the best rules, add them
    (and the verification designs) to the database, re-mine and re-verify;
-5. **choose**: among the simulated designs inside the best verified rule that meet the target,
-   the one with the largest worst-case margin to the target's thresholds (each normalised by
-   its threshold);
-6. **files**: ``design.json``, the design's fabrication files, pictures and ``report.html``.
+5. **choose** (:mod:`~holofold.design.choice`): from every simulated design, the best under the
+   designer's objective inside the best verified rule of all rounds; without a qualifying rule
+   the best design meeting the target; without one, the nearest, with its shortfall. A design
+   whose thick panels overlap is not chosen unless ``allow_overlap``. Always an answer;
+6. **files**: ``design.json``, the design's fabrication files, its fit on the printer's bed,
+   pictures, a 3D view and ``report.html``.
 
 Every simulation lands in a resumable database folder, so running the same call again
 continues where it stopped and recomputes only the cheap stages (mining, choosing, files).
+A larger ``samples``, ``rounds`` or ``verify`` extends the folder: the base sample and each
+rule's verification grow by a batch; refinement and verification folders are named by the
+rules they come from (a changed rule gets its own), and every design simulated in the folder
+by an earlier run stays a candidate.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
-import re
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from holofold.design.batches import grow
+from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed, part_fit
+from holofold.design.choice import Candidate, choose
+from holofold.design.describe import PILOT, distributions
 from holofold.design.folder_lock import locks_folder
 from holofold.design.mining import mine_rules
+from holofold.design.objective import Objective, parse_objective
+from holofold.design.rounds import Round, VerifiedRule
 from holofold.design.row_status import converged_rows, failed_rows
 from holofold.design.rulefile import mined_rules, write_rules
 from holofold.design.rules import Condition, FewRulesWarning, Rule
@@ -39,16 +54,14 @@ from holofold.design.runner import check_workers
 from holofold.design.sampling import MAX_SAMPLES, sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.store import build_database, load_database
+from holofold.design.summary import STAGES, DesignSummary, Pick, Timings
 from holofold.design.tables import ColumnRoles, write_table
 from holofold.design.targets import parse_target
-from holofold.design.verify import Verification, as_rule, rule_ranges
+from holofold.design.verify import as_rule, rule_key, rule_ranges, verify_rules
 from holofold.geometry.outputs import write_json
 from holofold.geometry.units import length_factor
 
 __all__ = ["run_design", "DesignOutcome", "refine_designs", "choose_design", "STAGES"]
-
-STAGES = ("database", "mine", "verify", "refine", "choose", "files")
-_BASE = re.compile(r"base-(\d{6})-(\d{6})$")
 
 
 @dataclass(frozen=True)
@@ -57,17 +70,22 @@ class DesignOutcome:
 
     Attributes
     ----------
-    summary : dict
-        The content of ``design.json`` (plus rounds, files, timings).
+    record : DesignSummary
+        The typed summary (``summary`` is its JSON, the content of ``design.json``).
     table : DataFrame
-        Every simulated design (database, refinement and verification rows) with ``origin``.
+        Every simulated design (database, refinement, verification and earlier rows) with
+        ``origin``.
     folder : Path
         The output folder.
     """
 
-    summary: dict
+    record: DesignSummary
     table: pd.DataFrame
     folder: Path
+
+    @property
+    def summary(self) -> dict:
+        return self.record.to_json()
 
     @property
     def features(self) -> dict:
@@ -76,6 +94,11 @@ class DesignOutcome:
     @property
     def performance(self) -> dict:
         return self.summary["performance"]
+
+    @property
+    def met(self) -> bool:
+        """The chosen design meets the target."""
+        return self.record.chosen is not None and self.record.chosen.meets
 
 
 # ---------------------------------------------------------------------- sampling
@@ -122,19 +145,29 @@ def refine_designs(
 
 # ---------------------------------------------------------------------- choosing
 def choose_design(
-    table: pd.DataFrame, target, rule: Rule | Mapping | None
+    table: pd.DataFrame,
+    target,
+    rule: Rule | Mapping | None,
+    objective: Objective | None = None,
 ) -> tuple[int | None, dict, str]:
-    """The row of ``table`` to build: inside ``rule``, meeting ``target``, largest margin.
+    """The row of ``table`` to build inside ``rule`` (None: anywhere) that meets ``target``,
+    best under ``objective`` (default: the largest worst-case margin).
 
     Returns (index label or None, per-condition margins of that row, how it was chosen).
     Converged rows are preferred; without one inside the box, every row meeting the target
-    is considered (and the returned text says so).
+    is considered (and the returned text says so). The loop itself chooses with
+    :func:`holofold.design.choice.choose`, which also weighs the rules of every round and
+    whether the design can be built.
     """
-    ok = ~failed_rows(table)
-    conv = converged_rows(table)
-    meets = np.zeros(len(table), bool)
-    meets[ok] = target.evaluate(table.loc[ok])
-    inside = as_rule(rule).mask(table) if rule is not None else np.ones(len(table), bool)
+    obj = objective or parse_objective(None, ())
+    ok = pd.Series(~failed_rows(table), index=table.index)
+    conv = pd.Series(converged_rows(table), index=table.index)
+    meets = pd.Series(False, index=table.index)
+    if ok.any():
+        meets.loc[ok] = target.evaluate(table.loc[ok])
+    inside = pd.Series(True, index=table.index)
+    if rule is not None:
+        inside[:] = as_rule(rule).mask(table)
     how = "inside the best verified rule"
     for pool, text in (
         (inside & meets & conv, how),
@@ -142,15 +175,10 @@ def choose_design(
         (meets & conv, "among all simulated designs (none inside the rule meets the target)"),
     ):
         if pool.any():
-            how = text
-            break
-    else:
-        return None, {}, "no simulated design meets the target"
-    cand = table.loc[pool]
-    worst = target.margin(cand)
-    label = cand.index[int(np.argmax(worst))]
-    margins = {k: float(v[0]) for k, v in target.margins(table.loc[[label]]).items()}
-    return label, margins, how
+            label = obj.best(table.loc[pool], target)
+            margins = {k: float(v[0]) for k, v in target.margins(table.loc[[label]]).items()}
+            return label, margins, text
+    return None, {}, "no simulated design meets the target"
 
 
 # ---------------------------------------------------------------------- the loop
@@ -170,8 +198,6 @@ def _given_database(db: Path, sc: Scenario) -> pd.DataFrame | None:
     meta = db / "meta.json"
     if not meta.is_file():
         return None
-    import json
-
     try:
         info = json.loads(meta.read_text(encoding="utf-8"))
         name = info["scenario"]
@@ -186,41 +212,7 @@ def _given_database(db: Path, sc: Scenario) -> pd.DataFrame | None:
     return table
 
 
-def _base_batches(db: Path, n: int, covered: int = 0) -> list[tuple[int, int]]:
-    """Row spans [start, stop) of the base sample from ``covered`` on: the existing batches,
-    then what is missing."""
-    spans = sorted(
-        (int(m[1]), int(m[2]))
-        for p in (db.iterdir() if db.is_dir() else ())
-        if (m := _BASE.match(p.name))
-    )
-    out = []
-    for a, b in spans:
-        if a == covered and covered < n:
-            out.append((a, b))
-            covered = b
-    if covered < n:
-        out.append((covered, n))
-    return out
-
-
-def _simulate(scenario, designs, folder, workers, progress) -> pd.DataFrame:
-    # sampled designs the scenario's check refuses are failed rows, not a refused run
-    return build_database(
-        scenario, designs, folder, workers=workers, progress=progress, on_invalid="skip"
-    )
-
-
-def _verify(scenario, rules, target, n, folder, seed, workers, progress):
-    out = []
-    for i, r in enumerate(rules, start=1):
-        designs = sample_designs(scenario, n, seed=seed + i, ranges=rule_ranges(scenario, r))
-        res = _simulate(scenario, designs, folder / f"rule{i}", workers, progress)
-        out.append(Verification.of(res, target))
-    return out
-
-
-def _box_of(sc: Scenario, hits: pd.DataFrame, roles: ColumnRoles) -> Rule:
+def _box_of(hits: pd.DataFrame, roles: ColumnRoles) -> Rule:
     """A pseudo-rule: the box spanned by the designs that meet the target (to refine around)."""
     conds = []
     for name in roles.features:
@@ -228,45 +220,17 @@ def _box_of(sc: Scenario, hits: pd.DataFrame, roles: ColumnRoles) -> Rule:
         if name in roles.categorical:
             conds.append(Condition(name, levels=tuple(col.tolist())))
         elif col.max() > col.min():
-            conds.append(Condition(name, gt=float(np.nextafter(col.min(), -np.inf)),
-                                   le=float(col.max())))  # fmt: skip
+            conds.append(
+                Condition(name, gt=float(np.nextafter(col.min(), -np.inf)), le=float(col.max()))
+            )
     return Rule(tuple(conds), rank=0)
 
 
-def _rule_entry(rule: Rule, v: Verification | None, columns: Mapping) -> dict:
-    rec = rule.to_json(columns)
-    e = {k: rec[k] for k in ("rank", "rule", "bounds", "display")}
-    e |= {
-        "train_precision": None if rule.train is None else rule.train.precision,
-        "test_precision": None if rule.test is None else rule.test.precision,
-        "test_support": None if rule.test is None else rule.test.support,
-    }
-    if rule.estimate is not None:
-        est = rec["estimate"]
-        e |= {
-            "estimate": est["precision"],
-            "estimate_95ci": est["interval"],
-            "estimate_rows": est["rows"],
-        }
-    if v is not None:
-        s = v.summary()
-        e |= {
-            "verified_precision": s["precision"],
-            "verified_95ci": s["precision_95ci"],
-            "verified_n": s["simulated"],
-            "verified_failed": s["failed"],
-        }
-    return {k: (None if isinstance(x, float) and not math.isfinite(x) else x) for k, x in e.items()}
+def _key(*parts) -> str:
+    """8 hex digits naming what a refinement's designs come from (its rules, size and seed)."""
+    import hashlib
 
-
-def _pick_rule(entries: list[dict]) -> int:
-    def key(i):
-        e = entries[i]
-        vp = e.get("verified_precision")
-        lo = (e.get("verified_95ci") or [-1, -1])[0]
-        return (-1 if vp is None else vp, lo, e.get("test_precision") or 0.0)
-
-    return max(range(len(entries)), key=key)
+    return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()[:8]
 
 
 def _fmt(p) -> str:
@@ -279,6 +243,107 @@ def _clean(v):
     if isinstance(v, float) and not math.isfinite(v):
         return None
     return v
+
+
+def _pilot_verdict(rows: pd.DataFrame, tgt) -> tuple[int, list[str], str | None]:
+    """(designs meeting the target, conditions met by none, why to stop or None)."""
+    ok = rows.loc[~failed_rows(rows)]
+    if not len(ok):
+        return 0, [], f"every one of the {len(rows)} pilot simulations failed"
+    hits = int(tgt.evaluate(ok).sum())
+    if hits:
+        return hits, [], None
+    margins = tgt.margins(ok)
+    unmet = [c for c, m in margins.items() if not (np.nan_to_num(m, nan=-np.inf) >= 0).any()]
+    if unmet:
+        return 0, unmet, (f"no pilot design meets {' nor '.join(unmet)}")
+    if not tgt.conjunctive:
+        return 0, [], f"no pilot design meets the target {str(tgt)!r}"
+    return 0, [], None  # each condition met by some, jointly by none: a rare target, go on
+
+
+def _buildable_target(sc: Scenario, tgt, table: pd.DataFrame):
+    """The target with ``overlap <= OVERLAP_TOLERANCE``, when the kind computes the overlap
+    (a column of NaN, as a pattern scenario without collisions gives, says nothing)."""
+    from holofold.design.choice import OVERLAP_TOLERANCE
+
+    ok = table.loc[~failed_rows(table)]
+    if not np.isfinite(ok["overlap"].to_numpy(dtype=float)).any():
+        return tgt
+    return parse_target(f"({tgt}) & overlap <= {OVERLAP_TOLERANCE:g}", sc.performance_names)
+
+
+def _stored_rows(folder: Path, prefix: str, covered: int) -> int:
+    """Rows already simulated in the batches ``{prefix}a-b`` that continue from ``covered``."""
+    from holofold.design.batches import batch_spans
+
+    spans = batch_spans(folder, 10**9, prefix, covered)[:-1]  # the last span is the missing one
+    done = [
+        (a, b)
+        for a, b in spans
+        if (folder / f"{prefix}{a:06d}-{b:06d}" / "database.parquet").is_file()
+    ]
+    return sum(b - a for a, b in done)
+
+
+def _on_disk(stored: int, wanted: int) -> str:
+    """`` (on disk: N)`` when a batch on disk already holds some of the rows asked for."""
+    k = max(0, min(stored, wanted))
+    return "" if k == 0 else f" ({k} already simulated, read from disk)"
+
+
+class _Ledger:
+    """``runs.json``: seconds per stage of every invocation on the folder (resumed runs add)."""
+
+    def __init__(self, out: Path):
+        self.path = out / "runs.json"
+        try:
+            runs = json.loads(self.path.read_text(encoding="utf-8"))
+            self.runs = [
+                r for r in runs if isinstance(r, dict) and isinstance(r.get("stages"), dict)
+            ]
+        except (OSError, ValueError, TypeError):
+            self.runs = []
+
+    def timings(self, this: dict) -> Timings:
+        total = dict.fromkeys(STAGES, 0.0)
+        for r in self.runs:
+            for k, v in r["stages"].items():
+                if k in total and isinstance(v, (int, float)) and v >= 0:
+                    total[k] += float(v)
+        for k, v in this.items():
+            total[k] += v
+        return Timings(dict(this), total, len(self.runs) + 1)
+
+    def append(self, this: dict) -> None:
+        stamp = datetime.now(UTC).isoformat(timespec="seconds")
+        write_json(
+            self.path,
+            [*self.runs, {"started": stamp, "stages": {k: round(v, 3) for k, v in this.items()}}],
+        )
+
+
+def _earlier_rows(sc: Scenario, roots: Sequence[Path], used: set) -> pd.DataFrame | None:
+    """Rows simulated in this folder by earlier runs that this run did not read (a refinement
+    of rules that have since changed, a larger sample asked before): still candidates."""
+    parts = []
+    for root in roots:
+        if not root.is_dir():
+            continue
+        for d in sorted(root.rglob("designs.parquet")):
+            folder = d.parent
+            if folder.resolve() in used:
+                continue
+            try:
+                info = json.loads((folder / "meta.json").read_text(encoding="utf-8"))
+                if info.get("scenario") != sc.name:
+                    continue
+                rows = load_database(folder)
+            except (OSError, ValueError, KeyError, TypeError, AttributeError):
+                continue
+            if all(c in rows for c in (*sc.required_features, *sc.performance_names, "status")):
+                parts.append(rows.assign(origin=f"earlier: {folder.relative_to(root.parent)}"))
+    return pd.concat(parts, ignore_index=True) if parts else None
 
 
 @locks_folder("folder")  # one run per design folder (its databases are locked on their own)
@@ -299,9 +364,13 @@ def run_design(
     files: bool = True,
     mesh_units: str = "mm",
     cutter=None,
+    objective: str | Objective | None = None,
+    allow_overlap: bool = False,
+    bed: str | Bed | tuple = DEFAULT_BED,
+    pilot: int = PILOT,
     say: Callable[[str], None] = lambda text: None,
 ) -> DesignOutcome:
-    """Run the design loop (module docstring) into ``folder``; resumable.
+    """Run the design loop (module docstring) into ``folder``; resumable and extendable.
 
     Parameters
     ----------
@@ -335,14 +404,32 @@ def run_design(
     cutter : CutterOptions, optional
         How the SVG and DXF of the flat pattern are drawn (a
         :class:`~holofold.geometry.CutterOptions`; default Origami Simulator's convention).
+    objective : str or Objective, optional
+        ``"margin"`` (default: the largest worst-case margin to the target), ``"min COLUMN"``
+        or ``"max COLUMN"`` (any performance or feature column).
+    allow_overlap : bool
+        Let a design whose thick panels overlap be chosen (never by default).
+    bed : "WxD" in mm, Bed or (x, y) in m
+        The printer's bed the part's fit is judged on (default 250 x 210 mm).
+    pilot : int
+        Designs simulated first (0: no pilot); the run stops after them, with the columns'
+        distributions, when none meets the target and a condition is met by none.
     say : callable
         Receives one line of progress per stage.
     """
     sc = load_scenario(scenario)
     tgt = parse_target(target, sc.performance_names)
-    for name, v, low in (("samples", samples, 20), ("rounds", rounds, 0), ("verify", verify, 1),
-                         ("top", top, 1), ("refine", refine, 1 if rounds else 0)):  # fmt: skip
-        if int(v) != v or v < low:
+    obj = parse_objective(objective, [*sc.performance_names, *sc.feature_names])
+    bed = parse_bed(bed)
+    for name, v, low in (
+        ("samples", samples, 20),
+        ("rounds", rounds, 0),
+        ("verify", verify, 1),
+        ("top", top, 1),
+        ("refine", refine, 1 if rounds else 0),
+        ("pilot", pilot, 0),
+    ):
+        if isinstance(v, bool) or int(v) != v or v < low:
             raise ValueError(f"{name} = {v!r} must be an integer >= {low}")
     total = samples + rounds * refine + (rounds + 1) * top * verify
     if total > MAX_SAMPLES:
@@ -355,154 +442,166 @@ def run_design(
     out = Path(folder)
     dbf = Path(db) if db is not None else out / "database"
     roles = _roles(sc)
-    columns = sc.columns
     if not roles.features:
         raise ValueError(f"scenario {sc.name!r} varies no feature: give ranges in [features]")
+    # buildable by default: rules are mined and verified for the target with panels that do not
+    # overlap (the choice filters on it too); the margins and the objective use the target alone
+    buildable = (
+        "overlap" in sc.performance_names and not allow_overlap and "overlap" not in tgt.columns
+    )
     out.mkdir(parents=True, exist_ok=True)
+    ledger = _Ledger(out)
     times = dict.fromkeys(STAGES, 0.0)
+    used: set = set()
 
-    # 1. database
+    def simulate(designs: pd.DataFrame, path: Path) -> pd.DataFrame:
+        # sampled designs the scenario's check refuses are failed rows, not a refused run
+        used.add(path.resolve())
+        return build_database(
+            sc, designs, path, workers=workers, progress=progress, on_invalid="skip"
+        )
+
+    def base(start: int, count: int) -> pd.DataFrame:
+        return sample_designs(sc, count, seed=seed, start=start)
+
+    # 1. database: the pilot first
     t0 = time.perf_counter()
-    say(f"[database] {samples} designs of {sc.name}")
     parts, have = [], 0
     given = _given_database(dbf, sc)
     if given is not None:  # a database the user made (holofold generate): all its rows
+        used.add(dbf.resolve())
         parts.append(given.assign(origin="database"))
         have = len(given)
-    for a, b in _base_batches(dbf, max(samples, have), have):
-        designs = sample_designs(sc, b - a, seed=seed, start=a)
-        res = _simulate(sc, designs, dbf / f"base-{a:06d}-{b:06d}", workers, progress)
-        parts.append(res.assign(origin="database"))
-    table = pd.concat(parts, ignore_index=True)
-    if given is None:
-        table = table.iloc[:samples]
-    times["database"] = time.perf_counter() - t0
-
-    history = []
-    best = None
-    mined = None
-    for r in range(rounds + 1):
-        rdir = out / "rounds" / f"round-{r}"
-        if r:
-            t0 = time.perf_counter()
-            say(f"[refine] round {r}/{rounds}: {refine} new designs inside and around the rules")
-            new = refine_designs(sc, history[-1]["records"], refine, seed=seed + 7919 * r,
-                                 start=10**6 * r)  # fmt: skip
-            res = _simulate(sc, new, dbf / f"refine-{r}", workers, progress)
-            table = pd.concat([table, res.assign(origin=f"refine-{r}")], ignore_index=True)
-            times["refine"] += time.perf_counter() - t0
-        t0 = time.perf_counter()
-        say(f"[mine] round {r}: rules for {tgt} from {len(table)} designs")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", FewRulesWarning)
-            mined = mine_rules(table, tgt, roles=roles, seed=seed, n_rules=top, max_overlap=0.5,
-                               source=str(dbf))  # fmt: skip
-        records = mined_rules(mined.miner, mined.test_scores)[:top]
-        if records:
-            rdir.mkdir(parents=True, exist_ok=True)
-            write_rules(rdir / "rules.json", records, columns)
-        times["mine"] += time.perf_counter() - t0
-        if not records:
-            hits = int(mined.meets.sum())
-            if r == rounds:
-                more = "more --rounds, " if hits else ""
-                raise ValueError(
-                    f"no rule reaches the miner's precision for {str(tgt)!r} in round {r} "
-                    f"({hits} of {len(mined.table)} designs meet it); try {more}more samples "
-                    "or a looser target"
-                )
-            # a rare target: refine around the designs that meet it, then mine again
-            box = _box_of(sc, mined.table.loc[mined.meets], roles)
-            say(f"  round {r}: no rule yet ({hits} of {len(mined.table)} designs meet the "
-                "target); the next round samples around them")  # fmt: skip
-            history.append({"round": r, "rows": int(len(mined.table) + mined.n_failed),
-                            "records": [box], "rules": [], "best": None})  # fmt: skip
-            continue
-        t0 = time.perf_counter()
-        say(f"[verify] round {r}: {len(records)} rule(s), {verify} fresh designs each")
-        checks = _verify(sc, records, tgt, verify, rdir / "verify", seed + 100 * r, workers,
-                         progress)  # fmt: skip
-        times["verify"] += time.perf_counter() - t0
-        entries = [_rule_entry(rec, v, columns) for rec, v in zip(records, checks, strict=True)]
-        for e in entries:
-            est, test = _fmt(e.get("estimate")), _fmt(e["test_precision"])
-            ver = _fmt(e.get("verified_precision"))
-            say(f"  round {r} rule {e['rank']}: {e['rule']}  "
-                f"(estimate {est}, test {test}, verified {ver})")  # fmt: skip
-        for i, v in enumerate(checks, start=1):
-            table = pd.concat(
-                [table, v.designs.drop(columns="meets_target").assign(origin=f"verify-{r}-{i}")],
-                ignore_index=True,
-            )
-        best = _pick_rule(entries)
-        history.append({"round": r, "rows": int(len(mined.table) + mined.n_failed),
-                        "records": records, "rules": entries, "best": best})  # fmt: skip
-
-    # 5. choose
-    t0 = time.perf_counter()
-    say("[choose] the design with the largest worst-case margin inside the best rule")
-    rule = history[-1]["rules"][best]
-    label, margins, how = choose_design(table, tgt, history[-1]["records"][best])
-    if label is None:
-        raise ValueError(f"no simulated design meets {str(tgt)!r}; try more samples or rounds")
-    row = table.loc[label]
-    features = {c.name: _clean(float(row[c.name])) for c in sc.features if c.name in row}
-    performance = {c: _clean(float(row[c])) for c in sc.performance_names}
-    units = {c.name: c.unit for c in (*sc.features, *sc.performance)}
-    times["choose"] = time.perf_counter() - t0
-    summary = {
-        "scenario": _scenario_summary(sc),
-        "target": str(tgt),
-        "features": features,
-        "performance": performance,
-        "status": str(row["status"]),
-        "units": units,
-        "rule": rule,
-        "verified_precision": rule.get("verified_precision"),
-        "margins": {k: _clean(v) for k, v in margins.items()},
-        "worst_margin": _clean(min(margins.values())) if margins else None,
-        "chosen": {"how": how, "origin": str(row["origin"])},
-        "database": {
+    first = min(samples, pilot) if pilot else samples
+    stored = _stored_rows(dbf, "base-", have)
+    if have < first:
+        what = f"pilot: {first - have}" if pilot else f"{samples - have}"
+        say(f"[database] {what} designs of {sc.name}{_on_disk(stored, first - have)}")
+    rows, _ = grow(dbf, first, base, simulate, prefix="base-", covered=have)
+    parts.append(rows.assign(origin="database"))
+    table = pd.concat([p for p in parts if len(p)], ignore_index=True)
+    pilot_info = None
+    if pilot:
+        hits, unmet, stop = _pilot_verdict(table, tgt)
+        pilot_info = {
             "rows": int(len(table)),
-            "failed": int(failed_rows(table).sum()),
-            "path": os.path.relpath(dbf, out),
-        },  # fmt: skip
-        "rounds": [{k: h[k] for k in ("round", "rows", "rules", "best")} for h in history],
-    }
-    write_table(table, out / "designs.parquet")
-    if files:
+            "meeting": hits,
+            "stopped": stop is not None,
+            "reason": stop or "",
+            "unmet": unmet,
+        }
+        if stop is not None:
+            say(f"  pilot: {stop} ({len(table)} designs); stopping before the rest")
+    times["database"] += time.perf_counter() - t0
+    history: list[Round] = []
+    miners: dict = {}
+    mine_tgt = tgt
+    if not (pilot_info and pilot_info["stopped"]):
         t0 = time.perf_counter()
-        what = "fabrication files, " if sc.write_files is not None else "(no fabrication files "
-        what += "" if sc.write_files is not None else f"for scenario {sc.name!r}) "
-        say(f"[files] {what}pictures and report.html")
+        if len(table) < samples:
+            more = samples - len(table)
+            say(
+                f"[database] {more} more designs of {sc.name}"
+                f"{_on_disk(stored - len(table) + have, more)}"
+            )
+            rows, _ = grow(dbf, samples, base, simulate, prefix="base-", covered=len(table))
+            table = pd.concat([table, rows.assign(origin="database")], ignore_index=True)
+        if given is None:
+            table = table.iloc[:samples]
+        times["database"] += time.perf_counter() - t0
+        mine_tgt = _buildable_target(sc, tgt, table) if buildable else tgt
+        table, history, miners = _rounds(
+            sc,
+            mine_tgt,
+            roles,
+            table,
+            out,
+            dbf,
+            simulate,
+            rounds=rounds,
+            refine=refine,
+            verify=verify,
+            top=top,
+            seed=seed,
+            workers=workers,
+            progress=progress,
+            times=times,
+            used=used,
+            say=say,
+        )
+
+    # 5. choose, from everything simulated in the folder
+    t0 = time.perf_counter()
+    earlier = _earlier_rows(sc, [dbf, out / "rounds"], used)
+    everything = table if earlier is None else pd.concat([table, earlier], ignore_index=True)
+    if earlier is not None:
+        say(
+            f"[choose] {len(earlier)} designs simulated by earlier runs in {out} join the "
+            "candidates"
+        )
+    say(f"[choose] {obj.words}" + (", thick panels not overlapping" if buildable else ""))
+    rules = [r for h in history for r in h.rules]
+    answer = choose(everything, tgt, obj, rules, allow_overlap=allow_overlap)
+    everything = everything.reset_index(drop=True)
+    times["choose"] = time.perf_counter() - t0
+    say(f"  {answer.headline}")
+
+    summary = DesignSummary(
+        scenario=_scenario_summary(sc),
+        target=str(tgt),
+        mined_target=str(mine_tgt),
+        objective=str(obj),
+        allow_overlap=bool(allow_overlap),
+        answer=answer.kind,
+        headline=answer.headline,
+        chosen=_pick(sc, everything, answer.chosen, tgt),
+        alternatives=tuple(_pick(sc, everything, c, tgt) for c in answer.alternatives),
+        rounds=tuple(history),
+        database=_counts(everything, dbf, out),
+        pilot=pilot_info,
+        distributions=tuple(distributions(everything, _target_columns(sc, tgt, obj))),
+    )
+    write_table(everything, out / "designs.parquet")
+    if files and answer.chosen is not None:
+        t0 = time.perf_counter()
+        what = (
+            "fabrication files, "
+            if sc.write_files is not None
+            else f"(no fabrication files for scenario {sc.name!r}) "
+        )
+        say(f"[files] {what}pictures, 3D view and report.html")
+        row = everything.loc[answer.chosen.label]
+        rule = answer.chosen.rule
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            summary["files"], summary["images"] = _write_files(
-                sc, row, out, mined, rule, table, tgt, mesh_units, cutter
+            extra = _write_files(
+                sc, row, out, rule, miners, everything, tgt, mesh_units, bed, answer.chosen, cutter
             )
-        summary["warnings"] = list(dict.fromkeys(str(w.message) for w in caught))
-        for w in summary["warnings"]:
+        notes = list(dict.fromkeys(str(w.message) for w in caught))
+        for w in notes:
             say(f"  note: {w}")
+        summary = _replace(summary, warnings=tuple(notes), **extra)
         times["files"] = time.perf_counter() - t0
-    summary["timings"] = {k: round(v, 3) for k, v in times.items()}
-    write_json(out / "design.json", summary)
+    summary = _replace(summary, timings=ledger.timings(times))
+    write_json(out / "design.json", summary.to_json())
+    ledger.append(times)
     if files:
         from holofold.design.report_page import write_report_page
 
         write_report_page(out, summary)
-    _check_own_summary(out, summary)
-    vp = rule.get("verified_precision")
-    say(f"chosen: {', '.join(f'{k} = {_shown(columns, k, v)}' for k, v in features.items())}\n"
-        f"  {', '.join(f'{k} = {_shown(columns, k, performance[k])}' for k in tgt.columns)}; "
-        f"worst margin {summary['worst_margin']:.3g}; rule verified precision "
-        f"{'n/a' if vp is None else f'{vp:.2f}'}; files in {out}/")  # fmt: skip
-    return DesignOutcome(summary, table, out)
+    _check_own_summary(out, summary.to_json())
+    _say_chosen(say, summary, tgt, out, sc.columns)
+    return DesignOutcome(summary, everything, out)
+
+
+def _replace(summary: DesignSummary, **kw) -> DesignSummary:
+    from dataclasses import replace
+
+    return replace(summary, **kw)
 
 
 def _check_own_summary(out: Path, summary: dict) -> None:
     """Before the run reports success: ``design.json`` in ``out`` is the one it wrote."""
-    import json
-
     try:
         stored = json.loads((out / "design.json").read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
@@ -514,6 +613,173 @@ def _check_own_summary(out: Path, summary: dict) -> None:
 def _shown(columns: Mapping, name: str, value) -> str:
     """A value of the chosen design in its column's display unit (4 digits), or n/a."""
     return "n/a" if value is None else columns[name].format(value, 4)
+
+
+def _say_chosen(say, summary: DesignSummary, tgt, out: Path, columns: Mapping) -> None:
+    c = summary.chosen
+    if c is None:
+        say(f"no design: every simulation failed; see {out}/report.html")
+        return
+    vp = None if c.rule is None else c.rule.precision
+    feats = ", ".join(f"{k} = {_shown(columns, k, v)}" for k, v in c.features.items())
+    perf = ", ".join(f"{k} = {_shown(columns, k, c.performance.get(k))}" for k in tgt.columns)
+    state = "meets the target" if c.meets else "does NOT meet the target (nearest)"
+    say(
+        f"chosen: {feats}\n  {perf}; {state}; worst margin {c.worst_margin:.3g}; answer "
+        f"{summary.answer!r}; rule verified precision {_fmt(vp)}; files in {out}/"
+    )
+
+
+def _target_columns(sc: Scenario, tgt, obj: Objective) -> list:
+    names = list(dict.fromkeys([*tgt.columns, *([obj.column] if obj.column else [])]))
+    cols = {c.name: c for c in (*sc.performance, *sc.features)}
+    return [cols[n] for n in names if n in cols]
+
+
+def _counts(table: pd.DataFrame, dbf: Path, out: Path) -> dict:
+    by = table["origin"].astype(str)
+    kind = by.str.replace(r"-\d+(-\d+)?$", "", regex=True).str.replace(
+        r"^earlier: .*", "earlier", regex=True
+    )
+    return {
+        "rows": int(len(table)),
+        "failed": int(failed_rows(table).sum()),
+        "by_origin": {k: int(v) for k, v in kind.value_counts(sort=False).items()},
+        "path": os.path.relpath(dbf, out),
+    }
+
+
+def _pick(sc: Scenario, table: pd.DataFrame, c: Candidate | None, tgt) -> Pick | None:
+    if c is None:
+        return None
+    row = table.loc[c.label]
+    return Pick(
+        source=c.source,
+        features={f.name: _clean(float(row[f.name])) for f in sc.features if f.name in row},
+        performance={k: _clean(float(row[k])) for k in sc.performance_names},
+        status=str(row["status"]),
+        origin=str(row["origin"]),
+        margins=dict(c.margins),
+        worst_margin=c.worst_margin,
+        meets=c.meets,
+        buildable=c.buildable,
+        objective=_clean(c.score),
+        rule=c.rule,
+    )
+
+
+def _rounds(
+    sc,
+    tgt,
+    roles,
+    table,
+    out,
+    dbf,
+    simulate,
+    *,
+    rounds,
+    refine,
+    verify,
+    top,
+    seed,
+    workers,
+    progress,
+    times,
+    used,
+    say,
+):
+    """Stages 2-4: mine, verify and refine; returns the grown table, the rounds and each
+    round's mined rules (round -> MinedRules)."""
+    history: list[Round] = []
+    miners: dict = {}
+    boxes: list = []
+    for r in range(rounds + 1):
+        rdir = out / "rounds" / f"round-{r}"
+        if r:
+            t0 = time.perf_counter()
+            say(f"[refine] round {r}/{rounds}: {refine} new designs inside and around the rules")
+            s = seed + 7919 * r
+            key = _key([rule_key(b) for b in boxes], refine, s)
+            new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
+            res = simulate(new, dbf / f"refine-{r}-{key}")
+            table = pd.concat([table, res.assign(origin=f"refine-{r}")], ignore_index=True)
+            times["refine"] += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        ok = table.loc[~failed_rows(table)]
+        hits = int(tgt.evaluate(ok).sum()) if len(ok) else 0
+        if hits in (0, len(ok)):  # nothing to tell apart: no rule to mine
+            note = (
+                f"no rule to mine: {hits} of {len(ok)} simulated designs meet "
+                f"{'the target' if hits == 0 else 'the target, all of them'}"
+            )
+            say(f"[mine] round {r}: {note}")
+            history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
+            times["mine"] += time.perf_counter() - t0
+            break
+        say(f"[mine] round {r}: rules for {tgt} from {len(table)} designs")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FewRulesWarning)
+            mined = mine_rules(
+                table, tgt, roles=roles, seed=seed, n_rules=top, max_overlap=0.5, source=str(dbf)
+            )
+        records = mined_rules(mined.miner, mined.test_scores)[:top]
+        miners[r] = mined
+        if records:
+            rdir.mkdir(parents=True, exist_ok=True)
+            write_rules(rdir / "rules.json", records, sc.columns)
+        times["mine"] += time.perf_counter() - t0
+        rows, failed = int(len(mined.table)), int(mined.n_failed)
+        hits = int(mined.meets.sum())
+        if not records:
+            if hits and r < rounds:  # a rare target: refine around the designs that meet it
+                boxes = [_box_of(mined.table.loc[mined.meets], roles)]
+                note = (
+                    f"no rule yet ({hits} of {rows} designs meet the target); the next "
+                    "round samples around them"
+                )
+            else:
+                note = (
+                    f"no rule reaches the miner's precision ({hits} of {rows} designs meet "
+                    "the target)"
+                )
+            say(f"  round {r}: {note}")
+            history.append(Round(r, rows, failed, hits, (), note))
+            if not hits:
+                break  # nothing to refine around: more rounds would sample the same
+            continue
+        t0 = time.perf_counter()
+        say(f"[verify] round {r}: {len(records)} rule(s), {verify} fresh designs each")
+        checks = verify_rules(
+            sc,
+            records,
+            tgt,
+            verify,
+            seed=seed + 100 * r,
+            folder=rdir / "verify",
+            workers=workers,
+            progress=progress,
+        )
+        for i, rec in enumerate(records, start=1):  # the verification databases read
+            vdir = rdir / "verify" / f"rule{i}-{rule_key(rec)}"
+            used.update(p.parent.resolve() for p in vdir.rglob("designs.parquet"))
+        times["verify"] += time.perf_counter() - t0
+        ranked = [
+            VerifiedRule.of(rec, r, v.counts, sc.columns)
+            for rec, v in zip(records, checks, strict=True)
+        ]
+        for e in ranked:
+            say(
+                f"  round {r} rule {e.rank}: {e.text}  (estimate {_fmt(e.estimate)}, held-out "
+                f"{_fmt(e.test_precision)}, verified {_fmt(e.precision)})"
+            )
+        for i, v in enumerate(checks, start=1):
+            table = pd.concat(
+                [table, v.designs.drop(columns="meets_target").assign(origin=f"verify-{r}-{i}")],
+                ignore_index=True,
+            )
+        history.append(Round(r, rows, failed, hits, tuple(ranked)))
+        boxes = records
+    return table, history, miners
 
 
 def _scenario_summary(sc: Scenario) -> dict:
@@ -528,21 +794,40 @@ def _scenario_summary(sc: Scenario) -> dict:
                 "name": c.name,
                 "unit": c.unit,
                 "description": c.description,
+                "display_unit": c.display_unit,
                 "low": c.low,
                 "high": c.high,
                 "choices": list(c.choices),
-            }  # fmt: skip
+            }
             for c in sc.features
         ],
         "performance": [
-            {"name": c.name, "unit": c.unit, "description": c.description} for c in sc.performance
+            {
+                "name": c.name,
+                "unit": c.unit,
+                "display_unit": c.display_unit,
+                "description": c.description,
+            }
+            for c in sc.performance
         ],
     }
 
 
 def _write_files(
-    sc: Scenario, row, out: Path, mined, rule: Mapping, table, tgt, mesh_units: str, cutter
-):
+    sc: Scenario,
+    row,
+    out: Path,
+    rule: VerifiedRule | None,
+    miners,
+    table,
+    tgt,
+    mesh_units: str,
+    bed: Bed,
+    chosen: Candidate,
+    cutter,
+) -> dict:
+    """The chosen design's files, pictures, 3D view and fit on the bed: the summary's
+    ``files``, ``images``, ``fabrication`` and ``extras``."""
     from holofold.design.report import (
         plot_folded_design,
         plot_rule_boxes,
@@ -550,13 +835,34 @@ def _write_files(
         save_figure,
     )
 
-    files, images = {}, {}
+    files, images, extras = {}, {}, {}
+    fabrication = None
     design = {c.name: float(row[c.name]) for c in sc.features if c.name in row}
+    overlap = chosen.buildable is False
     if sc.write_files is not None:
         fab = sc.write_files(design, out / "files", units=mesh_units, cutter=cutter)
-        files = fab.record(out)  # stable key -> {"path", "label"}
         for note in fab.notes:  # the report's notes on the files (the loop records warnings)
             warnings.warn(note, UserWarning, stacklevel=2)
+        for key in _FOLDED_SOLIDS if overlap else ():
+            if key in fab:  # the folded part cannot exist as designed: not written
+                fab[key].path.unlink(missing_ok=True)
+                warnings.warn(
+                    f"{fab[key].path.name} not written: the folded thick panels of this design "
+                    f"overlap by {float(row['overlap']) * 1e9:.3g} mm^3, so the folded part "
+                    "cannot be made as designed",
+                    stacklevel=2,
+                )
+        files = {k: v for k, v in fab.record(out).items() if not (overlap and k in _FOLDED_SOLIDS)}
+        path = next((fab[k].path for k in ("printable", "thick") if k in fab), None)
+        if path is not None and path.is_file():
+            part = sc.part(design) if sc.part is not None and "printable" in fab else None
+            fabrication = part_fit(path, bed, units=mesh_units, root=out, part=part)
+            if fabrication.segments:
+                files["segments"] = {
+                    "path": f"{fabrication.segments}/assembly.svg",
+                    "label": f"the {fabrication.pieces} pieces to print (segments/"
+                    "segment_NN.stl) and their assembly sheet (SVG)",
+                }
     if sc.shape is not None:
         pat = sc.shape(design)
         creases = pat.edges[pat.interior] if hasattr(pat, "interior") else None
@@ -565,19 +871,38 @@ def _write_files(
         )
         save_figure(fig, out / "design.png")
         images["design"] = "design.png"
-    X = mined.table[list(mined.features)]
-    fig = plot_rule_boxes(mined.miner, X, rule["rank"] - 1, columns=sc.columns)
-    fig.tight_layout()  # long feature names stay inside the picture
-    save_figure(fig, out / "rule.png")
-    images["rule"] = "rule.png"
-    cols = list(tgt.columns)
-    if len(cols) >= 2:
-        x, y = cols[0], cols[1]
+    if rule is not None and rule.round in miners:  # drawn from the table it was mined from
+        mined = miners[rule.round]
+        fig = plot_rule_boxes(
+            mined.miner, mined.table[list(mined.features)], rule.rank - 1, columns=sc.columns
+        )
+        p = rule.train_precision
+        fig.axes[0].set_title(
+            f"{rule.label}: training precision {'n/a' if p is None else f'{p:.2f}'} "
+            f"(verified {_fmt(rule.precision)})",
+            fontsize=9,
+        )
+        fig.tight_layout()  # long feature names stay inside the picture
+        save_figure(fig, out / "rule.png")
+        images["rule"] = "rule.png"
+    tcols = list(tgt.columns)
+    if len(tcols) >= 2:
+        x, y = tcols[0], tcols[1]
     else:  # the target's column against the rule's first continuous feature
-        x = next((k for k in rule["bounds"] if k not in sc.categorical), mined.features[0])
-        y = cols[0]
+        feats = [k for k in (rule.bounds if rule else {}) if k not in sc.categorical]
+        x = feats[0] if feats else next(c for c in _roles(sc).features if c not in sc.categorical)
+        y = tcols[0]
     ok = table.loc[~failed_rows(table)]
     fig = plot_target_scatter(ok, tgt, x, y, chosen=row, columns=sc.columns)
     save_figure(fig, out / "scatter.png")
     images["scatter"] = "scatter.png"
-    return files, images
+    if getattr(sc, "view", None) is not None:
+        view = sc.view(design)
+        extras["view"] = view.to_json()
+        extras.update(view.facts_json())
+    return {"files": files, "images": images, "fabrication": fabrication, "extras": extras}
+
+
+#: fabrication-set keys of the folded thick part, which cannot exist when its panels overlap
+#: (docs/scenarios.md §8.2)
+_FOLDED_SOLIDS = ("thick", "printable_folded")

@@ -1,11 +1,19 @@
-"""The self-contained HTML report of ``holofold design``: one page, read top to bottom.
+"""The self-contained HTML report of ``holofold design``: one page, the answer first.
 
-:func:`write_report_page` turns the design summary (what ``design.json`` holds) into
-``report.html``: the problem (scenario, fixed setting, design features), the target, the rules
-of each round with their verified precision, the chosen design with its margins, the pictures
-(embedded as base64 PNG), links to the design's files and the time of each stage. The page
-loads nothing from anywhere (inline CSS, no JS library); a tiny inline script records, after
-load, how many of its images decoded (``data-images-loaded`` on ``<body>``).
+:func:`write_report_page` turns the design summary (a
+:class:`~holofold.design.summary.DesignSummary`, or what ``design.json`` holds, validated by
+it) into ``report.html``. The first screen is the answer: how the design was found, stated
+honestly (a verified rule, the best simulated design, or the nearest one and what it misses),
+each target condition with the chosen design's value, margin and met/missed, the part to print
+(its extent, whether it fits the printer's bed and what to do if not, a print-time class), the
+kind's own facts (the gripper's closed state and temperatures) and a 3D view to turn, from flat
+to folded, with supports, loads and the target curve. Then the alternatives side by side, the
+problem, what the designs reach, the chosen design in full, the rules of each round with their
+training, held-out and verified precision labelled, the pictures (embedded PNG), the files,
+and the counts and times of this run and of all runs on the folder. Values are shown in the
+columns' display units (mm, um, degrees). The page loads nothing from anywhere (inline CSS and
+script, no library); an inline script records how many of its images decoded
+(``data-images-loaded`` on ``<body>``).
 """
 
 from __future__ import annotations
@@ -18,12 +26,13 @@ from collections.abc import Mapping
 from pathlib import Path
 from urllib.parse import quote
 
+from holofold.design.scenarios import Column, format_value
+from holofold.design.summary import DesignSummary, Pick
 from holofold.design.targets import TargetError, parse_target
+from holofold.design.view import view_css, view_html
 from holofold.geometry.outputs import check_output_path, write_text
 
 __all__ = ["write_report_page", "report_page_html"]
-
-_REQUIRED = ("scenario", "target", "features", "performance")
 
 _MISSING = "\u2013"  # en dash: a value that is absent or not finite
 
@@ -45,6 +54,7 @@ _CAPTIONS = {
 
 _STAGES = {
     "database": "database (simulations)",
+    "choose": "choosing the design",
     "mine": "rule mining",
     "verify": "verification (new simulations inside the rule)",
     "refine": "refinement rounds",
@@ -84,6 +94,22 @@ figure { margin: 16px 0 24px; }
 figure img { max-width: 100%; height: auto; border: 1px solid #d7dee6; }
 figcaption { color: #3d4650; font-size: 14px; margin-top: 4px; }
 ul.files li { margin: 2px 0; }
+.answer { border-left: 6px solid #3c9a5f; background: #f1f8f3; padding: 10px 16px;
+  margin: 12px 0; font-size: 16px; }
+.answer.nearest { border-color: #d08a1e; background: #fdf6e9; }
+.answer.nothing { border-color: #b3261e; background: #fbeceb; }
+.answer .kind { font-weight: 700; text-transform: uppercase; font-size: 12px;
+  letter-spacing: 0.05em; color: #3d4650; display: block; margin-bottom: 2px; }
+.cards { display: flex; gap: 14px; flex-wrap: wrap; margin: 8px 0; }
+.card { flex: 1 1 300px; border: 1px solid #d7dee6; border-radius: 4px; padding: 8px 12px;
+  background: #fbfcfd; }
+.card h3 { margin: 0 0 6px; font-size: 15px; }
+.card p { margin: 4px 0; }
+.fits { color: #19703a; font-weight: 600; }
+.nofit { color: #b3261e; font-weight: 600; }
+table.side td { white-space: nowrap; }
+table.side th { white-space: normal; max-width: 230px; font-weight: 500; }
+table.side th b { font-weight: 700; }
 """
 
 _SCRIPT = """
@@ -158,34 +184,24 @@ def _precision(p) -> str:
     return _percent(p) or _MISSING
 
 
-def _estimate(rule: Mapping) -> str:
-    """'91.0 % (95 % interval 85.0 % to 95.0 %)' or the missing mark."""
-    p = _percent(rule.get("estimate"))
+def _estimate(rule) -> str:
+    """A VerifiedRule's estimate: '91.0 % (85.0 % to 95.0 %)' or the missing mark."""
+    est = rule.rule.estimate
+    p = None if est is None else _percent(est.precision)
     if p is None:
         return _MISSING
-    ci = rule.get("estimate_95ci")
-    if isinstance(ci, list | tuple) and len(ci) == 2:
-        lo, hi = (_percent(c) for c in ci)
-        if lo is not None and hi is not None:
-            return f"{p} ({lo} to {hi})"
-    return p
+    lo, hi = _percent(est.low), _percent(est.high)
+    return f"{p} ({lo} to {hi})" if lo is not None and hi is not None else p
 
 
-def _verified(rule: Mapping, fallback=None) -> str:
-    """'88.0 % (95 % interval 76.0 % to 94.0 %, n = 50)' or 'not verified'."""
-    p = _percent(rule.get("verified_precision", fallback))
+def _verified(rule) -> str:
+    """A VerifiedRule's verified precision: '88.0 % (95 % interval 76.0 % to 94.0 %, n = 50)'
+    or 'not verified'."""
+    p = _percent(rule.precision)
     if p is None:
         return "not verified"
-    extra = []
-    ci = rule.get("verified_95ci")
-    if isinstance(ci, list | tuple) and len(ci) == 2:
-        lo, hi = (_percent(c) for c in ci)
-        if lo is not None and hi is not None:
-            extra.append(f"95\u00a0% interval {lo} to {hi}")
-    n = rule.get("verified_n")
-    if _is_number(n) and math.isfinite(float(n)):
-        extra.append(f"n\u00a0=\u00a0{int(n)}")
-    return f"{p} ({', '.join(extra)})" if extra else p
+    lo, hi = (_percent(c) for c in rule.interval)
+    return f"{p} (95\u00a0% interval {lo} to {hi}, n\u00a0=\u00a0{rule.verified.simulated})"
 
 
 def _seconds(t) -> str:
@@ -216,22 +232,232 @@ def _table(header, rows, cls: str | None = None, row_classes=None) -> str:
     return "".join(out)
 
 
+# ---- units -----------------------------------------------------------------------------------
+
+
+def _columns(summary: DesignSummary) -> dict[str, Column]:
+    """Name -> Column (unit and display unit) of the summary's scenario."""
+    out = {}
+    for key in ("features", "performance"):
+        for c in summary.scenario.get(key) or []:
+            if not isinstance(c, Mapping) or "name" not in c:
+                continue
+            unit = str(c.get("unit") or "-")
+            try:
+                col = Column(str(c["name"]), unit, display=str(c.get("display_unit") or ""))
+            except ValueError:  # a display unit this holofold does not know: the SI unit
+                col = Column(str(c["name"]), unit)
+            out[col.name] = col
+    return out
+
+
+def _shown(v, col: Column | None, digits: int = 4) -> str:
+    """A value in its column's display unit, labelled; the missing mark if absent."""
+    if v is None or isinstance(v, bool) or not _is_number(v) or not math.isfinite(float(v)):
+        return _MISSING
+    if col is None:
+        return _num(v, digits)
+    return _esc(col.format(float(v), digits=digits).replace(" ", "\u00a0"))
+
+
+def _plain(v: float, digits: int = 3) -> str:
+    """A number without a unit and, below 1e6, without an exponent (the missing mark if NaN)."""
+    return _esc(format_value(float(v), digits=digits)) if math.isfinite(v) else _MISSING
+
+
 # ---- the sections ----------------------------------------------------------------------------
 
-
-def _units(summary: Mapping) -> dict:
-    scenario = summary["scenario"]
-    units = {}
-    for key in ("features", "performance"):
-        for col in scenario.get(key) or []:
-            if isinstance(col, Mapping) and "name" in col:
-                units[col["name"]] = col.get("unit")
-    units.update(summary.get("units") or {})
-    return units
+_KIND_TITLE = {
+    "rule": "A verified design",
+    "designs": "The best simulated design",
+    "nearest": "No design meets the target: the nearest",
+    "none": "No design",
+}
 
 
-def _problem(summary: Mapping, units: Mapping) -> str:
-    sc = summary["scenario"]
+def _condition_rows(pick: Pick, target: str, cols: Mapping) -> list:
+    """Per target condition: the chosen design's value, its margin and met / missed."""
+    rows = []
+    for cond, m in pick.margins.items():
+        try:
+            names = parse_target(cond).columns
+        except TargetError:
+            names = ()
+        values = [_shown(pick.performance.get(n, pick.features.get(n)), cols.get(n)) for n in names]
+        value = ", ".join(values) or _MISSING
+        if math.isnan(m):
+            margin, state = _MISSING, _MISSING
+        elif math.isinf(m):  # == and !=: met or missed, no size; say by how much it differs
+            margin = "holds exactly" if m > 0 else "does not hold"
+            state = (
+                '<span class="met">met</span>' if m > 0 else '<span class="missed">missed</span>'
+            )
+        else:
+            margin = f"{m:+.3g} ({100 * m:+.1f}\u00a0%)"
+            state = (
+                '<span class="met">met</span>' if m >= 0 else '<span class="missed">missed</span>'
+            )
+        rows.append(
+            [
+                f"<code>{_esc(cond)}</code>",
+                (value, "num"),
+                (margin, "num"),
+                _margin_bar(m) if math.isfinite(m) else "",
+                state,
+            ]
+        )
+    return rows
+
+
+def _fabrication(summary: DesignSummary) -> str:
+    f = summary.fabrication
+    if f is None:
+        return ""
+    bed = _esc(f.bed_text)
+    if f.fits:
+        verdict = f'<span class="fits">fits</span> the {bed} bed'
+    elif f.pieces:
+        verdict = f'<span class="nofit">does not fit</span> the {bed} bed whole: {f.pieces} pieces'
+    else:
+        verdict = f'<span class="nofit">does not fit</span> the {bed} bed'
+    href = _esc(quote(f.file.replace("\\", "/"), safe="/"))
+    pieces = ""
+    if f.segments:
+        sheet = _esc(quote(f"{f.segments}/assembly.svg", safe="/"))
+        pieces = (
+            f'<p>The pieces: <a href="{sheet}">assembly sheet</a> and '
+            f"<code>{_esc(f.segments)}/segment_01.stl</code> ... "
+            f"<code>segment_{f.pieces:02d}.stl</code>, each placed on the bed.</p>"
+        )
+    from holofold.geometry.bed import INFILL, PRINT_RATE, SOLID_SKIN
+
+    return (
+        '<div class="card" id="part"><h3>The part to print</h3>'
+        f'<p><a href="{href}">{_esc(f.file)}</a>: <b>{_esc(f.extent_text())}</b>; {verdict}.</p>'
+        f"<p>{_esc(f.advice)}</p>{pieces}"
+        f"<p>Print time: <b>{_esc(f.time_class)}</b> (about {f.hours:.2g}&nbsp;h: the volume "
+        f"a slicer deposits, solid to {SOLID_SKIN * 1e3:g}&nbsp;mm and {INFILL:.0%} infill "
+        f"above, at {PRINT_RATE * 1e9:g}&nbsp;mm<sup>3</sup>/s, calibrated with PrusaSlicer; "
+        "the slicer gives the real time)."
+        "</p></div>"
+    )
+
+
+def _facts(summary: DesignSummary) -> str:
+    facts = summary.extras.get("facts") if isinstance(summary.extras, Mapping) else None
+    if not facts:
+        return ""
+    title = "The design in use"
+    if summary.scenario.get("kind") == "gripper":
+        title = "Closed by heating"
+    rows = "".join(f"<p>{_esc(k)}: <b>{_esc(v)}</b></p>" for k, v in facts.items())
+    return f'<div class="card" id="facts"><h3>{_esc(title)}</h3>{rows}</div>'
+
+
+def _answer(summary: DesignSummary, cols: Mapping) -> str:
+    out = ['<section id="answer"><h2>The answer</h2>']
+    kind = summary.answer
+    css = {"rule": "", "designs": "", "nearest": " nearest", "none": " nothing"}[kind]
+    out.append(
+        f'<div class="answer{css}"><span class="kind">{_esc(_KIND_TITLE[kind])}</span>'
+        f"{_esc(summary.headline)}</div>"
+    )
+    obj = summary.objective
+    out.append(
+        f'<p>Target <span class="expr">{_esc(summary.target)}</span> &middot; objective '
+        f"<b>{_esc(obj)}</b>"
+        + ("" if not summary.allow_overlap else " &middot; overlapping panels allowed")
+        + "</p>"
+    )
+    if summary.mined_target and summary.mined_target != summary.target:
+        out.append(
+            '<p class="note">Buildable by default: rules were mined and verified for '
+            f"<code>{_esc(summary.mined_target)}</code>, the target with thick panels "
+            "that do not overlap (--allow-overlap drops the condition), and no design "
+            "whose panels overlap is chosen.</p>"
+        )
+    pick = summary.chosen
+    if pick is not None:
+        rows = _condition_rows(pick, summary.target, cols)
+        out.append(
+            _table(["condition", "chosen design", "margin", "", "status"], rows, "target-check")
+        )
+        out.append(
+            '<p class="note">Margin: (value &minus; threshold) / |threshold| for a lower '
+            "bound, the other way round for an upper bound: 0 on the threshold, +0.1 = "
+            "10&nbsp;% to spare, negative when missed. An equality holds exactly or not."
+            "</p>"
+        )
+    cards = _fabrication(summary) + _facts(summary)
+    if cards:
+        out.append(f'<div class="cards">{cards}</div>')
+    view = summary.extras.get("view") if isinstance(summary.extras, Mapping) else None
+    if view:
+        out.append("<h3>The chosen design in 3D</h3>")
+        out.append(view_html(view, "design-view"))
+    out.append("</section>")
+    return "".join(out)
+
+
+def _alternatives(summary: DesignSummary, cols: Mapping) -> str:
+    picks = [p for p in ((summary.chosen,) + summary.alternatives) if p is not None]
+    seen, unique = set(), []
+    for p in picks:  # the chosen design first, each design once
+        key = tuple(sorted(p.features.items()))
+        if key not in seen:
+            seen.add(key)
+            unique.append(p)
+    out = ['<section id="alternatives"><h2>Alternatives, side by side</h2>']
+    if len(unique) < 2:
+        out.append(
+            "<p>No other design was put forward: the chosen one is the best of each "
+            "verified rule and overall.</p></section>"
+        )
+        return "".join(out)
+    try:
+        target_cols = list(parse_target(summary.target).columns)
+    except TargetError:
+        target_cols = []
+    obj = summary.objective.split()[-1] if summary.objective != "margin" else None
+    perf = list(dict.fromkeys([*target_cols, *([obj] if obj else []), "mass", "overlap"]))
+    perf = [n for n in perf if any(n in p.performance for p in unique)]
+    feats = list(unique[0].features)
+    header = [""] + [
+        ("chosen: " if k == 0 else "") + p.source.replace("; ", ", ") for k, p in enumerate(unique)
+    ]
+    rows = [
+        ["rule verified precision"]
+        + [_precision(p.rule.precision) if p.rule is not None else _MISSING for p in unique]
+    ]
+    rows.append(["meets the target"] + ["yes" if p.meets else "no" for p in unique])
+    rows.append(
+        ["buildable (no overlap)"]
+        + [_MISSING if p.buildable is None else ("yes" if p.buildable else "no") for p in unique]
+    )
+    rows.append(["worst margin"] + [(_num(p.worst_margin, 3), "num") for p in unique])
+    if obj:
+        rows.append(
+            [f"objective: {_esc(summary.objective)}"]
+            + [(_shown(p.objective, cols.get(obj)), "num") for p in unique]
+        )
+    for n in perf:
+        rows.append(
+            [f"<b>{_esc(n)}</b>"]
+            + [(_shown(p.performance.get(n), cols.get(n)), "num") for p in unique]
+        )
+    for n in feats:
+        rows.append([_esc(n)] + [(_shown(p.features.get(n), cols.get(n)), "num") for p in unique])
+    out.append(_table(header, rows, "side"))
+    out.append(
+        '<p class="note">Each verified rule\'s best design under the objective, and the '
+        "best of every simulated design; the first column is the chosen one.</p>"
+    )
+    out.append("</section>")
+    return "".join(out)
+
+
+def _problem(summary: DesignSummary, cols: Mapping) -> str:
+    sc = summary.scenario
     out = ['<section id="problem"><h2>1. The problem</h2>']
     facts = [("scenario", sc.get("name")), ("kind", sc.get("kind")), ("source", sc.get("source"))]
     out.append(
@@ -242,26 +468,25 @@ def _problem(summary: Mapping, units: Mapping) -> str:
     setting = sc.get("setting") or {}
     if setting:
         out.append("<h3>Fixed setting</h3>")
-        rows = [[_esc(k), _value(v, units.get(k))] for k, v in setting.items()]
+        rows = [[_esc(k), _value(v)] for k, v in setting.items()]
         out.append(_table(["quantity", "value"], rows, "setting-table"))
     feats = [f for f in sc.get("features") or [] if isinstance(f, Mapping)]
     if feats:
         out.append("<h3>Design features (what the designer chooses)</h3>")
         rows = []
         for f in feats:
-            unit = _unit(f.get("unit"))
+            col = cols.get(f.get("name"))
             if f.get("choices"):
-                span = "one of " + _value(list(f["choices"]))
+                span = "one of " + ", ".join(_shown(v, col) for v in f["choices"])
             elif f.get("low") is not None or f.get("high") is not None:
-                span = f"{_num(f.get('low'))} to {_num(f.get('high'))}"
+                span = f"{_shown(f.get('low'), col)} to {_shown(f.get('high'), col)}"
             else:
                 span = _MISSING
-            if unit and span != _MISSING:
-                span += f"\u00a0{_esc(unit)}"
+            unit = col.display_unit if col is not None else ""
             rows.append(
                 [
                     _esc(f.get("name", "")),
-                    _esc(unit) or _MISSING,
+                    _esc(_unit(unit)) or _MISSING,
                     span,
                     _value(f.get("description")),
                 ]
@@ -273,7 +498,8 @@ def _problem(summary: Mapping, units: Mapping) -> str:
         rows = [
             [
                 _esc(p.get("name", "")),
-                _esc(_unit(p.get("unit"))) or _MISSING,
+                _esc(_unit(cols[p["name"]].display_unit if p.get("name") in cols else ""))
+                or _MISSING,
                 _value(p.get("description")),
             ]
             for p in perf
@@ -283,95 +509,165 @@ def _problem(summary: Mapping, units: Mapping) -> str:
     return "".join(out)
 
 
-def _target(summary: Mapping) -> str:
-    out = ['<section id="target"><h2>2. The target</h2>']
-    out.append(f'<p><span class="expr">{_esc(summary["target"])}</span></p>')
-    db = summary.get("database") or {}
-    if db:
-        parts = []
-        if _is_number(db.get("rows")):
-            parts.append(f"{_num(db['rows'])} simulated designs")
-        if _is_number(db.get("failed")) and db["failed"]:
-            parts.append(f"{_num(db['failed'])} failed simulation(s) left out")
-        if db.get("path"):
-            href = _esc(quote(str(db["path"]).replace("\\", "/"), safe="/"))
-            parts.append(f'stored in <a href="{href}">{_esc(db["path"])}</a>')
-        if parts:
-            out.append(f"<p>Database: {'; '.join(parts)}.</p>")
+def _reach(summary: DesignSummary, cols: Mapping) -> str:
+    out = ['<section id="reach"><h2>2. What the designs reach</h2>']
+    pilot = summary.pilot
+    if pilot:
+        line = (
+            f"The pilot: {_num(pilot.get('rows'))} designs simulated first, "
+            f"{_num(pilot.get('meeting'))} meeting the target."
+        )
+        if pilot.get("stopped"):
+            line += (
+                f" <b>The run stopped there</b>: {_esc(pilot.get('reason'))}. The "
+                "distributions below say what the designs reach; change the target or the "
+                "feature ranges and run again (the simulations are kept)."
+            )
+        out.append(f"<p>{line}</p>")
+    if summary.distributions:
+        from holofold.design.describe import QUANTILES
+
+        head = ["column", "unit", "designs"] + [
+            "min" if q == 0 else "max" if q == 1 else f"{round(100 * q)}\u00a0%" for q in QUANTILES
+        ]
+        rows = []
+        for d in summary.distributions:
+            col = cols.get(d.name)
+            unit = col.display_unit if col is not None else d.unit
+            factor = col.display_factor if col is not None else 1.0
+            rows.append(
+                [f"<b>{_esc(d.name)}</b>", _esc(_unit(unit)) or _MISSING, (_num(d.rows), "num")]
+                + [(_plain(v * factor), "num") for v in d.quantiles]
+            )
+        out.append(_table(head, rows, "distributions"))
+        out.append(
+            "<p class=\"note\">Quantiles of the target's (and the objective's) columns over "
+            "every successfully simulated design of this folder.</p>"
+        )
+    else:
+        out.append("<p>No distribution was recorded.</p>")
     out.append("</section>")
     return "".join(out)
 
 
-def _best(rules) -> tuple[float, Mapping] | None:
-    scored = [
-        (float(r["verified_precision"]), r)
-        for r in rules
-        if _percent(r.get("verified_precision")) is not None
-    ]
-    return max(scored, key=lambda s: s[0]) if scored else None
-
-
-def _rounds(summary: Mapping) -> str:
-    out = ['<section id="rules"><h2>3. The rules</h2>']
-    rounds = [r for r in summary.get("rounds") or [] if isinstance(r, Mapping)]
-    if not rounds:
-        out.append("<p>No rules were mined.</p></section>")
+def _design(summary: DesignSummary, cols: Mapping) -> str:
+    out = ['<section id="design"><h2>3. The chosen design</h2>']
+    pick = summary.chosen
+    if pick is None:
+        out.append("<p>Every simulation failed: there is no design to show.</p></section>")
         return "".join(out)
     out.append(
-        '<p class="note">Estimate: the precision the miner expects on new designs inside the '
-        "rule, with its 95&nbsp;% interval, from database rows its trees did not train on. "
-        "Train and test precision: the share of database designs inside the "
-        "rule that meet the target. Verified precision: the share of new designs sampled inside "
-        "the rule and simulated that meet it, with its 95&nbsp;% interval and the number of "
-        "new designs n.</p>"
+        f"<p>{_esc(pick.source)}; simulated as <code>{_esc(pick.origin)}</code>, status "
+        f"<code>{_esc(pick.status)}</code>.</p>"
     )
-    chosen_text = (summary.get("rule") or {}).get("rule")
-    changes = []
-    previous, previous_round = None, None
-    for k, rd in enumerate(rounds):
-        number = rd.get("round", k)
-        rules = [r for r in rd.get("rules") or [] if isinstance(r, Mapping)]
-        head = f"Round {_num(number)}"
-        if _is_number(rd.get("rows")):
-            head += f" ({_num(rd['rows'])} designs in the database)"
-        out.append(f"<h3>{head}</h3>")
-        if rules:
+    if pick.rule is not None:
+        out.append(
+            f'<p class="headline">Its rule, {_esc(pick.rule.label)}: '
+            f"<code>{_esc(pick.rule.text)}</code><br>verified precision "
+            f"{_verified(pick.rule)}</p>"
+        )
+    try:
+        in_target = set(parse_target(summary.target).columns)
+    except TargetError:
+        in_target = set()
+    body = [
+        '<table class="design-table"><thead><tr><th>quantity</th><th>value</th></tr></thead><tbody>'
+    ]
+    for group, values in (("design features", pick.features), ("performance", pick.performance)):
+        body.append(f'<tr class="group"><th colspan="2">{_esc(group)}</th></tr>')
+        for name, v in values.items():
+            cls = ' class="in-target"' if name in in_target else ""
+            body.append(
+                f"<tr{cls}><td>{_esc(name)}</td>"
+                f'<td class="num">{_shown(v, cols.get(name))}</td></tr>'
+            )
+    body.append("</tbody></table>")
+    out.append("".join(body))
+    if in_target:
+        out.append('<p class="note">Quantities in bold appear in the target.</p>')
+    out.append("<h3>Margins to the target</h3>")
+    out.append(
+        _table(
+            ["condition", "value", "margin", "", "status"],
+            _condition_rows(pick, summary.target, cols),
+            "margins",
+        )
+    )
+    out.append("</section>")
+    return "".join(out)
+
+
+def _rounds(summary: DesignSummary, cols: Mapping) -> str:
+    out = ['<section id="rules"><h2>4. The rules</h2>']
+    if not summary.rounds:
+        out.append("<p>No rules were mined (the run stopped after its pilot).</p></section>")
+        return "".join(out)
+    out.append(
+        '<p class="note">Four precisions, each the share of designs inside the rule that meet the '
+        "target: <b>estimate</b>, what the miner expects on new designs (95&nbsp;% interval), "
+        "from database rows its trees did not train on; <b>train</b>, on the database rows the "
+        "rule was mined from; <b>held-out</b>, on the database rows kept out of mining (the "
+        "test split); <b>verified</b>, on new designs sampled inside the rule and simulated, "
+        "with its 95&nbsp;% interval and the number n of new designs. Only the verified "
+        "precision decides.</p>"
+    )
+    chosen = summary.chosen.rule if summary.chosen is not None else None
+    changes, previous, previous_round = [], None, None
+    for rd in summary.rounds:
+        head = (
+            f"Round {rd.index}: mined from {rd.rows} designs"
+            + (f" ({rd.failed} failed simulations left out)" if rd.failed else "")
+            + f", {rd.meeting} meeting the target"
+        )
+        out.append(f"<h3>{_esc(head)}</h3>")
+        if rd.rules:
             rows, classes = [], []
-            for r in rules:
+            for r in rd.rules:
                 rows.append(
                     [
-                        (_num(number), "num"),
-                        (_num(r.get("rank")), "num"),
-                        f"<code>{_esc(r.get('rule', ''))}</code>",
+                        (_num(r.round), "num"),
+                        (_num(r.rank), "num"),
+                        f"<code>{_esc(r.text)}</code>",
                         (_estimate(r), "num"),
-                        (_precision(r.get("train_precision")), "num"),
-                        (_precision(r.get("test_precision")), "num"),
+                        (_precision(r.train_precision), "num"),
+                        (_precision(r.test_precision), "num"),
                         _verified(r),
                     ]
                 )
-                is_chosen = chosen_text is not None and r.get("rule") == chosen_text
+                is_chosen = chosen is not None and (r.round, r.rank) == (chosen.round, chosen.rank)
                 classes.append("chosen" if is_chosen else "")
-            header = ["round", "rank", "rule", "estimate", "train precision", "test precision"]
-            out.append(_table(header + ["verified precision"], rows, "rules", classes))
+            header = [
+                "round",
+                "rank",
+                "rule",
+                "estimate",
+                "train precision",
+                "held-out precision",
+                "verified precision",
+            ]
+            out.append(_table(header, rows, "rules", classes))
         else:
-            out.append("<p>No rule reached the miner's precision and support thresholds.</p>")
-        best = _best(rules)
-        if best is None:
+            out.append(f"<p>{_esc(rd.note) or 'No rule reached the miner thresholds.'}</p>")
+        best = rd.best
+        if best is None or best.precision is None:
             line = "no rule verified"
         else:
-            p, r = best
-            line = f"best verified precision {_percent(p)} (rank {_num(r.get('rank'))})"
+            p = best.precision
+            line = f"best verified precision {_percent(p)} (rank {best.rank})"
             if previous is not None:
                 delta = 100 * (p - previous)
                 if abs(delta) < 0.05:
-                    line += f", unchanged from round {_num(previous_round)}"
+                    line += f", unchanged from round {previous_round}"
                 else:
                     word = "up" if delta > 0 else "down"
-                    line += f", {word} {abs(delta):.1f} points from round {_num(previous_round)}"
-            previous, previous_round = p, number
-        changes.append(f"<li>Round {_num(number)}: {line}.</li>")
-    if chosen_text is not None:
-        out.append('<p class="note">Highlighted: the chosen rule.</p>')
+                    line += f", {word} {abs(delta):.1f} points from round {previous_round}"
+            previous, previous_round = p, rd.index
+        changes.append(f"<li>Round {rd.index}: {line}.</li>")
+    if chosen is not None:
+        out.append(
+            f'<p class="note">Highlighted: the chosen design\'s rule, {_esc(chosen.label)}'
+            ", the best verified rule of all rounds.</p>"
+        )
     out.append("<h3>How the verified precision changed</h3><ul>" + "".join(changes) + "</ul>")
     out.append("</section>")
     return "".join(out)
@@ -383,80 +679,8 @@ def _margin_bar(m: float) -> str:
     return f'<span class="bar {cls}" style="width:{width:.0f}px"></span>'
 
 
-def _design(summary: Mapping, units: Mapping) -> str:
-    out = ['<section id="design"><h2>4. The chosen design</h2>']
-    rule = summary.get("rule") or {}
-    verified = _verified(rule, summary.get("verified_precision"))
-    if rule.get("rule"):
-        out.append(
-            f'<p class="headline">Chosen rule: <code>{_esc(rule["rule"])}</code><br>'
-            f"verified precision: {verified}</p>"
-        )
-    try:
-        in_target = set(parse_target(str(summary["target"])).columns)
-    except TargetError:
-        in_target = set()
-    rows, classes = [], []
-    for group, key in (("design features", "features"), ("performance", "performance")):
-        values = summary[key] or {}
-        rows.append(None)
-        classes.append(group)
-        for name, v in values.items():
-            u = _unit(units.get(name))
-            rows.append([_esc(name), (_value(v), "num"), _esc(u)])
-            classes.append("in-target" if name in in_target else "")
-    body = [
-        '<table class="design-table"><thead><tr><th>quantity</th><th>value</th>'
-        "<th>unit</th></tr></thead><tbody>"
-    ]
-    for row, cls in zip(rows, classes, strict=True):
-        if row is None:
-            body.append(f'<tr class="group"><th colspan="3">{_esc(cls)}</th></tr>')
-            continue
-        cells = "".join(
-            f'<td class="{c[1]}">{c[0]}</td>' if isinstance(c, tuple) else f"<td>{c}</td>"
-            for c in row
-        )
-        body.append(f'<tr class="{cls}">{cells}</tr>' if cls else f"<tr>{cells}</tr>")
-    body.append("</tbody></table>")
-    out.append("".join(body))
-    if in_target:
-        out.append('<p class="note">Quantities in bold appear in the target.</p>')
-    margins = summary.get("margins") or {}
-    if margins:
-        out.append("<h3>Margins to the target</h3>")
-        rows = []
-        for cond, m in margins.items():
-            m = float(m) if _is_number(m) else math.nan
-            if math.isnan(m):
-                state = _MISSING
-            else:  # == and != conditions have an infinite margin: met or missed, no size
-                state = (
-                    '<span class="met">met</span>'
-                    if m >= 0
-                    else ('<span class="missed">missed</span>')
-                )
-            finite = math.isfinite(m)
-            rows.append(
-                [
-                    f"<code>{_esc(cond)}</code>",
-                    (f"{m:+.3g}" if finite else _MISSING, "num"),
-                    _margin_bar(m) if finite else "",
-                    state,
-                ]
-            )
-        out.append(_table(["condition", "margin", "", "status"], rows, "margins"))
-        out.append(
-            '<p class="note">Margin: (value &minus; threshold) / |threshold| for a lower bound '
-            "(the other way round for an upper bound): 0 on the threshold, 0.1 = 10&nbsp;% to "
-            "spare, negative when the condition is missed.</p>"
-        )
-    out.append("</section>")
-    return "".join(out)
-
-
-def _pictures(folder: Path, summary: Mapping) -> tuple[str, int]:
-    images = summary.get("images") or {}
+def _pictures(folder: Path, summary: DesignSummary) -> tuple[str, int]:
+    images = summary.images
     out = ['<section id="pictures"><h2>5. Pictures</h2>']
     order = [k for k in _CAPTIONS if k in images] + [k for k in images if k not in _CAPTIONS]
     n = 0
@@ -485,8 +709,8 @@ def _pictures(folder: Path, summary: Mapping) -> tuple[str, int]:
     return "".join(out), n
 
 
-def _files(folder: Path, summary: Mapping) -> str:
-    files = summary.get("files") or {}
+def _files(folder: Path, summary: DesignSummary) -> str:
+    files = summary.files
     out = ['<section id="files"><h2>6. Files</h2>']
     if not files:
         out.append("<p>No files were written.</p></section>")
@@ -504,7 +728,7 @@ def _files(folder: Path, summary: Mapping) -> str:
             f"{missing}</li>"
         )
     out.append("</ul>")
-    notes = [str(w) for w in summary.get("warnings") or () if w]
+    notes = [str(w) for w in summary.warnings if w]
     if notes:
         out.append('<p><strong>Notes on the files:</strong></p><ul class="files">')
         out.extend(f"<li>{_esc(w)}</li>" for w in notes)
@@ -513,59 +737,90 @@ def _files(folder: Path, summary: Mapping) -> str:
     return "".join(out)
 
 
-def _timings(summary: Mapping) -> str:
-    timings = summary.get("timings") or {}
-    out = ['<section id="timings"><h2>7. Time per stage</h2>']
-    if not timings:
+_ORIGINS = {
+    "database": "base sample",
+    "refine": "refinement rounds",
+    "verify": "verification of rules",
+    "earlier": "earlier runs (rules since changed)",
+}
+
+
+def _timings(summary: DesignSummary) -> str:
+    out = ['<section id="timings"><h2>7. Designs simulated and time spent</h2>']
+    db = summary.database
+    if db:
+        by = db.get("by_origin") or {}
+        parts = ", ".join(f"{_ORIGINS.get(k, k)} {_num(v)}" for k, v in by.items())
+        line = f"{_num(db.get('rows'))} designs simulated in this folder"
+        if parts:
+            line += f" ({parts})"
+        if db.get("failed"):
+            line += f"; {_num(db['failed'])} of them failed (left out of mining and choosing)"
+        if db.get("path"):
+            href = _esc(quote(str(db["path"]).replace("\\", "/"), safe="/"))
+            line += f'; stored in <a href="{href}">{_esc(db["path"])}</a>'
+        out.append(
+            f"<p>{line}. Every one of them is a candidate; each round mined from the "
+            "designs simulated before it.</p>"
+        )
+    t = summary.timings
+    if t is None:
         out.append("<p>No timings were recorded.</p></section>")
         return "".join(out)
-    rows = [[_esc(_STAGES.get(k, k)), (_seconds(t), "num")] for k, t in timings.items()]
-    finite = [float(t) for t in timings.values() if _is_number(t) and math.isfinite(float(t))]
-    rows.append(["<b>total</b>", (f"<b>{_seconds(sum(finite))}</b>", "num")])
-    out.append(_table(["stage", "wall time"], rows, "timings"))
+    keys = list(dict.fromkeys([*t.this_run, *t.all_runs]))
+    rows = [
+        [
+            _esc(_STAGES.get(k, k)),
+            (_seconds(t.this_run.get(k, 0.0)), "num"),
+            (_seconds(t.all_runs.get(k, 0.0)), "num"),
+        ]
+        for k in keys
+    ]
+    rows.append(
+        [
+            "<b>total</b>",
+            (f"<b>{_seconds(sum(t.this_run.values()))}</b>", "num"),
+            (f"<b>{_seconds(sum(t.all_runs.values()))}</b>", "num"),
+        ]
+    )
+    runs = "1 run" if t.runs == 1 else f"all {t.runs} runs"
+    out.append(_table(["stage", "this run", runs], rows, "timings"))
+    out.append(
+        '<p class="note">Wall time per stage. A resumed run finds its simulations on '
+        "disk: its own time is short, the total over all runs is the cost.</p>"
+    )
     out.append("</section>")
     return "".join(out)
 
 
-def _check(summary) -> None:
-    if not isinstance(summary, Mapping):
-        raise TypeError(f"the summary must be a mapping, got {type(summary).__name__}")
-    missing = [k for k in _REQUIRED if k not in summary]
-    if missing:
-        raise ValueError(f"the summary lacks {', '.join(missing)}")
-    if not isinstance(summary["scenario"], Mapping):
-        raise ValueError("summary['scenario'] must be a mapping")
-    for key in ("features", "performance"):
-        if not isinstance(summary[key], Mapping):
-            raise ValueError(f"summary[{key!r}] must map names to values")
-
-
-def report_page_html(folder, summary: Mapping) -> str:
+def report_page_html(folder, summary: DesignSummary | Mapping) -> str:
     """The report page as one HTML string (images read from files relative to ``folder``).
 
     Parameters
     ----------
     folder : path
         The design folder; the summary's ``images`` and ``files`` are relative to it.
-    summary : mapping
-        The design summary: ``scenario``, ``target``, ``features`` and ``performance`` are
-        required; ``database``, ``rounds``, ``rule``, ``verified_precision``, ``units``,
-        ``margins``, ``files``, ``images`` and ``timings`` are optional.
+    summary : DesignSummary or mapping
+        The design summary, or its JSON (``design.json``), validated by
+        :meth:`DesignSummary.from_json`.
 
     Returns
     -------
     str
     """
-    _check(summary)
+    if not isinstance(summary, DesignSummary):
+        summary = DesignSummary.from_json(summary)
     folder = Path(folder)
-    units = _units(summary)
-    name = summary["scenario"].get("name") or "design"
+    cols = _columns(summary)
+    name = summary.scenario.get("name") or "design"
     pictures, n_images = _pictures(folder, summary)
     sections = [
-        _problem(summary, units),
-        _target(summary),
-        _rounds(summary),
-        _design(summary, units),
+        _answer(summary, cols),
+        _alternatives(summary, cols),
+        _problem(summary, cols),
+        _reach(summary, cols),
+        _design(summary, cols),
+        _rounds(summary, cols),
         pictures,
         _files(folder, summary),
         _timings(summary),
@@ -573,20 +828,22 @@ def report_page_html(folder, summary: Mapping) -> str:
     nav = " ".join(
         f'<a href="#{a}">{t}</a>'
         for a, t in (
+            ("answer", "answer"),
+            ("alternatives", "alternatives"),
             ("problem", "problem"),
-            ("target", "target"),
-            ("rules", "rules"),
+            ("reach", "what designs reach"),
             ("design", "chosen design"),
+            ("rules", "rules"),
             ("pictures", "pictures"),
             ("files", "files"),
-            ("timings", "timings"),
+            ("timings", "time"),
         )
     )
     return (
         "<!DOCTYPE html>\n"
         '<html lang="en"><head><meta charset="utf-8">'
         '<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>holofold design: {_esc(name)}</title><style>{_CSS}</style></head>\n"
+        f"<title>holofold design: {_esc(name)}</title><style>{_CSS}{view_css}</style></head>\n"
         f'<body data-images-total="{n_images}">\n'
         f"<header><h1>Design report: {_esc(name)}</h1>"
         f'<p class="sub">made by <code>holofold design</code></p><nav>{nav}</nav></header>\n'
@@ -595,14 +852,14 @@ def report_page_html(folder, summary: Mapping) -> str:
     )
 
 
-def write_report_page(folder, summary: Mapping) -> Path:
+def write_report_page(folder, summary: DesignSummary | Mapping) -> Path:
     """Write ``folder/report.html`` atomically: the whole page is built before anything is written.
 
     Parameters
     ----------
     folder : path
         An existing design folder (images and files named in the summary are relative to it).
-    summary : mapping
+    summary : DesignSummary or mapping
         See :func:`report_page_html`.
 
     Returns
@@ -617,5 +874,6 @@ def write_report_page(folder, summary: Mapping) -> Path:
     OSError
         The folder does not exist.
     """
+    page = report_page_html(folder, summary)
     path = check_output_path(Path(folder) / "report.html", "report page")
-    return write_text(path, report_page_html(folder, summary))
+    return write_text(path, page)

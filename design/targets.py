@@ -278,6 +278,12 @@ def _conditions(node, out: list) -> None:
         out.extend(_pairs(node))
 
 
+def _has_or(node) -> bool:
+    if isinstance(node, _BoolOp):
+        return node.op == "|" or any(_has_or(a) for a in node.args)
+    return False
+
+
 def _render(node) -> str:
     if isinstance(node, _BoolOp):
         inner = f" {node.op} ".join(
@@ -343,6 +349,12 @@ class Target:
         out: list = []
         _conditions(self._tree, out)
         return tuple(f"{_text(a)} {op} {_text(b)}" for a, op, b in out)
+
+    @property
+    def conjunctive(self) -> bool:
+        """True when every condition must hold (no ``|``): the target is missed whenever one
+        condition is."""
+        return _has_or(self._tree) is False
 
     def margins(self, frame) -> dict[str, np.ndarray]:
         """Per condition, the signed margin of every row, normalised by its threshold.

@@ -8,7 +8,9 @@ interval: the rule's precision on designs it has never seen.
 
 from __future__ import annotations
 
-import math
+import hashlib
+import json
+import tempfile
 from collections.abc import Mapping, Sequence
 from contextlib import nullcontext
 from dataclasses import dataclass
@@ -17,12 +19,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.design.batches import grow
+from holofold.design.rounds import Counts, wilson
 from holofold.design.row_limits import check_on_invalid, resolve_row_timeout
 from holofold.design.row_status import failed_rows
 from holofold.design.rules.record import Rule
-from holofold.design.runner import dask_scheduler, evaluate_designs
+from holofold.design.runner import dask_scheduler
 from holofold.design.sampling import sample_designs
 from holofold.design.scenarios import Scenario, load_scenario
+from holofold.design.store import build_database
 from holofold.design.tables import write_table
 from holofold.design.targets import parse_target
 from holofold.geometry.outputs import write_json
@@ -31,6 +36,7 @@ __all__ = [
     "as_rule",
     "rule_ranges",
     "rule_mask",
+    "rule_key",
     "verify_rule",
     "verify_rules",
     "write_verification",
@@ -83,6 +89,14 @@ def rule_ranges(scenario: Scenario, rule: Rule | Mapping) -> dict:
     return out
 
 
+def rule_key(rule: Rule | Mapping) -> str:
+    """8 hex digits naming a rule's box (its SI bounds as canonical JSON): the folder of its
+    verification designs, so a changed rule never meets another rule's designs."""
+    bounds = {c.feature: c.to_json() for c in as_rule(rule).conditions}
+    text = json.dumps(bounds, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
 def rule_mask(table: pd.DataFrame, rule: Rule | Mapping) -> np.ndarray:
     """(n,) bool: the rows of ``table`` inside ``rule`` (:meth:`Rule.mask`)."""
     return as_rule(rule).mask(table)
@@ -119,14 +133,12 @@ class Verification:
 
     @property
     def interval(self) -> tuple[float, float]:
-        n, p, z = self.n_ok, self.precision, 1.959964
-        if not n:
-            return (float("nan"), float("nan"))
-        centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-        half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-        lo = 0.0 if self.n_meeting == 0 else max(0.0, centre - half)
-        hi = 1.0 if self.n_meeting == n else min(1.0, centre + half)
-        return (lo, hi)  # exact at p = 0 and p = 1 (no round-off past the estimate)
+        """95 % Wilson interval (exact at p = 0 and p = 1; NaN when nothing simulated)."""
+        return wilson(self.n_meeting, self.n_ok)
+
+    @property
+    def counts(self) -> Counts:
+        return Counts(self.n_ok, self.n_failed, self.n_meeting)
 
     def summary(self) -> dict:
         """JSON-ready counts, precision and interval (None where no design simulated)."""
@@ -154,42 +166,62 @@ class Verification:
 def verify_rule(
     scenario: Scenario | str,
     rule: Rule | Mapping,
-    target: str,
+    target,
     n: int = 50,
     *,
     seed: int = 0,
+    folder: str | Path | None = None,
     workers: int = 1,
     progress: bool | None = None,
     scheduler: str | None = None,
     on_invalid: str = "skip",
     row_timeout: float | str | None = None,
 ) -> Verification:
-    """Simulate ``n`` fresh designs inside ``rule`` and count those meeting ``target``.
+    """Simulate ``n`` fresh designs inside ``rule`` and count those meeting ``target`` (an
+    expression or a :class:`~holofold.design.targets.Target`).
 
-    ``workers``, ``progress``, ``scheduler`` (a Dask scheduler address or ``"local"``),
-    ``on_invalid`` and ``row_timeout`` are passed to
-    :func:`holofold.design.runner.evaluate_designs`: with ``on_invalid="skip"`` fresh designs
-    the scenario's check refuses (a box reaching past a validity limit) are failed rows, as
-    are rows past their time limit; failed rows count in ``n_failed``, not in the precision.
+    The designs are simulated into resumable databases in ``folder``, in batches
+    ``{a:06d}-{b:06d}`` (:mod:`~holofold.design.batches`): a second call resumes, and a larger
+    ``n`` adds a batch (design i depends on ``seed`` and i alone). Without ``folder`` a
+    temporary one is used and removed. ``workers``, ``progress``, ``scheduler`` (a Dask
+    scheduler address or ``"local"``), ``on_invalid`` and ``row_timeout`` are passed to
+    :func:`holofold.design.store.build_database`: with ``on_invalid="skip"`` fresh designs the
+    scenario's check refuses (a box reaching past a validity limit) are failed rows, as are
+    rows past their time limit; failed rows count in ``n_failed``, not in the precision.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
-    tgt = parse_target(target, scenario.performance_names)
-    designs = sample_designs(scenario, n, seed=seed, ranges=rule_ranges(scenario, rule))
-    res = evaluate_designs(
-        scenario, designs, workers=workers, progress=progress, scheduler=scheduler,
-        on_invalid=on_invalid, row_timeout=row_timeout,
-    )  # fmt: skip
-    return Verification.of(res, tgt)
+    tgt = parse_target(target, scenario.performance_names) if isinstance(target, str) else target
+    ranges = rule_ranges(scenario, rule)
+
+    def sample(start: int, count: int) -> pd.DataFrame:
+        return sample_designs(scenario, count, seed=seed, start=start, ranges=ranges)
+
+    def simulate(designs: pd.DataFrame, path: Path) -> pd.DataFrame:
+        return build_database(
+            scenario,
+            designs,
+            path,
+            workers=workers,
+            progress=progress,
+            scheduler=scheduler,
+            on_invalid=on_invalid,
+            row_timeout=row_timeout,
+        )
+
+    with tempfile.TemporaryDirectory() if folder is None else nullcontext(folder) as where:
+        res, _ = grow(Path(where), int(n), sample, simulate)
+    return Verification.of(res.iloc[: int(n)], tgt)
 
 
 def verify_rules(
     scenario: Scenario | str,
     rules: Sequence[Rule | Mapping],
-    target: str,
+    target,
     n: int = 50,
     *,
     seed: int = 0,
+    folder: str | Path | None = None,
     workers: int = 1,
     progress: bool | None = None,
     scheduler: str | None = None,
@@ -199,16 +231,18 @@ def verify_rules(
     """:func:`verify_rule` for each rule (a :class:`Rule` or its record), in order.
 
     Every rule is checked against the scenario before anything is simulated; rule ``i``
-    (1-based) samples with seed ``seed + i``. A local Dask cluster (``scheduler="local"``) is
+    (1-based) samples with seed ``seed + i`` into ``folder/rule{i}-{rule_key(rule)}`` (a
+    changed rule gets a folder of its own). A local Dask cluster (``scheduler="local"``) is
     started once for all rules. ``on_invalid`` and ``row_timeout`` as in :func:`verify_rule`.
+    This is the one verification: ``holofold verify`` and the design loop both run it.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
-    parse_target(target, scenario.performance_names)
+    tgt = parse_target(target, scenario.performance_names) if isinstance(target, str) else target
     check_on_invalid(on_invalid)
     resolve_row_timeout(scenario.row_timeout, row_timeout)
-    if int(n) < 1:
-        raise ValueError(f"n = {n} designs per rule must be >= 1")
+    if isinstance(n, bool) or int(n) != n or int(n) < 1:
+        raise ValueError(f"n = {n} designs per rule must be a whole number >= 1")
     rules = [as_rule(r) for r in rules]
     for r in rules:
         rule_ranges(scenario, r)
@@ -218,15 +252,16 @@ def verify_rules(
             verify_rule(
                 scenario,
                 r,
-                target,
+                tgt,
                 n,
                 seed=seed + i,
+                folder=None if folder is None else Path(folder) / f"rule{i}-{rule_key(r)}",
                 workers=1 if address else workers,
                 progress=progress,
                 scheduler=address,
                 on_invalid=on_invalid,
                 row_timeout=row_timeout,
-            )  # fmt: skip
+            )
             for i, r in enumerate(rules, start=1)
         ]
 

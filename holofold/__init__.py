@@ -8,8 +8,9 @@ fabricated. Four layers, each with its own public face, import one way only::
     holofold.mechanics  bar-and-hinge simulation, electro-thermal actuation, modes
     holofold.design     scenarios, databases, design rules, verification
 
-The names a user needs first are here too (imported on first use, so ``import holofold``
-is cheap). SI units throughout.
+The layers are attributes (``hf.design``, ``hf.geometry``, ...) and the names a user needs
+first are here too, all imported on first use, so ``import holofold`` is cheap. SI units
+throughout.
 
 Quickstart: fit the paper's arch to a half circle, simulate one design, build a small
 database and mine a rule from it.
@@ -31,9 +32,11 @@ database and mine a rule from it.
 
 import lazy_loader
 
-#: the names a user needs first, by the layer whose face offers them (imported on first use)
+#: the four layers, and the names a user needs first by the layer whose face offers them
+#: (each imported on first use)
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
+    submodules=["geometry", "fitting", "mechanics", "design"],
     submod_attrs={
         "geometry": ["CreasePattern", "miura_sheet", "tmp_sheet", "export"],
         "fitting": [
@@ -54,6 +57,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "ForestRuleMiner",
             "mine_rules",
             "verify_rules",
+            "run_design",
+            "load_scenario",
         ],
     },
 )

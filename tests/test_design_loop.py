@@ -159,8 +159,9 @@ def test_design_loop_on_a_users_curve_writes_a_verified_design(designed):
             assert rule["verified_n"] + rule["verified_failed"] == 10
             lo, hi = rule["verified_95ci"]
             assert lo <= rule["verified_precision"] <= hi
-            lo, hi = rule["estimate_95ci"]  # what the miner expects, shown beside it
-            assert 0 <= lo <= rule["estimate"] <= hi <= 1 and rule["estimate_rows"] > 0
+            est = rule["estimate"]  # what the miner expects, shown beside it
+            lo, hi = est["interval"]
+            assert 0 <= lo <= est["precision"] <= hi <= 1 and est["rows"] > 0
     # the chosen design lies inside the chosen rule
     row = pd.DataFrame([s["features"]])
     assert rule_mask(row, s["rule"]["bounds"])[0]
@@ -175,7 +176,8 @@ def test_design_loop_on_a_users_curve_writes_a_verified_design(designed):
     with open(folder / "out" / "files" / "strip.stl", "rb") as fh:
         assert b"mm" in fh.read(80)  # meshes in mm by default, as slicers read them
     stages = [line.split("]")[0] + "]" for line in said if line.startswith("[")]
-    assert stages[:3] == ["[database]", "[mine]", "[verify]"] and "[refine]" in stages
+    assert stages[:2] == ["[database]", "[database]"]  # the pilot, then the rest
+    assert stages[2:4] == ["[mine]", "[verify]"] and "[refine]" in stages
     assert stages[-2:] == ["[choose]", "[files]"]
 
 
@@ -203,7 +205,14 @@ def test_design_loop_resumes_without_simulating_again(designed):
     assert [p.stat().st_mtime_ns for p in chunks] == stamps  # nothing re-simulated
     assert sorted((folder / "out" / "database").rglob("part-*.parquet")) == chunks
     assert again.features == out.features and again.summary["rounds"] == out.summary["rounds"]
-    assert again.summary["timings"]["database"] < 0.5 * max(out.summary["timings"]["database"], 1)
+    t0, t1 = out.summary["timings"], again.summary["timings"]
+    assert t1["this_run"]["database"] < 0.5 * max(t0["this_run"]["database"], 1)
+    # the totals add up over the two runs, and the counts agree
+    assert t1["runs"] == t0["runs"] + 1
+    assert t1["all_runs"]["database"] == pytest.approx(
+        t0["all_runs"]["database"] + t1["this_run"]["database"], abs=2e-3
+    )
+    assert again.summary["database"] == out.summary["database"]
 
 
 @pytest.mark.slow
@@ -215,7 +224,9 @@ def test_more_samples_extend_the_database_instead_of_rebuilding_it(designed, tmp
     shutil.copytree(folder / "out" / "database", db)
     res = run_design(folder / "my_arch.toml", TARGET, tmp_path / "o", samples=120, db=db,
                      verify=4, top=1, workers=2, progress=False, files=False)  # fmt: skip
-    assert (db / "base-000000-000100").is_dir() and (db / "base-000100-000120").is_dir()
+    # the pilot's batch, the rest of the first run's sample, and the new batch
+    for batch in ("base-000000-000050", "base-000050-000100", "base-000100-000120"):
+        assert (db / batch).is_dir(), batch
     base = res.table[res.table["origin"] == "database"]
     assert len(base) == 120 and base["sample"].tolist() == list(range(120))
 
@@ -305,9 +316,12 @@ def test_a_rare_target_is_refined_around_its_hits_before_any_rule_exists(tmp_pat
     assert len(refined) == 60 and (refined["a"] > 0.96).sum() >= 30 and refined["a"].min() > 0.7
     assert r1["rules"] and res.summary["verified_precision"] >= 0.9
     assert res.performance["double"] > 1.94
-    with pytest.raises(ValueError, match="try more --rounds"):
-        run_design(cheap, "double > 1.94", tmp_path / "p", samples=100, verify=5,
-                   workers=1, progress=False, files=False)  # fmt: skip
+    # without rounds no rule is found, and the answer is the best design that meets the target
+    once = run_design(cheap, "double > 1.94", tmp_path / "p", samples=100, verify=5,
+                      workers=1, progress=False, files=False)  # fmt: skip
+    assert once.record.answer == "designs" and once.met
+    assert once.performance["double"] == once.table["double"].max()
+    assert once.record.headline.startswith("No rule was found for this target.")
 
 
 def test_the_rule_box_chart_shows_the_rules_thresholds():
@@ -322,3 +336,204 @@ def test_the_rule_box_chart_shows_the_rules_thresholds():
     texts = [t.get_text() for t in fig.axes[0].texts]
     lo = miner.rule_bounds(0)[0][0]  # in m: shown in mm, 3 digits
     assert f"> {float(f'{lo * 1e3:.3g}'):g}" in texts and any(t.endswith(" mm") for t in texts)
+
+
+# ---- always an answer, the objective, buildable, extending a folder -------------------------
+
+
+def _two(row):
+    return {"double": 2.0 * row["a"], "mass": row["a"] + row["b"],
+            "overlap": max(0.0, row["b"] - 0.8) * 1e-6, "status": CONVERGED}  # fmt: skip
+
+
+def _cheap_scenario(evaluate=_two, performance=("double", "mass", "overlap")):
+    from holofold.design import Column, Scenario
+
+    units = {"double": "m", "mass": "kg", "overlap": "m^3"}
+    return Scenario(
+        name="cheap2", description="cheap", check=lambda row: [], evaluate=evaluate,
+        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
+        performance=tuple(Column(n, units[n]) for n in performance),
+    )  # fmt: skip
+
+
+def _rule(round_, rank, bounds, k, n=10):
+    from holofold.design import Counts, Rule, VerifiedRule
+
+    return VerifiedRule(round_, Rule.from_bounds(bounds, rank), verified=Counts(n, 0, k))
+
+
+def test_choose_takes_the_best_verified_rule_of_all_rounds_and_the_objective():
+    from holofold.design import choose, parse_objective
+
+    t = parse_target("double > 1")
+    df = pd.DataFrame({"a": [0.55, 0.6, 0.9, 0.95, 0.7], "b": [0.5, 0.1, 0.3, 0.9, 0.2]})
+    df = pd.DataFrame([{**r, **_two(r)} for r in df.to_dict("records")])
+    low = {"a": {"gt": 0.5, "le": 0.75}}
+    high = {"a": {"gt": 0.85, "le": None}}
+    rules = [_rule(0, 1, low, 9), _rule(1, 1, high, 7)]  # round 0's rule is the better one
+    margin = choose(df, t, parse_objective(None, df.columns), rules)
+    assert margin.kind == "rule" and margin.chosen.rule is rules[0]
+    assert margin.chosen.label == 4  # inside round 0's rule, a = 0.7: the largest margin
+    light = choose(df, t, parse_objective("min mass", df.columns), rules)
+    assert light.chosen.label == 1 and light.chosen.score == pytest.approx(0.7)
+    # alternatives: the best of each rule and overall, each design once
+    sources = [c.source for c in margin.alternatives]
+    assert sources[0] == "best inside rule 1 of round 0"
+    assert sources[1].startswith("best inside rule 1 of round 1")
+    assert "best of all simulated designs" in sources[1]  # a = 0.9: the overall best margin
+    # a design whose panels overlap (row 3, b = 0.9) is never chosen unless allowed
+    assert 3 not in [c.label for c in margin.alternatives[:2]]
+    allowed = choose(df, t, parse_objective("max double", df.columns), rules, allow_overlap=True)
+    assert allowed.alternatives[-1].label == 3 and allowed.alternatives[-1].buildable is False
+    strict = choose(df, t, parse_objective("max double", df.columns), rules)
+    assert strict.left_out_overlap == 1 and "--allow-overlap" in strict.headline
+    assert any("overlapping panels were allowed" in c.source for c in strict.alternatives)
+
+
+def test_without_a_qualifying_rule_or_a_meeting_design_the_answer_is_still_there():
+    from holofold.design import choose, parse_objective
+
+    t = parse_target("double > 1.5 & mass < 1")
+    df = pd.DataFrame([{**r, **_two(r)} for r in [{"a": 0.8, "b": 0.1}, {"a": 0.9, "b": 0.3},
+                                                  {"a": 0.6, "b": 0.1}]])  # fmt: skip
+    weak = [_rule(0, 1, {"a": {"gt": 0.7, "le": None}}, 2)]  # verified 0.2: not an answer
+    ans = choose(df, t, parse_objective(None, df.columns), weak)
+    assert ans.kind == "designs" and ans.chosen.label == 0
+    assert "no verified rule reached 50 %" in ans.headline.lower()
+    far = choose(df, parse_target("double > 4"), parse_objective(None, df.columns), weak)
+    assert far.kind == "nearest" and far.chosen.label == 1 and not far.chosen.meets
+    assert "misses double > 4 by 55 %" in far.headline
+    df["status"] = [Status.failed("boom")] * 3
+    assert choose(df, t, parse_objective(None, df.columns), []).kind == "none"
+
+
+def test_an_unreachable_target_stops_after_the_pilot_with_an_answer(tmp_path):
+    sc = _cheap_scenario()
+    said = []
+    res = run_design(sc, "double > 3", tmp_path / "o", samples=200, pilot=30, verify=5,
+                     workers=1, progress=False, say=said.append)  # fmt: skip
+    s = json.loads((tmp_path / "o" / "design.json").read_text())
+    assert s["pilot"]["stopped"] and s["pilot"]["rows"] == 30 and s["rounds"] == []
+    assert "no pilot design meets double > 3" in s["pilot"]["reason"]
+    assert s["answer"] == "nearest" and not s["meets_target"] and len(res.table) == 30
+    d = {x["name"]: x for x in s["distributions"]}["double"]
+    assert d["rows"] == 30 and d["quantiles"]["100%"] < 2.0  # what the designs reach
+    page = (tmp_path / "o" / "report.html").read_text()
+    assert "The run stopped there" in page and 'class="distributions"' in page
+    # a target met jointly by none but each condition by some goes on (a rare target)
+    rare = run_design(sc, "double > 1.9 & mass < 1.0", tmp_path / "r", samples=60, pilot=30,
+                      verify=5, workers=1, progress=False, files=False)  # fmt: skip
+    assert not rare.record.pilot["stopped"] and len(rare.table) >= 60
+
+
+def test_growing_samples_rounds_and_verify_extends_the_folder(tmp_path):
+    sc = _cheap_scenario()
+    kw = dict(refine=40, top=1, workers=1, progress=False, files=False, pilot=0)
+    out = tmp_path / "o"
+    first = run_design(sc, "double > 1.6", out, samples=100, rounds=1, verify=10, **kw)
+    refined = sorted(p.name for p in (out / "database").iterdir() if p.name.startswith("refine"))
+    assert len(refined) == 1 and refined[0].startswith("refine-1-")
+    more = run_design(sc, "double > 1.6", out, samples=150, rounds=2, verify=15, **kw)
+    names = sorted(p.name for p in (out / "database").iterdir())
+    assert "base-000000-000100" in names and "base-000100-000150" in names
+    base = more.table[more.table["origin"] == "database"]
+    assert base["sample"].tolist() == list(range(150))
+    # every rule's verification grew by a batch, and the summary counts every design once
+    for v in (out / "rounds" / "round-0" / "verify").iterdir():
+        assert sorted(p.name for p in v.iterdir())[:1] == ["000000-000010"] or v.name
+    assert [r["round"] for r in more.summary["rounds"]] == [0, 1, 2]
+    assert more.summary["database"]["rows"] == len(more.table)
+    # designs of the first run that the second did not read (its refinement of a round-0 rule
+    # that changed) are still candidates
+    earlier = more.table[more.table["origin"].str.startswith("earlier")]
+    assert len(more.table) >= len(first.table)
+    assert len(earlier) == len(more.table) - more.summary["database"]["by_origin"].get(
+        "database", 0) - sum(v for k, v in more.summary["database"]["by_origin"].items()
+                             if k in ("refine", "verify"))  # fmt: skip
+    assert more.met
+
+
+def test_describe_prints_a_databases_quantiles(tmp_path, capsys):
+    sc = _cheap_scenario()
+    run_design(sc, "double > 1", tmp_path / "o", samples=40, verify=3, top=1, workers=1,
+               progress=False, files=False, pilot=0)  # fmt: skip
+    assert main(["describe", str(tmp_path / "o" / "database"), "--json"]) == 0
+    got = {d["name"]: d for d in json.loads(capsys.readouterr().out)}
+    table = pd.read_parquet(tmp_path / "o" / "designs.parquet")
+    table = table[table["origin"] == "database"]  # the base sample: database/base-...
+    assert got["double"]["rows"] == len(table) == 40
+    assert got["double"]["quantiles"]["50%"] == pytest.approx(table["double"].median())
+    assert got["mass"]["unit"] == "kg"
+    assert main(["describe", str(tmp_path / "nothing-here")]) == 2
+
+
+def test_bad_objective_or_bed_is_refused_before_writing(tmp_path, capsys):
+    for extra, match in ((["--objective", "min weight"], "unknown column 'weight'"),
+                         (["--objective", "lightest"], "expected 'min COLUMN'"),
+                         (["--bed", "250 by 210"], "--bed '250 by 210'")):  # fmt: skip
+        out = tmp_path / "out"
+        assert main(["design", "arch", "--target", "Zstiff > 1", "-o", str(out), *extra]) == 2
+        err = capsys.readouterr().err
+        assert match in err and err.count("\n") == 1 and not out.exists()
+
+
+def test_hf_design_and_the_other_layers_are_reachable():
+    import subprocess
+    import sys
+
+    code = ("import holofold as hf, sys; assert 'holofold.design' not in sys.modules; "
+            "print(hf.design.run_design.__name__, hf.geometry.__name__, hf.fitting.__name__, "
+            "hf.mechanics.__name__, hf.run_design.__name__)")  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True)  # fmt: skip
+    assert done.stdout.split() == ["run_design", "holofold.geometry", "holofold.fitting",
+                                   "holofold.mechanics", "run_design"]  # fmt: skip
+
+
+SHEET = """
+kind = "sheet"
+name = "awning"
+[sheet]
+size_x = 0.3
+size_y = 0.15
+gamma_deg = 60.0
+extensions = [0.5, 0.8]
+pattern = "miura"
+[[load]]
+name = "lift"
+direction = [0, 0, 1]
+force = 3.0
+increments = 2
+[features]
+m = {choices = [12]}
+n = {choices = [6]}
+tcrease = [0.6e-3, 0.8e-3]
+tpanel = [1.0e-3, 3.0e-3]
+W = [1.0e-3, 6.0e-3]
+"""
+
+
+@pytest.mark.slow
+def test_overlapping_panels_are_chosen_only_when_allowed_and_then_not_printed_folded(tmp_path):
+    (tmp_path / "awning.toml").write_text(SHEET)
+    kw = dict(samples=24, pilot=0, verify=3, top=1, workers=2, progress=False)
+    # the heaviest design (thick panels, narrow hinges) has the largest margin on mass > 0
+    loose = run_design(tmp_path / "awning.toml", "mass > 0", tmp_path / "a", allow_overlap=True,
+                       **kw)  # fmt: skip
+    s = loose.summary
+    assert s["buildable"] is False and s["allow_overlap"]
+    assert s["performance"]["overlap"] > 0 and s["meets_target"]
+    assert "thick" not in s["files"] and "printable_folded" not in s["files"]
+    assert not (tmp_path / "a" / "files" / "thick.stl").exists()
+    assert any("thick.stl not written" in w for w in s["warnings"])
+    assert (tmp_path / "a" / s["files"]["printable"]["path"]).is_file()  # the flat part prints
+    # by default the same designs give a buildable one, or say that none is
+    strict = run_design(tmp_path / "awning.toml", "mass > 0", tmp_path / "a", **kw)
+    t = strict.summary
+    assert t["buildable"] is True and t["performance"]["overlap"] == 0.0
+    assert t["mined_target"] == "mass > 0 & overlap <= 1e-12"
+    assert (tmp_path / "a" / t["files"]["thick"]["path"]).is_file()
+    table = strict.table
+    free = table["overlap"] <= 1e-12
+    assert t["performance"]["mass"] == pytest.approx(table.loc[free, "mass"].max())

@@ -26,31 +26,48 @@ from holofold.design.targets import parse_target
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
+def _rule(round_, rank, text, bounds, verified=None, **kw) -> dict:
+    """A rule as the loop writes it: the Rule record's JSON with its round and verification."""
+    n, failed, meeting = verified if verified else (None, None, None)
+    out = {"round": round_, "rank": rank, "rule": text, "bounds": bounds,
+           "train": {"precision": kw.get("train"), "recall": 0.5, "support": 60},
+           "test": {"precision": kw.get("test"), "recall": 0.5, "support": 40},
+           "verified_n": n, "verified_failed": failed, "verified_meeting": meeting}  # fmt: skip
+    if kw.get("estimate") is not None:
+        lo, hi = kw["estimate_95ci"]
+        out["estimate"] = {"precision": kw["estimate"], "interval": [lo, hi], "rows": 60,
+                           "out_of_bag_rows": 50, "held_out_rows": 10}  # fmt: skip
+    return out
+
+
 def make_summary() -> dict:
-    """A complete summary in the shape the design loop writes."""
-    rule0 = {
-        "rank": 1,
-        "rule": "offset <= 0.2 & m in {12, 16}",
-        "estimate": 0.86,
-        "estimate_95ci": [0.78, 0.92],
-        "estimate_rows": 60,
-        "train_precision": 0.95,
-        "test_precision": 0.9,
-        "test_support": 40,
-        "verified_precision": 0.88,
-        "verified_95ci": [0.76, 0.94],
-        "verified_n": 50,
+    """A complete summary in the shape the design loop writes (``DesignSummary.to_json``)."""
+    rule0 = _rule(0, 1, "offset <= 200 mm and m in {12, 16}",
+                  {"offset": {"gt": None, "le": 0.2}, "m": {"in": [12.0, 16.0]}},
+                  (50, 0, 44), train=0.95, test=0.9, estimate=0.86,
+                  estimate_95ci=[0.78, 0.92])  # fmt: skip
+    rule0b = _rule(0, 2, "m = 8", {"m": {"in": [8.0]}}, None, train=0.9, test=0.8)
+    rule1 = _rule(1, 1, "offset <= 180 mm and m in {12, 16}",
+                  {"offset": {"gt": None, "le": 0.18}, "m": {"in": [12.0, 16.0]}},
+                  (50, 0, 46), train=0.97, test=0.93)  # fmt: skip
+    chosen = {
+        "source": "best inside rule 1 of round 1",
+        "features": {"m": 12.0, "offset": 0.1537},
+        "performance": {"Zstiff": 140.2, "error": 0.031, "mass": 1.2},
+        "status": "converged",
+        "origin": "refine-1",
+        "margins": {"Zstiff > 100": 0.402, "error < 0.05": -0.38, "m == 12": "inf"},
+        "worst_margin": -0.38,
+        "meets_target": False,
+        "buildable": True,
+        "objective": -0.38,
+        "rule": {"round": 1, "rank": 1},
     }
-    rule1 = {
-        "rank": 1,
-        "rule": "offset <= 0.18 & m in {12, 16}",
-        "train_precision": 0.97,
-        "test_precision": 0.93,
-        "test_support": 35,
-        "verified_precision": 0.92,
-        "verified_95ci": [0.81, 0.97],
-        "verified_n": 50,
-    }
+    other = {**chosen, "source": "best of all simulated designs", "rule": None,
+             "features": {"m": 16.0, "offset": 0.12},
+             "performance": {"Zstiff": 310.0, "error": 0.02, "mass": 0.8},
+             "margins": {"Zstiff > 100": 2.1, "error < 0.05": 0.6, "m == 12": "-inf"},
+             "worst_margin": "-inf", "origin": "database"}  # fmt: skip
     return {
         "scenario": {
             "name": "my-arch",
@@ -62,6 +79,7 @@ def make_summary() -> dict:
                 {
                     "name": "m",
                     "unit": "-",
+                    "display_unit": "-",
                     "description": "panels",
                     "low": None,
                     "high": None,
@@ -70,49 +88,68 @@ def make_summary() -> dict:
                 {
                     "name": "offset",
                     "unit": "m",
+                    "display_unit": "mm",
                     "description": "crease offset",
                     "low": 0.1,
                     "high": 0.3,
                     "choices": [],
                 },
-            ],
+            ],  # fmt: skip
             "performance": [
                 {"name": "Zstiff", "unit": "N/m", "description": "vertical stiffness"},
                 {"name": "error", "unit": "-", "description": "fit error"},
+                {"name": "mass", "unit": "kg", "description": "mass"},
             ],
         },
-        "target": "Zstiff > 100 & error < 0.05",
-        "database": {"rows": 600, "failed": 2, "path": "database/"},
+        "target": "Zstiff > 100 & error < 0.05 & m == 12",
+        "objective": "margin",
+        "answer": "rule",
+        "headline": "The design with the largest worst-case margin inside rule 1 of round 1.",
+        "chosen": chosen,
+        "alternatives": [other],
+        "database": {
+            "rows": 600,
+            "failed": 2,
+            "path": "database/",
+            "by_origin": {"database": 500, "refine": 50, "verify": 50},
+        },  # fmt: skip
         "rounds": [
-            {
-                "round": 0,
-                "rows": 500,
-                "rules": [
-                    rule0,
-                    {
-                        **rule0,
-                        "rank": 2,
-                        "rule": "m == 8",
-                        "verified_precision": None,
-                        "verified_95ci": None,
-                        "verified_n": None,
-                    },
-                ],
-            },
-            {"round": 1, "rows": 600, "rules": [rule1]},
+            {"round": 0, "rows": 500, "failed": 2, "meeting": 80, "rules": [rule0, rule0b]},
+            {"round": 1, "rows": 600, "failed": 2, "meeting": 95, "rules": [rule1]},
         ],
-        "rule": {**rule1, "bounds": {"offset": [None, 0.18], "m": [12, 16]}},
-        "verified_precision": 0.92,
-        "features": {"m": 12.0, "offset": 0.1537},
-        "performance": {"Zstiff": 140.2, "error": 0.031},
-        "units": {"m": "-", "offset": "m", "Zstiff": "N/m", "E": "Pa"},
-        "margins": {"Zstiff > 100": 0.402, "error < 0.05": -0.38, "m == 12": float("inf")},
+        "distributions": [
+            {
+                "name": "Zstiff",
+                "unit": "N/m",
+                "rows": 598,
+                "failed": 2,
+                "quantiles": {
+                    "0%": 1.5,
+                    "5%": 10.0,
+                    "25%": 40.0,
+                    "50%": 90.0,
+                    "75%": 150.0,
+                    "95%": 3600.0,
+                    "100%": 12000.0,
+                },
+            }
+        ],  # fmt: skip
         "files": {
             "fold": {"path": "files/design.fold", "label": "FOLD"},
             "printable": {"path": "files/printable.stl", "label": "printable STL"},
         },
         "images": {"design": "design.png", "rule": "rule.png", "scatter": "scatter.png"},
-        "timings": {"database": 41.2, "mine": 3.1, "verify": 10.2, "refine": 30.0, "files": 1.2},
+        "timings": {
+            "this_run": {"database": 1.2, "mine": 3.1, "verify": 0.2, "refine": 0.1, "files": 1.2},
+            "all_runs": {
+                "database": 41.2,
+                "mine": 3.1,
+                "verify": 10.2,
+                "refine": 30.0,
+                "files": 1.2,
+            },
+            "runs": 3,
+        },  # fmt: skip
     }
 
 
@@ -175,7 +212,9 @@ def _parse(page: str) -> _Tables:
 
 
 def _visible(page: str) -> str:
-    """The page without its embedded images (base64 may contain any letters)."""
+    """The page without its embedded images (base64 may contain any letters), style and
+    scripts (code, not text the reader sees)."""
+    page = re.sub(r"<(style|script)[^>]*>.*?</\1>", "", page, flags=re.S)
     return re.sub(r"data:image/[a-z+]+;base64,[A-Za-z0-9+/=]*", "data:", page)
 
 
@@ -188,17 +227,38 @@ def test_page_holds_the_design_table_and_target(folder):
     page = path.read_text(encoding="utf-8")
     assert page.startswith("<!DOCTYPE html>")
     design = _parse(page).tables["design-table"]
-    rows = {r[0]: r[1:] for r in design if len(r) == 3}
-    assert rows["m"] == ["12", ""]
-    assert rows["offset"] == ["0.1537", "m"]
-    assert rows["Zstiff"] == ["140.2", "N/m"]
-    assert rows["error"] == ["0.031", ""]
+    rows = {r[0]: r[1] for r in design if len(r) == 2}
+    assert rows["m"] == "12"
+    assert rows["offset"] == "153.7 mm"  # the display unit, labelled
+    assert rows["Zstiff"] == "140.2 N/m"
+    assert rows["error"] == "0.031"
     assert "Zstiff &gt; 100 &amp; error &lt; 0.05" in page
-    # the margins, signed, one met and one missed
-    margins = {r[0]: r[1:] for r in _parse(page).tables["margins"][1:]}
-    assert margins["Zstiff > 100"][0] == "+0.402" and margins["Zstiff > 100"][-1] == "met"
-    assert margins["error < 0.05"][0] == "-0.38" and margins["error < 0.05"][-1] == "missed"
-    assert margins["m == 12"] == ["\u2013", "", "met"]  # an equality: met, of no size
+    # every condition: its value, margin and met / missed, the equality included
+    for table in ("margins", "target-check"):
+        m = {r[0]: r[1:] for r in _parse(page).tables[table][1:]}
+        assert m["Zstiff > 100"][:2] == ["140.2 N/m", "+0.402 (+40.2 %)"]
+        assert m["Zstiff > 100"][-1] == "met"
+        assert m["error < 0.05"][1] == "-0.38 (-38.0 %)" and m["error < 0.05"][-1] == "missed"
+        assert m["m == 12"] == ["12", "holds exactly", "", "met"]
+
+
+def test_the_answer_comes_first_and_says_how_it_was_found(folder):
+    page = _visible(report_page_html(folder, make_summary()))
+    sections = re.findall(r'<section id="([a-z]+)"', page)
+    assert sections[:2] == ["answer", "alternatives"]
+    assert "A verified design" in page and "inside rule 1 of round 1" in page
+    s = make_summary()
+    s["answer"], s["headline"] = "nearest", "No simulated design meets the target."
+    s["chosen"]["rule"] = None
+    nearest = _visible(report_page_html(folder, s))
+    assert 'class="answer nearest"' in nearest and "No design meets the target" in nearest
+    # the alternatives side by side: the chosen one first
+    side = _parse(page).tables["side"]
+    assert side[0][1].startswith("chosen: best inside rule 1 of round 1")
+    assert side[0][2] == "best of all simulated designs"
+    by = {r[0]: r[1:] for r in side[1:]}
+    assert by["mass"] == ["1.2 kg", "0.8 kg"] and by["offset"] == ["153.7 mm", "120 mm"]
+    assert by["rule verified precision"] == ["92.0 %", "\u2013"]
 
 
 def test_page_problem_rules_and_timings(folder):
@@ -206,39 +266,48 @@ def test_page_problem_rules_and_timings(folder):
     t = _parse(page).tables
     features = {r[0]: r[1:] for r in t["features"][1:]}
     assert features["m"][1] == "one of 8, 12, 16"
-    assert features["offset"][1] == "0.1 to 0.3 m"
+    assert features["offset"] == ["mm", "100 mm to 300 mm", "crease offset"]
     setting = dict(r for r in t["setting-table"][1:])
-    assert setting["E"] == "2×109 Pa"  # 2×10<sup>9</sup>, tags dropped
+    assert setting["E"] == "2×109"  # 2×10<sup>9</sup>, tags dropped
     assert setting["curve"] == "catenary from catenary.csv (mm), span 3 m"
     rules = [r for r in t["rules"] if r[0] != "round"]  # both rounds' rows, no headers
     assert rules[0] == [
         "0",
         "1",
-        "offset <= 0.2 & m in {12, 16}",
+        "offset <= 200 mm and m in {12, 16}",  # the rule in display units
         "86.0 % (78.0 % to 92.0 %)",
         "95.0 %",
         "90.0 %",
-        "88.0 % (95 % interval 76.0 % to 94.0 %, n = 50)",
+        "88.0 % (95 % interval 76.2 % to 94.4 %, n = 50)",
     ]
     assert rules[1][-1] == "not verified"
-    assert rules[2][:4] == ["1", "1", "offset <= 0.18 & m in {12, 16}", "–"]  # no estimate
+    assert rules[2][:4] == ["1", "1", "offset <= 180 mm and m in {12, 16}", "–"]  # no estimate
     assert "Round 1: best verified precision 92.0\u00a0% (rank 1), up 4.0 points from round 0" in (
         page
     )
     assert '<tr class="chosen"><td class="num">1</td>' in page  # the chosen rule highlighted
-    timings = dict(r for r in t["timings"][1:])
-    assert timings["rule mining"] == "3.1 s"
-    assert timings["total"] == "1 min 26 s"  # 85.7 s
+    for label in ("train precision", "held-out precision", "verified precision"):
+        assert f"<th>{label}</th>" in page  # each precision labelled
+    assert "Round 1: mined from 600 designs (2 failed simulations left out)" in page
+    timings = {r[0]: r[1:] for r in t["timings"][1:]}
+    assert t["timings"][0] == ["stage", "this run", "all 3 runs"]
+    assert timings["rule mining"] == ["3.1 s", "3.1 s"]
+    assert timings["total"] == ["5.8 s", "1 min 26 s"]  # 85.7 s over the three runs
+    assert "600 designs simulated in this folder (base sample 500, refinement rounds 50, " in page
+    dist = {r[0]: r[1:] for r in t["distributions"][1:]}
+    assert dist["Zstiff"] == ["N/m", "598", "1.5", "10", "40", "90", "150", "3600", "12000"]
 
 
 def test_text_is_escaped(folder):
     s = make_summary()
     s["scenario"]["name"] = "arch <b>&</b>"
+    s["headline"] = "<script>alert(1)</script>"
     page = report_page_html(folder, s)
-    assert "offset &lt;= 0.2 &amp; m in {12, 16}" in page
+    assert "offset &lt;= 200 mm and m in {12, 16}" in page
     assert "offset <= 0.2" not in page
     assert "catenary &lt;span&gt; &amp; loaded" in page and "<span> &" not in page
     assert "<b>&</b>" not in page and "arch &lt;b&gt;&amp;&lt;/b&gt;" in page
+    assert "<script>alert" not in page
 
 
 def test_images_are_embedded_and_links_relative(folder):
@@ -259,36 +328,31 @@ def test_images_are_embedded_and_links_relative(folder):
 
 def test_missing_parts_render_gracefully(folder):
     s = make_summary()
-    for key in ("rounds", "database", "margins", "files", "images", "timings", "units"):
+    for key in ("rounds", "database", "files", "images", "timings", "alternatives",
+                "distributions"):  # fmt: skip
         s.pop(key)
-    s["rule"] = {
-        "rank": 1,
-        "rule": "offset <= 0.2",
-        "verified_precision": None,
-        "verified_95ci": None,
-        "verified_n": None,
-    }
-    s["verified_precision"] = None
-    s["performance"]["error"] = float("nan")
-    s["performance"]["mass"] = None
+    s["chosen"]["rule"] = None
+    s["chosen"]["performance"]["error"] = None
+    s["chosen"]["performance"]["mass"] = None
     s["scenario"]["description"] = None
     page = _visible(write_report_page(folder, s).read_text(encoding="utf-8"))
-    assert "not verified" in page
     assert re.search(r"\bnone\b", page, re.IGNORECASE) is None
     assert re.search(r"\bnan\b", page, re.IGNORECASE) is None
     assert "<img" not in page and 'data-images-total="0"' in page
-    assert "No rules were mined." in page
-    rows = {r[0]: r[1:] for r in _parse(page).tables["design-table"] if len(r) == 3}
-    assert rows["error"][0] == rows["mass"][0] == "\u2013"
-    assert rows["Zstiff"] == ["140.2", "N/m"]  # the unit from the scenario's columns
+    assert "No rules were mined" in page and "No timings were recorded." in page
+    rows = {r[0]: r[1] for r in _parse(page).tables["design-table"] if len(r) == 2}
+    assert rows["error"] == rows["mass"] == "\u2013"
+    assert rows["Zstiff"] == "140.2 N/m"  # the unit from the scenario's columns
 
 
 def test_only_round_zero_and_missing_image_files(tmp_path):
     s = make_summary()
     s["rounds"] = s["rounds"][:1]
-    s["rounds"][0]["rules"][0]["verified_precision"] = None
+    s["chosen"]["rule"] = {"round": 0, "rank": 1}
+    for r in s["rounds"][0]["rules"]:
+        r["verified_n"] = r["verified_failed"] = r["verified_meeting"] = None
     page = _visible(report_page_html(tmp_path, s))  # no image file exists in tmp_path
-    assert "Round 0: best verified precision" not in page  # rank 2 is not verified either
+    assert "Round 0: best verified precision" not in page
     assert "Round 0: no rule verified." in page
     assert "<img" not in page and "picture design.png was not made" in page
     assert re.search(r"\b(none|nan)\b", page, re.IGNORECASE) is None
@@ -298,9 +362,13 @@ def test_only_round_zero_and_missing_image_files(tmp_path):
     "breakage",
     [
         lambda s: s.pop("target"),
-        lambda s: s.pop("features"),
+        lambda s: s["chosen"].pop("features"),
         lambda s: s.__setitem__("scenario", "my-arch"),
-        lambda s: s.__setitem__("performance", [140.2]),
+        lambda s: s["chosen"].__setitem__("performance", [140.2]),
+        lambda s: s["chosen"].__setitem__("rule", {"round": 7, "rank": 1}),
+        lambda s: s.__setitem__("answer", "maybe"),
+        lambda s: s.__setitem__("files", {"x": "../../etc/passwd"}),
+        lambda s: s["rounds"][0]["rules"][0].__setitem__("verified_meeting", 51),
     ],
 )
 def test_a_malformed_summary_writes_nothing(folder, breakage):
@@ -319,6 +387,18 @@ def test_a_malformed_summary_leaves_no_page(tmp_path):
     with pytest.raises(OSError):
         write_report_page(tmp_path / "absent", make_summary())
     assert not list(tmp_path.iterdir())
+
+
+def test_the_summary_round_trips_through_its_json():
+    from holofold.design import DesignSummary
+
+    s = make_summary()
+    record = DesignSummary.from_json(s)
+    again = DesignSummary.from_json(record.to_json())
+    assert again == record
+    assert record.chosen.rule.precision == pytest.approx(46 / 50)
+    assert record.chosen.margins["m == 12"] == float("inf")
+    assert record.alternatives[0].worst_margin == float("-inf")
 
 
 # ---- the plots -----------------------------------------------------------------------------
@@ -481,9 +561,9 @@ def test_the_page_in_a_headless_browser(folder, tmp_path):
     assert '<table class="design-table">' in dom and "140.2" in dom
 
     shot = tmp_path / "shot.png"
-    _chromium(tmp_path, f"--screenshot={shot}", "--window-size=1200,3000", url)
+    _chromium(tmp_path, f"--screenshot={shot}", "--window-size=1200,5200", url)
     pixels = matplotlib.image.imread(shot)[..., :3]
-    assert pixels.shape[:2] == (3000, 1200)
+    assert pixels.shape[:2] == (5200, 1200)
     colours = np.unique((pixels * 255).astype(np.uint8).reshape(-1, 3), axis=0)
     assert len(colours) > 200  # text, tables and the three pictures
     assert pixels.std() > 0.08

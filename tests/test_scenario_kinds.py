@@ -55,7 +55,7 @@ def test_shipped_canopy_is_the_python_canopy(reference_data):
     toml, py = _shipped("canopy"), get_scenario("canopy")
     assert toml.kind == "sheet" and toml.features == py.features
     assert toml.categorical == py.categorical
-    assert toml.performance_names == [*py.performance_names, "mass"]
+    assert toml.performance_names == [*py.performance_names, "mass", "overlap", "clearance"]
     rows = _rows(reference_data, py, "data1_MiuraSheet_sample", [0])
     rows += _rows(reference_data, py, "data1_TMPSheet_sample", [0])
     rows += _rows(reference_data, py, "data4_TMPSheetMat_sample", [0])  # creaseE, panelE
@@ -139,7 +139,7 @@ def _user_sheet(tmp_path, E=2e9, force=3.0, name="mine.toml"):
 
 def test_user_sheet_columns_and_linear_scaling(tmp_path):
     sc = _user_sheet(tmp_path)
-    assert sc.performance_names == ["liftstiff50", "liftstiff80", "mass"]
+    assert sc.performance_names == ["liftstiff50", "liftstiff80", "mass", "overlap", "clearance"]
     assert sc.feature_names == ["m", "n", "tcrease", "tpanel", "W"]  # pattern fixed, no moduli
     assert sc.categorical == ("m", "n")
     assert sc.setting["footprint (m)"] == "0.3 x 0.15"
@@ -158,6 +158,30 @@ def test_user_sheet_columns_and_linear_scaling(tmp_path):
     for c in ("liftstiff50", "liftstiff80"):
         assert stiff[c] / small[c] == pytest.approx(2.0, rel=1e-3), c
     assert stiff["mass"] == base["mass"]
+
+
+def test_sheet_overlap_and_clearance_at_the_most_folded_state(tmp_path):
+    """Thick panels collide where creases are narrow for their thickness (W = t: they overlap
+    at Ext 0.5), not where the hinges are wide (W = 6 t: apart, with a positive gap); the
+    overlap only grows as the hinges narrow."""
+    from holofold.design.scenarios.sheet import sheet_shape
+    from holofold.geometry import printability
+
+    sc = _user_sheet(tmp_path)
+    assert sc.performance[3].display_unit == "mm^3" and sc.performance[4].display_unit == "mm"
+    rows = [sc.complete({**SHEET_ROW, "tpanel": 1e-3, "W": w}) for w in (1e-3, 2e-3, 6e-3)]
+    out = [sc.evaluate(r) for r in rows]
+    ov = [o["overlap"] for o in out]
+    assert ov[0] > ov[1] > 0 and ov[2] == 0.0
+    assert out[2]["clearance"] > 0 and out[0]["clearance"] < out[2]["clearance"]
+    # at the sheet's smallest extension (0.5), where it is most folded: the 0.8 state overlaps less
+    flatter = printability(sheet_shape(_setting(sc), rows[1], 0.8), 1e-3, 2e-3).overlap
+    assert flatter < ov[1]
+
+
+def _setting(sc):
+    """The SheetSetting behind a sheet scenario (its evaluator's first bound argument)."""
+    return sc.evaluate_batch.args[0]
 
 
 def test_sheet_mass_is_the_formula(tmp_path):

@@ -2,6 +2,8 @@
 
 import json
 
+import numpy as np
+import pandas as pd
 import pytest
 
 from holofold.cli import main
@@ -114,3 +116,35 @@ def test_verify_shows_what_mining_said_beside_the_verified_precision(tmp_path, c
     assert shown == [
         "mined with: estimate 0.875 (95 % interval 0.780-0.940), held-out precision 0.900"
     ]  # the second rule carries no usable estimate: nothing is made up
+
+
+def test_holofold_verify_is_the_loops_resumable_verification(tmp_path, capsys):
+    """With -o the fresh designs go to resumable databases, as the design loop's do: a second
+    run simulates nothing, a larger -n adds a batch with the first designs unchanged."""
+    soft = {"tcrease": {"gt": None, "le": 0.6e-3}, "tpanel": {"gt": None, "le": 1.2e-3}}
+    rules = tmp_path / "rules.json"
+    rules.write_text(json.dumps([{"rule": "soft", "bounds": soft}]))
+    out = tmp_path / "v"
+    argv = ["verify", "single-miura", "--rules", str(rules), "--target", "axialstiff60 < 6000",
+            "-o", str(out)]  # fmt: skip
+    assert main([*argv, "-n", "4"]) == 0
+    (folder,) = [p for p in out.iterdir() if p.is_dir()]
+    assert folder.name.startswith("rule1-") and [p.name for p in folder.iterdir()] == [
+        "000000-000004"]  # fmt: skip
+    chunks = sorted(folder.rglob("part-*.parquet"))
+    stamps = [p.stat().st_mtime_ns for p in chunks]
+    first = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert main([*argv, "-n", "4"]) == 0
+    assert [p.stat().st_mtime_ns for p in chunks] == stamps  # nothing simulated again
+    assert json.loads(capsys.readouterr().out.splitlines()[-1]) == first
+    assert main([*argv, "-n", "6"]) == 0
+    assert sorted(p.name for p in folder.iterdir()) == ["000000-000004", "000004-000006"]
+    got = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert got[0]["simulated"] == 6
+    # the loop's verification of the same rule with the same seed gives the same designs
+    from holofold.design import parse_target, verify_rules
+
+    direct = verify_rules("single-miura", [{"bounds": soft}], parse_target("axialstiff60 < 6000"),
+                          6, folder=tmp_path / "w")[0]  # fmt: skip
+    csv = pd.read_csv(out / "verify_rule1.csv")
+    assert np.allclose(csv["tcrease"], direct.designs["tcrease"])

@@ -93,5 +93,7 @@ SCENARIO = Scenario(
     evaluate_batch=_STRIP.evaluate_batch,
     batch_key=_STRIP.batch_key,
     shape=_STRIP.shape,
+    view=_STRIP.view,
+    part=_STRIP.part,
     write_files=_STRIP.write_files,  # the same seven files as the shipped arch.toml
 )

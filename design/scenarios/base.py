@@ -213,6 +213,13 @@ class Scenario:
         Writes the design's fabrication files into ``folder`` (meshes in ``units``, the SVG and
         DXF drawn for ``cutter``, a :class:`~holofold.geometry.CutterOptions`); returns the
         :class:`~holofold.geometry.FabricationSet` (files under stable keys with labels).
+    view : callable(row) -> DesignView, optional
+        The design to look at in 3D, flat to folded, with supports, loads and the target
+        (:class:`holofold.design.view.DesignView`).
+    part : callable(row) -> PrintablePart, optional
+        The part the design prints (its flat pattern, panel and hinge thicknesses, hinge
+        width; :class:`holofold.design.buildability.PrintablePart`), cut into bed-sized pieces
+        when it is larger than the printer's bed.
     evaluate_batch : callable(rows) -> list of dict, optional
         Simulates several rows with the same ``batch_key`` together (their Newton solves in
         lockstep); each output is the one ``evaluate`` gives the row alone. The runner uses it
@@ -237,6 +244,8 @@ class Scenario:
     source: str = ""
     shape: Callable | None = None
     write_files: Callable | None = None
+    view: Callable | None = None
+    part: Callable | None = None
     evaluate_batch: Callable[[list], list] | None = None
     batch_key: Callable[[Mapping[str, float]], object] | None = None
     row_timeout: float | None = None

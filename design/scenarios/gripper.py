@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import partial
 
 import numpy as np
 
@@ -843,6 +844,23 @@ def write_gripper_files(row, folder, units: str = "mm", cutter=None):
     )  # fmt: skip
 
 
+def _closed_files(converged: bool, row, folder, units: str = "mm", cutter=None):
+    """The built-in gripper's files with its closed (heated) state, as its scenario file's
+    (:func:`holofold.design.scenarios.gripper_kind.write_closed_gripper_files`)."""
+    from holofold.design.scenarios.gripper_kind import write_closed_gripper_files
+
+    options = GripperOptions(converged=converged)
+    return write_closed_gripper_files(options, row, folder, units=units, cutter=cutter)
+
+
+def _closed_view(converged: bool, row):
+    """The built-in gripper's 3D view, flat to closed by heating
+    (:func:`holofold.design.scenarios.gripper_kind.gripper_view`)."""
+    from holofold.design.scenarios.gripper_kind import gripper_view
+
+    return gripper_view(GripperOptions(converged=converged), row)
+
+
 SCENARIO = Scenario(
     name="gripper",
     description=(
@@ -857,7 +875,8 @@ SCENARIO = Scenario(
     categorical=("Pattern",),
     row_timeout=gripper_row_timeout(),
     shape=gripper_shape,
-    write_files=write_gripper_files,
+    write_files=partial(_closed_files, False),
+    view=partial(_closed_view, False),
 )
 CONVERGED_OPTIONS = GripperOptions(converged=True)
 #: the gripper with tightly converged Newton solves: repeatable outputs for new databases
@@ -872,4 +891,6 @@ SCENARIO_CONVERGED = replace(
         " converged solves)."
     ),
     evaluate=evaluate_converged,
+    write_files=partial(_closed_files, True),
+    view=partial(_closed_view, True),
 )

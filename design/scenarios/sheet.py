@@ -25,7 +25,12 @@ Columns, SI units:
 ``mass``
     density x (panel area x tpanel + fold-line length x W x (tcrease - tpanel)), kg: the flat
     sheet of panel thickness, thinned to the crease thickness over a strip of width W along
-    every fold line.
+    every fold line;
+``overlap``, ``clearance``
+    volume where the thick panels (tpanel, pulled back W/2 from the creases) intersect, m^3,
+    and the smallest gap between panels sharing no vertex, m, folded to the smallest modelled
+    extension (the most folded state the sheet is used in): 0 overlap means the part can be
+    folded there as designed (:func:`holofold.geometry.printability`).
 
 The paper's canopy (:mod:`~holofold.design.scenarios.canopy`) is this kind with a 0.2 m square,
 gamma = 70 deg, extensions 0.3, 0.6, 0.9 and the loads ``bend`` (3 N in -z) and ``axial``
@@ -94,6 +99,8 @@ __all__ = [
     "sheet_batch_key",
     "sheet_shape",
     "write_sheet_files",
+    "sheet_view",
+    "sheet_part",
     "sheet_scenario",
     "extension_tag",
     "from_config",
@@ -257,6 +264,18 @@ def sheet_columns(setting: SheetSetting, extras: bool = True) -> tuple[Column, .
     ]
     if extras:
         cols.append(Column("mass", "kg", "mass of the sheet (panels and thinned fold lines)"))
+        most = min(setting.extensions)
+        cols.append(
+            Column(
+                "overlap",
+                "m^3",
+                "volume where the thick panels intersect, folded to "
+                f"Ext = {most:g} (the most folded modelled state)",
+                display="mm^3",
+            )
+        )
+        cols.append(Column("clearance", "m", "smallest gap between panels sharing no vertex, "
+                           f"folded to Ext = {most:g}", display="mm"))  # fmt: skip
     return tuple(cols)
 
 
@@ -445,10 +464,28 @@ def evaluate_sheet_batch(setting: SheetSetting, columns: Sequence[str], rows) ->
     for row, out, case in zip(rows, outs, cases, strict=True):
         if "mass" in columns:
             out["mass"] = sheet_mass(setting, row)
+        if "overlap" in columns:
+            out["overlap"], out["clearance"] = _printability(setting, row)
         out = {c: out[c] for c in columns}
         out["status"] = Status.gather(case, worst=Outcome.NOT_CONVERGED)
         result.append(out)
     return result
+
+
+#: clearance reported when every pair of panels shares a vertex, m (as the strip kind's)
+_NO_NEIGHBOUR = 1e3
+
+
+def _printability(setting: SheetSetting, row) -> tuple[float, float]:
+    """(overlap m^3, clearance m) of the design's thick panels (tpanel, pulled back W/2 from
+    the creases) folded to the smallest modelled extension, where they come closest
+    (:func:`holofold.geometry.printability`, imported on first use: trimesh and
+    scipy.spatial are a second of start-up for a worker that never needs them)."""
+    from holofold.geometry import printability
+
+    shape = sheet_shape(setting, row, min(setting.extensions))
+    p = printability(shape, float(row["tpanel"]), float(row["W"]))
+    return float(p.overlap), float(min(p.clearance, _NO_NEIGHBOUR))
 
 
 def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreasePattern:
@@ -457,6 +494,41 @@ def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreaseP
     ext = max(setting.extensions) if ext is None else ext
     pat, m, n, gamma = _design(setting, row)
     return SHEET_FAMILIES[pat].shape(setting, m, n, gamma, ext)
+
+
+def sheet_view(setting: SheetSetting, row):
+    """The design folding from flat (Ext = 1) through each modelled extension, with the
+    supported nodes (x = min) and the loads shared by the nodes at x = max
+    (:class:`~holofold.design.view.DesignView`)."""
+    from holofold.design.view import DesignView, Load
+
+    exts = [1.0] + [e for e in sorted(setting.extensions, reverse=True) if e < 1.0]
+    frames = np.stack([sheet_nodes(setting, row, e) for e in exts])
+    pat, m, n, _ = _design(setting, row)
+    topo = _topology(pat, m, n)
+    shape = sheet_shape(setting, row)
+    last = frames[-1]
+    fixed = np.flatnonzero(last[:, 0] == last[:, 0].min())
+    tip = np.flatnonzero(last[:, 0] == last[:, 0].max())
+    loads = tuple(Load(int(v), ld.direction, f"{ld.name}: {ld.force:g} N shared")
+                  for ld in setting.loads for v in tip)  # fmt: skip
+    labels = tuple("flat" if e == 1.0 else f"Ext {e:g}" for e in exts)
+    return DesignView(
+        frames=frames, labels=labels, faces=[list(f) for f in topo.faces], edges=shape.edges,
+        kinds="".join(str(a)[0] for a in shape.assignment), supports=fixed, loads=loads,
+        facts=(("supports", f"the nodes at x = min, fixed in {setting.support_dofs}"),),
+    )  # fmt: skip
+
+
+def sheet_part(setting: SheetSetting, row):
+    """The printable part: the sheet's flat layout, printed with panels of ``tpanel`` joined
+    by hinge strips of ``tcrease`` and width ``W``
+    (:class:`~holofold.design.buildability.PrintablePart`)."""
+    from holofold.design.buildability import PrintablePart
+
+    return PrintablePart(
+        sheet_shape(setting, row), float(row["tpanel"]), float(row["tcrease"]), float(row["W"])
+    )
 
 
 def write_sheet_files(
@@ -535,6 +607,8 @@ def sheet_scenario(
         source=source,
         shape=partial(sheet_shape, setting),
         write_files=partial(write_sheet_files, setting),
+        view=partial(sheet_view, setting),
+        part=partial(sheet_part, setting),
     )
 
 

@@ -97,5 +97,7 @@ SCENARIO = Scenario(
     evaluate_batch=_SHEET.evaluate_batch,
     batch_key=_SHEET.batch_key,
     shape=_SHEET.shape,
+    view=_SHEET.view,
+    part=_SHEET.part,
     write_files=_SHEET.write_files,
 )

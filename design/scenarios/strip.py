@@ -94,6 +94,8 @@ __all__ = [
     "loaded_node",
     "strip_shape",
     "write_strip_files",
+    "strip_view",
+    "strip_part",
     "from_config",
 ]
 
@@ -222,8 +224,10 @@ def strip_columns(setting: StripSetting, extras: bool = True) -> tuple[Column, .
     if extras:
         cols.append(Column("closest_error", "m", "mean closest-point distance to the curve"))
         cols.append(Column("mass", "kg", "mass of the strip (panels and hinge strips)"))
-        cols.append(Column("overlap", "m^3", "volume where the folded thick panels intersect"))
-        cols.append(Column("clearance", "m", "smallest gap between panels sharing no vertex"))
+        cols.append(Column("overlap", "m^3", "volume where the folded thick panels intersect",
+                           display="mm^3"))  # fmt: skip
+        cols.append(Column("clearance", "m", "smallest gap between panels sharing no vertex",
+                           display="mm"))  # fmt: skip
     return tuple(cols)
 
 
@@ -443,6 +447,60 @@ def _fit(setting: StripSetting, row):
     )
 
 
+def strip_view(setting: StripSetting, row):
+    """The design from its flat development to the strip over the curve, with the supported
+    nodes, the loads and the target curve (:class:`~holofold.design.view.DesignView`)."""
+    from holofold.design.view import DesignView, Load
+
+    fit = _fit(setting, row)
+    pat = fit.flat_pattern if fit.flat is not None else fit.pattern
+    g = strip_geometry(
+        setting.curve,
+        int(row["m"]),
+        float(row["offset"]),
+        float(row["stripeWidth"]),
+        float(row["extrude"]),
+        setting.curve_sampling,
+    )
+    ends = {
+        "ends": g.ends,
+        "centre-ends": g.centre[[0, -1]],
+        "side-ends": np.concatenate([g.side_a[[0, -1]], g.side_b[[0, -1]]]),
+    }
+    fixed = ends[setting.supports]
+    frames, labels = [pat.coords], ["folded over the curve"]
+    if fit.flat is not None:
+        flat = np.column_stack([fit.flat, np.zeros(len(fit.flat))])
+        frames, labels = [flat, pat.coords], ["flat, as printed", "folded over the curve"]
+    loads = tuple(
+        Load(loaded_node(setting, g.m, ld.at, g.t), ld.direction, f"{ld.name}: {ld.force:g} N")
+        for ld in setting.loads
+    )
+    c = setting.curve(np.linspace(0.0, 1.0, 200))
+    curve = np.column_stack([c[:, 0], np.zeros(len(c)), c[:, 1]])
+    e = pat.edges
+    return DesignView(
+        frames=np.stack(frames), labels=tuple(labels), faces=[list(f) for f in pat.faces],
+        edges=e, kinds="".join(str(a)[0] for a in pat.assignment), supports=fixed, loads=loads,
+        curve=curve,
+        facts=(("supports", f"{SUPPORTS[setting.supports]}, fixed in {setting.support_dofs}"),),
+    )  # fmt: skip
+
+
+def strip_part(setting: StripSetting, row):
+    """The printable part: the strip's flat development, printed with panels of ``tpanel``
+    joined by hinge strips of ``tcrease`` and width ``W``
+    (:class:`~holofold.design.buildability.PrintablePart`; None if the development overlaps)."""
+    from holofold.design.buildability import PrintablePart
+
+    fit = _fit(setting, row)
+    if fit.flat is None:
+        return None
+    return PrintablePart(
+        fit.flat_pattern, float(row["tpanel"]), float(row["tcrease"]), float(row["W"])
+    )
+
+
 def write_strip_files(setting: StripSetting, row, folder, units: str = "mm", cutter=None):
     """The design's fabrication set (:func:`~holofold.fitting.write_strip_set`): the printable
     part (flat panels of ``tpanel`` joined by hinge strips of ``tcrease`` and width ``W``) flat and
@@ -504,6 +562,8 @@ def strip_scenario(
         source=source,
         shape=partial(strip_shape, setting),
         write_files=partial(write_strip_files, setting),
+        view=partial(strip_view, setting),
+        part=partial(strip_part, setting),
     )
 
 

@@ -36,7 +36,8 @@ from pathlib import Path
 __all__ = ["main", "build_parser"]
 
 # preferred order in --help; modules not listed here follow alphabetically
-_ORDER = ["demo", "design", "scenarios", "pattern", "fit", "evaluate", "generate", "mine", "verify"]
+_ORDER = ["demo", "design", "describe", "scenarios", "pattern", "fit", "evaluate", "generate",
+          "mine", "verify"]  # fmt: skip
 
 
 def _command_names() -> list[str]:

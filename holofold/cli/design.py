@@ -1,4 +1,4 @@
-"""``holofold design``: the whole loop on a scenario, from a target to a verified design's files."""
+"""``holofold design``: the whole loop on a scenario, from a target to the best design's files."""
 
 from __future__ import annotations
 
@@ -13,20 +13,28 @@ __all__ = ["register", "run"]
 def register(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "design",
-        help="design end to end: database, rules, verification, a chosen design and its files",
+        help="design end to end: database, rules, verification, the best design and its files",
         description=(
-            "Build (or reuse and extend) a database of the scenario, mine design rules for the "
-            "target, verify the best rules with fresh simulations, optionally refine the "
-            "database around them for --rounds rounds, choose the simulated design with the "
-            "largest margin to the target inside the best verified rule, and write "
-            "OUT/design.json, its fabrication files (FOLD, SVG, STL, OBJ, printable solid), "
-            "pictures and OUT/report.html. Re-running the same command resumes."
+            "Build (or reuse and extend) a database of the scenario, a pilot batch first (the "
+            "run stops after it, saying what the designs reach, when none meets the target), "
+            "mine design rules for the target, verify the best rules with fresh simulations, "
+            "optionally refine around them for --rounds rounds, and choose from every simulated "
+            "design the best under --objective inside the best verified rule of all rounds "
+            "(without one: the best design meeting the target; without that: the nearest, with "
+            "its shortfall). Designs whose thick panels overlap are not chosen unless "
+            "--allow-overlap. Always writes OUT/design.json and OUT/report.html, and the "
+            "design's fabrication files (FOLD, SVG, STL, OBJ, printable part) with its fit on "
+            "the printer's bed. Re-running resumes; a larger -n, --rounds or --verify extends "
+            "the folder. Exit status 0: the chosen design meets the target; 1: no simulated "
+            "design does (the nearest is shown); 2: bad input."
         ),
         epilog=(
             "examples:\n"
             "  holofold scenarios show arch > my_arch.toml   # then edit curve, loads, ranges\n"
+            "  holofold describe my_arch.toml                # what the designs reach\n"
             "  holofold design my_arch.toml --target 'Zstiff > 100 & error < 0.05' -o out\n"
-            "  holofold design arch --target 'Zstiff > 60 & error < 0.08' -o out --rounds 2"
+            "  holofold design arch --target 'Zstiff > 60 & error < 0.08' -o out --rounds 2 \\\n"
+            "      --objective 'min mass' --bed 250x210"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -34,6 +42,29 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--target", required=True, help="target over the performance columns")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
     p.add_argument("-n", "--samples", type=int, default=500, help="designs in the base database")
+    p.add_argument(
+        "--objective",
+        default="margin",
+        help="which design meeting the target is best: 'margin' (default: the "
+        "largest worst-case margin), 'min COLUMN' or 'max COLUMN' (e.g. 'min "
+        "mass')",
+    )
+    p.add_argument(
+        "--allow-overlap",
+        action="store_true",
+        help="let a design whose folded thick panels overlap be chosen",
+    )
+    p.add_argument(
+        "--bed",
+        default="250x210",
+        help="printer bed WIDTHxDEPTH in mm the part is fitted on (default 250x210)",
+    )
+    p.add_argument(
+        "--pilot",
+        type=int,
+        default=None,
+        help="designs simulated first to check the target is reachable (default 50; 0: none)",
+    )
     p.add_argument("--db", type=Path, help="database folder (default OUT/database)")
     p.add_argument("--rounds", type=int, default=0, help="refinement rounds (default 0)")
     p.add_argument("--refine", type=int, default=100, help="new designs per refinement round")
@@ -42,22 +73,39 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
     p.add_argument(
-        "--units", choices=("mm", "m"), default="mm",
+        "--units",
+        choices=("mm", "m"),
+        default="mm",
         help="length unit of the STL/OBJ files (default mm, as slicers read them)",
-    )  # fmt: skip
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     add_cutter_arguments(p)
     return p
 
 
 def run(args) -> int:
-    from holofold.design import run_design
+    from holofold.design import PILOT, run_design
 
     cutter = cutter_options(args)
-    run_design(
-        args.scenario, args.target, args.output, samples=args.samples, rounds=args.rounds,
-        refine=args.refine, verify=args.verify, top=args.top, db=args.db, seed=args.seed,
-        workers=args.workers, progress=False if args.no_progress else None, mesh_units=args.units,
-        cutter=cutter, say=lambda text: print(text, flush=True),
-    )  # fmt: skip
-    return 0
+    out = run_design(
+        args.scenario,
+        args.target,
+        args.output,
+        samples=args.samples,
+        rounds=args.rounds,
+        refine=args.refine,
+        verify=args.verify,
+        top=args.top,
+        db=args.db,
+        seed=args.seed,
+        workers=args.workers,
+        progress=False if args.no_progress else None,
+        mesh_units=args.units,
+        cutter=cutter,
+        objective=args.objective,
+        allow_overlap=args.allow_overlap,
+        bed=args.bed,
+        pilot=PILOT if args.pilot is None else args.pilot,
+        say=lambda text: print(text, flush=True),
+    )
+    return 0 if out.met else 1

@@ -22,7 +22,9 @@ def register(subparsers) -> argparse.ArgumentParser:
         description=(
             "Read the rules written by `holofold mine --json`, sample N fresh designs inside "
             "each rule's box (within the scenario's ranges), simulate them and report the "
-            "fraction meeting the target, with a 95 % Wilson interval."
+            "fraction meeting the target, with a 95 % Wilson interval. With -o the designs are "
+            "simulated into resumable databases OUT/rule{i}-{key}/ (the design loop's own "
+            "verification): an interrupted run resumes, and a larger -n adds designs."
         ),
     )
     p.add_argument(
@@ -35,7 +37,9 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0)
     add_parallel_arguments(p)
     add_row_arguments(p, on_invalid="skip")
-    p.add_argument("-o", "--output", help="folder for verify.json and the simulated designs")
+    p.add_argument("-o", "--output",
+                   help="folder for verify.json, the simulated designs and their resumable "
+                        "databases")  # fmt: skip
     return p
 
 
@@ -59,7 +63,7 @@ def run(args) -> int:
     results = verify_rules(
         scenario, rules, args.target, args.samples,
         seed=args.seed, workers=workers, scheduler=scheduler,
-        on_invalid=on_invalid, row_timeout=row_timeout,
+        on_invalid=on_invalid, row_timeout=row_timeout, folder=args.output,
     )  # fmt: skip
     for i, (r, v) in enumerate(zip(rules, results, strict=True), start=1):
         print(f"rule {i}: {r.text(scenario.columns)}\n  {v.describe()}")

@@ -1,0 +1,77 @@
+"""The worked design problems of examples/ end to end: a design, its files and a report."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from holofold.cli import main
+from holofold.design import load_scenario, parse_target
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+
+@pytest.mark.parametrize("name", ["petg_canopy", "pa12_miura_sheet", "robot_gripper"])
+def test_the_example_scenarios_read(name):
+    sc = load_scenario(EXAMPLES / f"{name}.toml")
+    assert sc.kind in ("strip", "sheet", "gripper")
+    if sc.kind in ("strip", "sheet"):  # a printable part: its panels' overlap is a column
+        assert {"overlap", "clearance", "mass"} <= set(sc.performance_names)
+
+
+def test_the_canopy_curve_is_the_inkscape_path():
+    """The canopy is the path "canopy" of an Inkscape drawing (mm document units, a layer
+    transform): 750 mm span, its crown at 40 % of the span, 330 mm high."""
+    sc = load_scenario(EXAMPLES / "petg_canopy.toml")
+    curve = sc.view.args[0].curve
+    import numpy as np
+
+    p = curve(np.linspace(0, 1, 2001))
+    assert p[0] == pytest.approx([0, 0], abs=1e-12)
+    assert p[-1] == pytest.approx([0.75, 0.0], abs=1e-9)
+    top = p[np.argmax(p[:, 1])]
+    assert top[1] == pytest.approx(0.33, abs=0.01) and 0.3 < top[0] / 0.75 < 0.45
+
+
+@pytest.mark.slow
+def test_the_petg_canopy_ends_with_a_design_files_and_a_report(tmp_path, capsys):
+    from _browser import chromium
+
+    out = tmp_path / "canopy"
+    target = "Pstiff > 1500 & error < 0.02 & Psnap == 0"
+    code = main(["design", str(EXAMPLES / "petg_canopy.toml"), "--target", target, "-o", str(out),
+                 "-n", "120", "--verify", "10", "--top", "2", "--no-progress",
+                 "--objective", "min mass"])  # fmt: skip
+    said = capsys.readouterr().out
+    s = json.loads((out / "design.json").read_text())
+    assert code == (0 if s["meets_target"] else 1)
+    assert s["answer"] in ("rule", "designs") and s["meets_target"] and s["buildable"]
+    assert parse_target(target).evaluate(__import__("pandas").DataFrame([s["performance"]]))[0]
+    assert s["objective"] == "min mass" and s["chosen"]["objective"] == s["performance"]["mass"]
+    assert "chosen: " in said and s["headline"] in said
+    # the lightest design meeting the target among the candidates it was chosen from
+    assert all(a["performance"]["mass"] >= s["performance"]["mass"] - 1e-12
+               for a in s["alternatives"] if a["source"].startswith("best inside")
+               and a["rule"] == s["chosen"]["rule"])  # fmt: skip
+    for key in ("printable", "fold", "svg"):
+        assert (out / s["files"][key]["path"]).is_file(), key
+    fab = s["fabrication"]
+    assert fab["file"] == "files/printable.stl" and fab["extent_m"][0] > 0.5
+    assert not fab["fits"]
+    if fab["pieces"]:  # cut into bed-sized pieces, their files beside the part
+        assert fab["pieces"] >= 3 and (out / fab["segments"] / "assembly.svg").is_file()
+    else:  # the cut failed: the report says which bed it needs
+        assert fab["problem"] and "bed of at least" in fab["advice"]
+    page = (out / "report.html").read_text()
+    first = page[: page.index('id="alternatives"')]  # the first screen
+    for words in ("The part to print", fab["extent"], "does not fit", "print time",
+                  "The chosen design in 3D", s["headline"][:60]):  # fmt: skip
+        assert words.lower() in first.lower(), words
+    dom = chromium(tmp_path, "--dump-dom", (out / "report.html").as_uri()).stdout
+    viewer = re.search(r'<div class="viewer"[^>]*>', dom).group(0)
+    assert 'data-viewer-ready="1"' in viewer
+    assert int(re.search(r'data-viewer-triangles="(\d+)"', viewer).group(1)) > 0
