@@ -75,3 +75,31 @@ def test_the_petg_canopy_ends_with_a_design_files_and_a_report(tmp_path, capsys)
     viewer = re.search(r'<div class="viewer"[^>]*>', dom).group(0)
     assert 'data-viewer-ready="1"' in viewer
     assert int(re.search(r'data-viewer-triangles="(\d+)"', viewer).group(1)) > 0
+
+
+def test_the_gripper_kinds_mass_is_the_film_of_its_pattern():
+    """A uniform film (bimorph as thick as the panels) weighs density x area x thickness, the
+    area being the flat pattern's faces (shoelace in the plane); the creases' bimorph adds
+    length x W x (t1 + t2 - tpanel)."""
+    import numpy as np
+
+    from holofold.design.scenarios.gripper_kind import gripper_mass
+    from holofold.geometry.gripper import gripper_pattern
+
+    sc = load_scenario(EXAMPLES / "robot_gripper.toml")
+    assert sc.performance_names[-1] == "mass" and sc.performance[-1].display_unit == "g"
+    options = sc.view.args[0]
+    rho = options.material.density
+    for p in (1, 2, 3):
+        row = {"Pattern": p, "L1": 5e-3, "L2": 3e-3, "t1": 4e-6, "t2": 6e-6, "tpanel": 1e-5,
+               "rate": 0.4, "W": 2e-4}  # fmt: skip
+        g = gripper_pattern(p, 5e-3, 3e-3, 0.4)
+        xy = g.pattern.coords[:, :2]
+        area = sum(0.5 * abs(np.dot(xy[f, 0], np.roll(xy[f, 1], -1))
+                             - np.dot(xy[f, 1], np.roll(xy[f, 0], -1)))
+                   for f in g.pattern.faces)  # fmt: skip
+        assert gripper_mass(options, row) == pytest.approx(rho * area * 1e-5, rel=1e-12)
+        thicker = gripper_mass(options, {**row, "t2": 16e-6})  # 1e-5 more over the creases
+        e = g.pattern.edges[g.active]
+        length = np.linalg.norm(np.diff(g.pattern.coords[e], axis=1)[:, 0], axis=1).sum()
+        assert thicker - gripper_mass(options, row) == pytest.approx(rho * length * 2e-4 * 1e-5)

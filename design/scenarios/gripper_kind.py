@@ -64,8 +64,38 @@ PAPER_OPTIONS = GripperOptions()
 
 
 def evaluate_gripper(options: GripperOptions, row) -> dict:
-    """freqFinal (rad/s), finalQ (W), Tmax (°C), stiff (N/m) and status of one design."""
-    return simulate(row, options).as_row()
+    """freqFinal (rad/s), finalQ (W), Tmax (°C), stiff (N/m), mass (kg) and status of one
+    design."""
+    return {**simulate(row, options).as_row(), "mass": gripper_mass(options, row)}
+
+
+#: the kind's columns: the paper's four and the gripper's mass
+MASS = Column(
+    "mass",
+    "kg",
+    "mass of the film: panels of tpanel, active creases of t1 + t2 over width W",
+    display="g",
+)
+
+
+def gripper_mass(options: GripperOptions, row) -> float:
+    """density x (panel area x tpanel + active-crease length x W x (t1 + t2 - tpanel)), kg:
+    the flat film of panel thickness, with the bimorph (t1 + t2) instead of the panel over a
+    strip of width W along every active crease (the compliant creases the model represents)."""
+    import numpy as np
+
+    from holofold.geometry.gripper import gripper_pattern
+
+    g = gripper_pattern(int(round(row["Pattern"])), row["L1"], row["L2"], row["rate"])
+    X = g.pattern.coords
+    area = 0.0
+    for f in g.pattern.faces:  # vector area of each planar polygon
+        P = X[f]
+        area += 0.5 * np.linalg.norm(np.cross(P, np.roll(P, -1, axis=0)).sum(axis=0))
+    e = g.pattern.edges[np.asarray(g.active)]  # 0-based ids of the active creases
+    length = float(np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1).sum())
+    tp, t1, t2, W = (float(row[k]) for k in ("tpanel", "t1", "t2", "W"))
+    return float(options.material.density * (area * tp + length * W * (t1 + t2 - tp)))
 
 
 @lru_cache(maxsize=8)
@@ -185,7 +215,7 @@ def gripper_scenario(
         name=name,
         description=description,
         features=features,
-        performance=PERFORMANCE,
+        performance=(*PERFORMANCE, MASS),
         check=check,
         evaluate=partial(evaluate_gripper, options),
         categorical=("Pattern",),
