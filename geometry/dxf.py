@@ -9,7 +9,9 @@ stroke width. Creases are drawn as the cutter profile says
 (:func:`~holofold.geometry.cutter.cutter_drawing`): whole lines, vertex to vertex, with the
 ``origami-simulator`` profile (a reader rebuilds the crease graph from them), dashes with gaps
 at the vertices with ``laser``. Every ``LINE`` carries no text; the fold angle of a crease is
-not in a DXF (use the FOLD file).
+not in a DXF (use the FOLD file). The header's dates and GUIDs are fixed (ezdxf's
+``write_fixed_meta_data_for_testing``, set only while writing), so a design always gives the same
+bytes.
 """
 
 from __future__ import annotations
@@ -77,6 +79,16 @@ def export_dxf(
     draw = cutter_drawing(
         pattern, prof, dash=dash, gap=gap, vertex_gap=vertex_gap, margin=margin_mm
     )
+    # fixed dates, GUIDs and ezdxf markers (created and written): a design gives the same bytes
+    fixed = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        return _dxf_text(ezdxf, prof, draw)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = fixed
+
+
+def _dxf_text(ezdxf, prof: CutterProfile, draw) -> str:
     doc = ezdxf.new("R2010", units=4)  # 4: millimetres
     doc.header["$MEASUREMENT"] = 1  # metric
     msp = doc.modelspace()

@@ -257,3 +257,10 @@ def test_dxf_round_trip_through_the_reader(miura, tmp_path):
     np.testing.assert_allclose(b[order_b], a[order_a], atol=1e-9)
     for code in "MVB":
         assert (back.assignment == code).sum() == (miura.assignment == code).sum()
+
+
+def test_dxf_is_the_same_bytes_every_time(miura):
+    import ezdxf
+
+    assert export_dxf(miura, profile="laser") == export_dxf(miura, profile="laser")
+    assert ezdxf.options.write_fixed_meta_data_for_testing is False  # restored
