@@ -57,8 +57,7 @@ __all__ = [
 
 #: mesh file types read (through trimesh)
 MESH_SURFACE_TYPES = ("stl", "obj", "ply", "off")
-#: the most triangles a target mesh may have (a 1000 x 1000 height grid is 2e6; closest-point
-#: queries on 2e6 triangles take about 1 s per thousand points)
+#: the most triangles a target mesh may have (a 1000 x 1000 height grid is 2e6; docs/limits.md)
 MAX_SURFACE_FACES = 2_000_000
 #: (smallest, largest) plausible extent of a target surface, m (as for curves)
 PLAUSIBLE_SIZE = (0.01, 100.0)
