@@ -89,13 +89,15 @@ def check_fold(
     crease_width: float | None = None,
     E: float = 2e9,
     max_iter: int = 30,
+    max_step_deg: float = 3.0,
 ) -> FoldCheck:
     """Fold ``fit`` (a :class:`~holofold.fitting.SurfaceFit`) from flat by simulation.
 
     Thicknesses and crease width (m) default to fractions of the mean panel edge h: panels
     h / 20, creases a quarter of that, crease width h / 10 (stiff panels, soft creases: only
     the ratios matter to the shape, the fitted state being stress free). ``tolerance`` is
-    relative to the target's size.
+    relative to the target's size. ``max_step_deg`` is the largest rest-angle change per
+    actuation step (a step that does not converge is retried at half the size).
     """
     t0 = time.perf_counter()
     tolerance = check_range("tolerance", tolerance, 0.0, None, low_open=True)
@@ -105,7 +107,7 @@ def check_fold(
     tc = tp / 4 if crease_thickness is None else crease_thickness
     W = h / 10 if crease_width is None else crease_width
     res = fold_pattern(pattern, 1.0, panel_thickness=tp, crease_thickness=tc, crease_width=W,
-                       E=E, max_iter=max_iter)  # fmt: skip
+                       E=E, max_iter=max_iter, max_step_deg=max_step_deg)  # fmt: skip
     size = fit.target.size
     tol_m = tolerance * size
     final = res.coords[-1]
