@@ -187,6 +187,16 @@ def _numba_missing() -> str | None:
     return None
 
 
+def _require_numba() -> None:
+    """:class:`EnvironmentFault` (cause and fix) where numba cannot be imported."""
+    why = _numba_missing()
+    if why:
+        raise EnvironmentFault(
+            f"the compiled kernels need numba, which cannot be imported ({why}); "
+            f"pip install numba, or set {ENV}=numpy"
+        )
+
+
 def kernel_path(name: str) -> KernelPath:
     """The path ``name`` (``numpy`` or ``compiled``); the compiled one is compiled in this
     process if its cache is cold. Raises :class:`EnvironmentFault` where numba is missing or
@@ -195,12 +205,7 @@ def kernel_path(name: str) -> KernelPath:
         return _numpy_path()
     if name != "compiled":
         raise ValueError(f"kernel path must be one of {KERNEL_PATHS}, got {name!r}")
-    why = _numba_missing()
-    if why:
-        raise EnvironmentFault(
-            f"the compiled kernels need numba, which cannot be imported ({why}); "
-            f"pip install numba, or set {ENV}=numpy"
-        )
+    _require_numba()
     try:
         return KernelPath("compiled", _import_compiled())
     except EnvironmentFault:
@@ -334,12 +339,7 @@ def compile_kernels(*, marker: bool = False) -> float:
     running small models through each assembly and solver path; returns the seconds it took.
     With ``marker``, records in the cache folder that they are ready (or why they failed)."""
     t0 = time.perf_counter()
-    why = _numba_missing()
-    if why:
-        raise EnvironmentFault(
-            f"the compiled kernels need numba, which cannot be imported ({why}); "
-            f"pip install numba, or set {ENV}=numpy"
-        )
+    _require_numba()
     try:
         from holofold.mechanics._warmup import run_warmup
 
