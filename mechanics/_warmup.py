@@ -51,6 +51,11 @@ def _exercise(structures) -> None:
     US = np.ascontiguousarray(np.tile(U.ravel(), (len(structures), 1)))
     batch.factorized(US.reshape(len(structures), -1, 3), np.ones(len(structures), bool))
     batch.newton_step(US, np.zeros_like(US), np.ones(len(structures), bool))
+    from holofold.mechanics.solvers import solve_newton_batch
+
+    load = np.zeros((s.n_nodes, 3))
+    load[-1, 2] = -1e-3
+    solve_newton_batch(structures, [load] * len(structures), increments=2, tol=1e-9)
 
 
 def _thermal() -> None:

@@ -92,14 +92,14 @@ _ROWS = textwrap.dedent(
     first = time.perf_counter() - t0
     sm = get_scenario("single-miura").evaluate(
         {"tcrease": 8e-4, "tpanel": 3e-3, "W": 2e-3, "gama": 1.0})
-    misses = 0
+    misses = []
     if kernels.active().compiled:
         from holofold.mechanics import _compiled, _spring_loop
         for mod in (_compiled, _spring_loop):
             for name in dir(mod):
                 fn = getattr(mod, name)
-                if hasattr(fn, "stats"):
-                    misses += sum(fn.stats.cache_misses.values())
+                if hasattr(fn, "stats") and sum(fn.stats.cache_misses.values()):
+                    misses.append(name)
     print(json.dumps({"path": kernels.active().name, "first": first, "misses": misses,
                       "Zstiff": out["Zstiff"], "single": sm["axialstiff60"]}))
     """
@@ -125,7 +125,7 @@ def test_cold_start_runs_on_numpy_while_compiling_then_a_warm_cache_needs_no_com
         assert time.monotonic() < deadline, "the background compile did not finish in 600 s"
         time.sleep(1)
     warm, _ = _rows(tmp_path)
-    assert warm["path"] == "compiled" and warm["misses"] == 0, warm
+    assert warm["path"] == "compiled" and warm["misses"] == [], warm
     for key in ("Zstiff", "single"):  # converged outputs: the paths agree to 1e-9
         assert warm[key] == pytest.approx(cold[key], rel=1e-9)
     numpy, _ = _rows(tmp_path, HOLOFOLD_KERNELS="numpy")
