@@ -18,11 +18,15 @@ Strategies (seeded; the same seed gives the same designs):
 * ``rounds``: today's design loop (``holofold design`` defaults): 500 random designs, the top 3
   distinct rules verified with 50 designs each, then rounds of 100 designs inside and around
   the rules (or around the designs meeting the target when there is no rule yet).
+* ``loop`` and ``loop-around``: the design loop itself (``run_design``, its defaults, rounds
+  until a rule is verified), sampling where the forest votes for the target (its default) or
+  around the rules.
 * ``likelihood``: forest-likelihood sampling. 200 random designs; each round the rule miner is
-  fitted on every simulated design, 100 new designs are drawn from 20,000 random candidates
+  fitted on every simulated design, 50 new designs are drawn from 20,000 random candidates
   with probability proportional to the square of the forest's vote for the target (where the
-  forest says the target is likely), and the best rule is verified only when its estimate
-  (``Rule.estimate``) reaches 0.85 (at most once per round).
+  forest says the target is likely), and the rule with the best lower estimate
+  (``Rule.estimate.low``) is verified when its estimate reaches 0.85 (one rule per round, never
+  the same box twice; its verification designs join the database).
 
 Run it niced; simulations are cached under ``benchmarks/.cache/rare`` (gitignored), so a second
 run re-mines without simulating. ``--quick`` runs the cheap scenarios only.
@@ -273,17 +277,28 @@ def rounds(ctx: Context, samples=500, refine=100, top=3) -> Run:
     return ctx.run
 
 
-def likelihood(ctx: Context, start=200, batch=100, candidates=20000, gate=0.85) -> Run:
+def likelihood(ctx: Context, start=200, batch=50, candidates=20000, gate=0.85) -> Run:
+    """Forest-likelihood sampling with one verification at a time.
+
+    Each round the miner is fitted on every simulated design; ``batch`` new designs are drawn
+    from ``candidates`` random ones with probability proportional to the square of the forest's
+    vote for the target; the rule with the best lower estimate (``estimate.low``) is verified
+    when its estimate reaches ``gate``, and the verification designs join the database (where
+    the rule fails, the next trees learn it).
+    """
     table = ctx.simulate(sample_designs(ctx.sc, start, seed=ctx.seed))
     r = 0
     rng = np.random.default_rng(ctx.seed)
+    tried = set()
     while ctx.run.sims < BUDGET:
-        m, good, y = ctx.fit(table, n_rules=3)
+        m, good, y = ctx.fit(table, n_rules=5)
         ctx.run.rounds = r + 1
-        rules = mined_rules(m) if m is not None else []
-        if rules:
-            best = max(rules, key=lambda x: x.estimate.precision)
+        rules = [x for x in (mined_rules(m) if m is not None else []) if x.to_json()["bounds"]]
+        fresh = [x for x in rules if repr(x.conditions) not in tried]
+        if fresh:
+            best = max(fresh, key=lambda x: x.estimate.low)
             if best.estimate.precision >= gate:
+                tried.add(repr(best.conditions))
                 ok, res = ctx.verify(best, seed=ctx.seed + 100 * r + 1)
                 table = pd.concat([table, res], ignore_index=True)
                 if ok:
@@ -292,8 +307,7 @@ def likelihood(ctx: Context, start=200, batch=100, candidates=20000, gate=0.85) 
         if m is None:
             pick = rng.choice(candidates, batch, replace=False)
         else:
-            p = m.forest_probability(pool[list(ctx.roles.features)]) ** 2
-            p = p + 1e-12
+            p = m.forest_probability(pool[list(ctx.roles.features)]) ** 2 + 1e-12
             pick = rng.choice(candidates, batch, replace=False, p=p / p.sum())
         new = pool.iloc[pick].drop(columns="sample")
         table = pd.concat([table, ctx.simulate(new)], ignore_index=True)
@@ -301,11 +315,55 @@ def likelihood(ctx: Context, start=200, batch=100, candidates=20000, gate=0.85) 
     return ctx.run
 
 
+def loop(ctx: Context, **kw) -> Run:
+    """The design loop itself (``run_design`` with its defaults: rounds until a rule is
+    verified, at most 10), its simulations routed through the cache."""
+    import tempfile
+
+    import holofold.design.loop as design_loop
+
+    real = design_loop._simulate
+
+    def cached(scenario, designs, folder, workers, progress):
+        res = ctx.simulate(designs.drop(columns="sample", errors="ignore"))
+        return res.assign(sample=designs["sample"].to_numpy())
+
+    params = dict(files=False, seed=ctx.seed, progress=False, workers=1)
+    params.update(kw)
+    design_loop._simulate = cached
+    try:
+        with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = design_loop.run_design(ctx.sc, ctx.case.target, folder, **params)
+    except ValueError as exc:  # no design meets the target, or no rule in the last round
+        ctx.run.log.append(str(exc))
+        return ctx.run
+    finally:
+        design_loop._simulate = real
+    rounds = out.summary["rounds"]
+    ctx.run.rounds = len(rounds)
+    ctx.run.verified = tuple(
+        (round(e["verified_precision"] * e["verified_n"]), e["verified_n"])
+        for h in rounds for e in h["rules"] if e.get("verified_n")
+    )  # fmt: skip
+    rule = out.summary["rule"]
+    if design_loop._verified(rule):
+        ctx.run.passed, ctx.run.rule = True, rule["rule"]
+    return ctx.run
+
+
+def loop_around(ctx: Context) -> Run:
+    """The design loop sampling around the rules (today's refinement), until verified."""
+    return loop(ctx, strategy="around")
+
+
 STRATEGIES = {
     "one-shot": one_shot,
     "one-shot-holofold": one_shot_holofold,
     "rounds": rounds,
     "likelihood": likelihood,
+    "loop": loop,
+    "loop-around": loop_around,
 }
 
 

@@ -17,6 +17,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
         "demo": ["run_demo", "DEMO_TARGET"],
+        "acquisition": ["likely_designs"],
         "folder_lock": ["folder_lock", "FolderBusyError"],
         "loop": ["run_design", "DesignOutcome", "refine_designs", "choose_design"],
         "objective": ["Objective", "parse_objective"],

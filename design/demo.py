@@ -38,6 +38,6 @@ def run_demo(
     """
     out = run_design(
         shipped_scenarios()["arch"], target, folder, samples=samples, rounds=rounds,
-        refine=refine, verify=verify, seed=seed, workers=workers, say=say,
+        refine=refine, verify=verify, seed=seed, workers=workers, say=say, until_verified=False,
     )  # fmt: skip
     return out.summary

@@ -7,7 +7,8 @@
    conditions is met by none of them, the run stops there and says what the designs reach;
 2. **mine**: rules for the target (random forest), keeping distinct alternatives;
 3. **verify**: simulate fresh designs inside each top rule (95 % Wilson interval);
-4. **refine** (``rounds`` times): sample new designs inside and around the best rules, add them
+4. **refine** (at most ``rounds`` times, until a rule is verified): sample new designs where the
+   last round's forest votes for the target (or inside and around the best rules), add them
    (and the verification designs) to the database, re-mine and re-verify;
 5. **choose** (:mod:`~holofold.design.choice`): from every simulated design, the best under the
    designer's objective inside the best verified rule of all rounds; without a qualifying rule
@@ -39,6 +40,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from holofold.design.acquisition import likely_designs
 from holofold.design.batches import grow
 from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed, part_fit
 from holofold.design.choice import Candidate, choose
@@ -57,11 +59,17 @@ from holofold.design.store import build_database, load_database
 from holofold.design.summary import STAGES, DesignSummary, Pick, Timings
 from holofold.design.tables import ColumnRoles, write_table
 from holofold.design.targets import parse_target
-from holofold.design.verify import as_rule, rule_key, rule_ranges, verify_rules
+from holofold.design.verify import as_rule, rule_key, rule_ranges, verify_rule
 from holofold.geometry.outputs import write_json
 from holofold.geometry.units import length_factor
 
 __all__ = ["run_design", "DesignOutcome", "refine_designs", "choose_design", "STAGES"]
+
+#: where refinement rounds sample (:func:`run_design`'s ``strategy``)
+REFINE_STRATEGIES = ("likely", "around")
+#: a rule is verified (fresh simulations) once its estimate reaches this precision: a rule the
+#: miner expects below it would not pass (90 % of its fresh designs meeting the target)
+VERIFY_FROM = 0.85
 
 
 @dataclass(frozen=True)
@@ -352,11 +360,13 @@ def run_design(
     target: str,
     folder: str | os.PathLike,
     *,
-    samples: int = 500,
-    rounds: int = 0,
-    refine: int = 100,
+    samples: int = 200,
+    rounds: int = 10,
+    refine: int = 50,
     verify: int = 50,
     top: int = 3,
+    strategy: str = "likely",
+    until_verified: bool = True,
     db: str | os.PathLike | None = None,
     seed: int = 0,
     workers: int = 1,
@@ -383,13 +393,24 @@ def run_design(
     samples : int
         Designs in the base database (>= 20).
     rounds : int
-        Refinement rounds (0: mine once, as the paper did).
+        Refinement rounds at most (0: mine once, as the paper did).
     refine : int
         New designs per refinement round.
     verify : int
-        Fresh designs simulated per verified rule and round.
+        Fresh designs simulated per verified rule and round. A rule is verified when its
+        estimate reaches :data:`VERIFY_FROM` (in the last round at least the best one), best
+        lower estimate first.
     top : int
-        Rules kept and verified per round (distinct alternatives).
+        Rules kept per round (distinct alternatives).
+    strategy : {"likely", "around"}
+        Where a refinement round samples: ``"likely"``, where the last round's forest votes for
+        the target (:func:`holofold.design.acquisition.likely_designs`: fewer simulations to a
+        verified rule on rare targets, ``benchmarks/bench_rare_targets.py``); ``"around"``, half
+        inside the rules and half in them widened by a quarter of each range
+        (:func:`refine_designs`; around the designs meeting the target while there is no rule).
+    until_verified : bool
+        Stop once a rule is verified: at least 90 % of its fresh designs meet the target and
+        the 95 % interval's lower end is at least 0.8 (:func:`rule_verified`).
     db : path, optional
         Database folder to use instead of ``folder/database`` (reused and extended). A folder
         made by ``holofold generate`` (with its ``meta.json``) gives all its rows, extended with
@@ -431,6 +452,10 @@ def run_design(
     ):
         if isinstance(v, bool) or int(v) != v or v < low:
             raise ValueError(f"{name} = {v!r} must be an integer >= {low}")
+    if strategy not in REFINE_STRATEGIES:
+        raise ValueError(
+            f"strategy = {strategy!r} must be one of {', '.join(map(repr, REFINE_STRATEGIES))}"
+        )
     total = samples + rounds * refine + (rounds + 1) * top * verify
     if total > MAX_SAMPLES:
         raise ValueError(
@@ -522,6 +547,8 @@ def run_design(
             refine=refine,
             verify=verify,
             top=top,
+            strategy=strategy,
+            until_verified=until_verified,
             seed=seed,
             workers=workers,
             progress=progress,
@@ -681,6 +708,8 @@ def _rounds(
     refine,
     verify,
     top,
+    strategy,
+    until_verified,
     seed,
     workers,
     progress,
@@ -697,10 +726,17 @@ def _rounds(
         rdir = out / "rounds" / f"round-{r}"
         if r:
             t0 = time.perf_counter()
-            say(f"[refine] round {r}/{rounds}: {refine} new designs inside and around the rules")
             s = seed + 7919 * r
-            key = _key([rule_key(b) for b in boxes], refine, s)
-            new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
+            if strategy == "likely":
+                say(f"[refine] round {r}/{rounds}: {refine} new designs where the forest votes "
+                    "for the target")  # fmt: skip
+                key = _key("likely", [rule_key(b) for b in boxes], len(table), refine, s)
+                new = likely_designs(sc, miners[r - 1].miner, refine, seed=s, start=10**6 * r)
+            else:
+                say(f"[refine] round {r}/{rounds}: {refine} new designs inside and around the "
+                    "rules")  # fmt: skip
+                key = _key([rule_key(b) for b in boxes], refine, s)
+                new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
             res = simulate(new, dbf / f"refine-{r}-{key}")
             table = pd.concat([table, res.assign(origin=f"refine-{r}")], ignore_index=True)
             times["refine"] += time.perf_counter() - t0
@@ -748,23 +784,21 @@ def _rounds(
                 break  # nothing to refine around: more rounds would sample the same
             continue
         t0 = time.perf_counter()
-        say(f"[verify] round {r}: {len(records)} rule(s), {verify} fresh designs each")
-        checks = verify_rules(
-            sc,
-            records,
-            tgt,
-            verify,
-            seed=seed + 100 * r,
-            folder=rdir / "verify",
-            workers=workers,
-            progress=progress,
-        )
-        for i, rec in enumerate(records, start=1):  # the verification databases read
-            vdir = rdir / "verify" / f"rule{i}-{rule_key(rec)}"
+        worth = _worth_verifying(records, last=r == rounds)
+        say(f"[verify] round {r}: {len(worth)} of {len(records)} rule(s) (estimate >= "
+            f"{VERIFY_FROM}), {verify} fresh designs each")  # fmt: skip
+        checks: list = [None] * len(records)
+        for i in worth:  # best lower estimate first; the first verified rule ends the round
+            rec = records[i]
+            vdir = rdir / "verify" / f"rule{i + 1}-{rule_key(rec)}"
+            checks[i] = verify_rule(sc, rec, tgt, verify, seed=seed + 100 * r + i + 1,
+                                    folder=vdir, workers=workers, progress=progress)  # fmt: skip
             used.update(p.parent.resolve() for p in vdir.rglob("designs.parquet"))
+            if until_verified and rule_verified(checks[i].counts):
+                break
         times["verify"] += time.perf_counter() - t0
         ranked = [
-            VerifiedRule.of(rec, r, v.counts, sc.columns)
+            VerifiedRule.of(rec, r, None if v is None else v.counts, sc.columns)
             for rec, v in zip(records, checks, strict=True)
         ]
         for e in ranked:
@@ -773,13 +807,41 @@ def _rounds(
                 f"{_fmt(e.test_precision)}, verified {_fmt(e.precision)})"
             )
         for i, v in enumerate(checks, start=1):
+            if v is None:
+                continue
             table = pd.concat(
                 [table, v.designs.drop(columns="meets_target").assign(origin=f"verify-{r}-{i}")],
                 ignore_index=True,
             )
         history.append(Round(r, rows, failed, hits, tuple(ranked)))
         boxes = records
+        done = [e for e in ranked if e.verified is not None and rule_verified(e.verified)]
+        if until_verified and done and r < rounds:
+            say(f"  round {r}: rule {done[0].rank} is verified; no more rounds")
+            break
     return table, history, miners
+
+
+def rule_verified(counts) -> bool:
+    """A rule is verified: at least 90 % of its fresh designs met the target and the lower end
+    of their 95 % Wilson interval is at least 0.8 (``counts``: a verification's ``Counts``)."""
+    p, ci = counts.precision, counts.interval
+    return p is not None and p >= 0.9 and ci[0] >= 0.8
+
+
+def _worth_verifying(rules: Sequence[Rule], last: bool) -> list[int]:
+    """Positions of the rules to verify, best lower estimate first: those whose estimate reaches
+    :data:`VERIFY_FROM` (a rule the miner expects below it would not be verified); in the last
+    round at least the best one."""
+
+    def low(i):
+        e = rules[i].estimate
+        return -1.0 if e is None else e.low
+
+    order = sorted(range(len(rules)), key=low, reverse=True)
+    worth = [i for i in order if rules[i].estimate is None
+             or rules[i].estimate.precision >= VERIFY_FROM]  # fmt: skip
+    return worth or (order[:1] if last else [])
 
 
 def _scenario_summary(sc: Scenario) -> dict:

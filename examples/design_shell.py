@@ -53,7 +53,7 @@ def main(out: Path, samples: int) -> dict:
     # centred thick panels of most designs meet where the folds close (the overlap column): the
     # designer accepts that here (offset panels, docs/fabrication.md, would avoid it)
     outcome = run_design(HERE / "my_shell.toml", TARGET, out / "design", samples=samples,
-                         verify=10, top=2, workers=2, progress=False, say=print,
+                         verify=10, top=2, rounds=0, workers=2, progress=False, say=print,
                          allow_overlap=True)  # fmt: skip
     # the chosen design, simulated again from its features alone
     sc = hf.design.read_scenario(HERE / "my_shell.toml")

@@ -44,7 +44,7 @@ def test_the_petg_canopy_ends_with_a_design_files_and_a_report(tmp_path, capsys)
     out = tmp_path / "canopy"
     target = "Pstiff > 1500 & error < 0.02 & Psnap == 0"
     code = main(["design", str(EXAMPLES / "petg_canopy.toml"), "--target", target, "-o", str(out),
-                 "-n", "120", "--verify", "10", "--top", "2", "--no-progress",
+                 "-n", "120", "--verify", "10", "--top", "2", "--rounds", "0", "--no-progress",
                  "--objective", "min mass"])  # fmt: skip
     said = capsys.readouterr().out
     s = json.loads((out / "design.json").read_text())

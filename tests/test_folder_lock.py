@@ -91,7 +91,7 @@ def test_a_second_generate_into_a_busy_folder_is_refused_and_the_first_is_intact
 def test_two_design_runs_with_other_units_never_mix_files(tmp_path):
     out = tmp_path / "d"
     argv = [*CLI, "design", "single-miura", "--target", "axialstiff60 > 40000", "-n", "60",
-            "--verify", "3", "--top", "1", "--workers", "1", "--no-progress",
+            "--verify", "3", "--top", "1", "--rounds", "0", "--workers", "1", "--no-progress",
             "-o", str(out)]  # fmt: skip
     a = _start([*argv, "--units", "m"], out)
     _refused([*argv, "--units", "mm"], out)

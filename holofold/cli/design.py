@@ -18,7 +18,8 @@ def register(subparsers) -> argparse.ArgumentParser:
             "Build (or reuse and extend) a database of the scenario, a pilot batch first (the "
             "run stops after it, saying what the designs reach, when none meets the target), "
             "mine design rules for the target, verify the best rules with fresh simulations, "
-            "optionally refine around them for --rounds rounds, and choose from every simulated "
+            "refine where the forest expects the target and mine again until a rule is verified "
+            "(at most --rounds rounds), and choose from every simulated "
             "design the best under --objective inside the best verified rule of all rounds "
             "(without one: the best design meeting the target; without that: the nearest, with "
             "its shortfall). Designs whose thick panels overlap are not chosen unless "
@@ -41,7 +42,9 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("scenario", help="scenario name (holofold scenarios) or a scenario file .toml")
     p.add_argument("--target", required=True, help="target over the performance columns")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
-    p.add_argument("-n", "--samples", type=int, default=500, help="designs in the base database")
+    p.add_argument(
+        "-n", "--samples", type=int, default=200, help="designs in the base database (default 200)"
+    )
     p.add_argument(
         "--objective",
         default="margin",
@@ -66,8 +69,29 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="designs simulated first to check the target is reachable (default 50; 0: none)",
     )
     p.add_argument("--db", type=Path, help="database folder (default OUT/database)")
-    p.add_argument("--rounds", type=int, default=0, help="refinement rounds (default 0)")
-    p.add_argument("--refine", type=int, default=100, help="new designs per refinement round")
+    p.add_argument(
+        "--rounds",
+        type=int,
+        default=10,
+        help="refinement rounds at most (default 10; 0 mines once, as the paper); the loop stops "
+        "once a rule is verified: 90 %% of its fresh designs meet the target and the 95 %% "
+        "interval's lower end is at least 0.8",
+    )
+    p.add_argument(
+        "--refine", type=int, default=50, help="new designs per refinement round (default 50)"
+    )
+    p.add_argument(
+        "--strategy",
+        choices=("likely", "around"),
+        default="likely",
+        help="where a refinement round samples: where the forest votes for the target (likely, "
+        "default) or inside and around the rules (around)",
+    )
+    p.add_argument(
+        "--all-rounds",
+        action="store_true",
+        help="run every refinement round, also after a rule is verified",
+    )
     p.add_argument("--verify", type=int, default=50, help="fresh designs per verified rule")
     p.add_argument("--top", type=int, default=3, help="rules kept and verified per round")
     p.add_argument("--seed", type=int, default=0)
@@ -96,6 +120,8 @@ def run(args) -> int:
         refine=args.refine,
         verify=args.verify,
         top=args.top,
+        strategy=args.strategy,
+        until_verified=not args.all_rounds,
         db=args.db,
         seed=args.seed,
         workers=args.workers,
