@@ -60,14 +60,16 @@ def _refused(argv, folder):
 
 
 def _gen(folder, *extra):
-    return [*CLI, "generate", "single-miura", "-o", str(folder), "--chunk-size", "10", *extra]
+    return [*CLI, "generate", "single-miura", "-o", str(folder), "--chunk-size", "500", *extra]
 
 
+# the first run must outlast the second's start (a Python process importing holofold, 1-3 s):
+# single-Miura rows take about 0.5 ms each, so it simulates 8000
 @pytest.mark.parametrize(
     ("first", "second"),
-    [pytest.param(["-n", "200", "--seed", "0"], ["-n", "200", "--seed", "1"],
+    [pytest.param(["-n", "8000", "--seed", "0"], ["-n", "8000", "--seed", "1"],
                   marks=pytest.mark.slow),  # another --seed
-     (["-n", "200", "--seed", "0"], ["-n", "190", "--seed", "0"])],  # another -n
+     (["-n", "8000", "--seed", "0"], ["-n", "7900", "--seed", "0"])],  # another -n
     ids=["seed", "rows"],
 )  # fmt: skip
 def test_a_second_generate_into_a_busy_folder_is_refused_and_the_first_is_intact(
