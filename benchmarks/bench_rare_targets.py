@@ -39,6 +39,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import math
+import os
 import sys
 import time
 import warnings
@@ -407,21 +408,27 @@ def main(argv=None) -> int:
                              "passed": run.passed, "rounds": run.rounds,
                              "verified": " ".join(f"{k}/{n}" for k, n in run.verified),
                              "rule": run.rule, "seconds": time.perf_counter() - t0})  # fmt: skip
+                save(rows[-1:], out)
                 print(f"{case.label:14s} {name:10s} seed {seed}: "
                       f"{'passed' if run.passed else 'gave up'} after {run.sims} sims, "
                       f"{run.rounds} rounds; {rows[-1]['verified']}; {run.rule}",
                       flush=True)  # fmt: skip
+    print(table(pd.DataFrame(rows)))
+    return 0
+
+
+def save(rows: list[dict], out: Path) -> None:
+    """Merge ``rows`` into the results file: rows of other cases, strategies or seeds stay;
+    these replace their own."""
     frame = pd.DataFrame(rows)
-    print(table(frame))
-    if out.is_file():  # runs of other cases or strategies stay; these replace their own rows
+    if out.is_file():
         old = pd.read_csv(out)
         key = ["case", "strategy", "seed"]
         mine = old.set_index(key).index.isin(frame.set_index(key).index)
         frame = pd.concat([old.loc[~mine], frame], ignore_index=True)
-    tmp = out.with_suffix(".tmp")
+    tmp = out.with_suffix(f".{os.getpid()}.tmp")
     frame.to_csv(tmp, index=False)
     tmp.replace(out)
-    return 0
 
 
 def table(frame: pd.DataFrame) -> str:

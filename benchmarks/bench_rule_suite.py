@@ -187,11 +187,15 @@ def _forest_task(db, target, split, forest, methods, ext_db=None) -> dict:
 
 def _baseline_task(db, target, split) -> dict:
     from sklearn.ensemble import GradientBoostingClassifier
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
 
     X = pd.get_dummies(db.table[list(db.features)], columns=list(db.categorical), dtype=float)
     y = target.labels(db)
     train, test = split_indices(len(y), random_state=split)
-    model = GradientBoostingClassifier(random_state=split).fit(X.iloc[train], y[train])
+    # standardised first: scikit-learn's trees cannot split features closer than 1e-7 (SI)
+    model = make_pipeline(StandardScaler(), GradientBoostingClassifier(random_state=split))
+    model.fit(X.iloc[train], y[train])
     pred = model.predict(X.iloc[test])
     yte = y[test]
     n_pred = int(pred.sum())

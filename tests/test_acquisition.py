@@ -38,3 +38,32 @@ def test_likely_designs_go_where_the_target_is():
     with pytest.raises(ValueError, match="must be in"):
         likely_designs(sc, m, 0, seed=1)
     assert np.all((new[["a", "b", "c"]] >= 0) & (new[["a", "b", "c"]] <= 1))
+
+
+def _loop_scenario():
+    return Scenario(
+        name="toy-loop", description="toy", check=lambda row: [],
+        evaluate=lambda row: {"y": row["a"] + 0.01 * row["b"], "status": CONVERGED},
+        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
+        performance=(Column("y", "-"),),
+    )  # fmt: skip
+
+
+def test_the_loop_stops_once_a_rule_is_verified(tmp_path):
+    from holofold.design import run_design
+
+    said = []
+    out = run_design(_loop_scenario(), "y > 0.5", tmp_path / "o", samples=120, rounds=4, pilot=0,
+                     workers=1, progress=False, files=False, say=said.append)  # fmt: skip
+    rounds = out.summary["rounds"]
+    assert len(rounds) == 1 and any("is verified; no more rounds" in s for s in said)
+    checked = [r for r in rounds[0]["rules"] if r.get("verified_n")]
+    assert checked and checked[-1]["verified_precision"] >= 0.9  # the last one tried passed
+    assert checked[-1]["verified_95ci"][0] >= 0.8
+    assert all(r["estimate"]["precision"] >= 0.85 for r in checked)
+    again = run_design(_loop_scenario(), "y > 0.5", tmp_path / "p", samples=120, rounds=2, pilot=0,
+                       workers=1, progress=False, files=False, until_verified=False,
+                       strategy="around")  # fmt: skip
+    assert len(again.summary["rounds"]) == 3
+    with pytest.raises(ValueError, match="strategy = 'near' must be one of 'likely', 'around'"):
+        run_design(_loop_scenario(), "y > 0.5", tmp_path / "q", strategy="near")
