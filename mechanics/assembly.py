@@ -320,13 +320,12 @@ class Assembler:
             if solve is not None:
                 return solve
             # not positive definite: LU below
-        data = self._tangent(a, "csr")
         if path == "cholesky":
-            solve = linear.cholesky_solver(data, red)
+            solve = linear.cholesky_solver(self._tangent(a, "csr_upper"), red)
             if solve is not None:
                 return solve
-            # not positive definite: LU on the same data
-        return linear.lu_solver(data, red)
+            # not positive definite: LU below
+        return linear.lu_solver(self._tangent(a, "csr"), red)
 
     def dense_stepper(self, U, F, spring_rest=None, r=None):
         """A :class:`~holofold.mechanics.newton_step.DenseStepper`: ``step()`` does
@@ -497,18 +496,14 @@ class BatchAssembler:
         (``rest``: its rest angles, for the LU fallback's own evaluation)."""
         if path == "dense":
             return linear.dense_solver(values.reshape(red.n_free, red.n_free))
-        if path == "banded":
-            solve = linear.band_solver(values, red)
+        if path in ("banded", "cholesky"):
+            factor = linear.band_solver if path == "banded" else linear.cholesky_solver
+            solve = factor(values, red)
             if solve is not None:
                 return solve
-            # not positive definite: LU on the CSR data of this sample alone
+            # not positive definite: LU on the full CSR data of this sample alone
             a = self.assemblers[s]
             values = a._tangent(a._kernels(U, rest, True, a._buffers()), "csr")
-        elif path == "cholesky":
-            solve = linear.cholesky_solver(values, red)
-            if solve is not None:
-                return solve
-            # not positive definite: LU on the same CSR data
         try:
             return linear.lu_solver(values, red)
         except SingularSystemError as exc:

@@ -55,7 +55,7 @@ CHOLESKY_MIN_WORK = 4e7
 BANDED_MAX_WORK = 2e10
 #: the solver paths, by the storage of the tangent each factorises
 SOLVER_PATHS = {
-    "none": None, "dense": "dense", "banded": "banded", "cholesky": "csr", "superlu": "csr",
+    "none": None, "dense": "dense", "banded": "banded", "cholesky": "csr_upper", "superlu": "csr",
 }  # fmt: skip
 
 NON_FINITE = "non-finite solution of the linear system (singular stiffness)"
@@ -208,14 +208,16 @@ def lu_solver(data: np.ndarray, red: ReducedPattern):
 
 def _cholesky_analysis(red: ReducedPattern):
     """The reduction's :class:`~holofold.mechanics.sparse_cholesky.SparseCholesky` (AMD
-    ordering and symbolic analysis of the free-free pattern), reading the full CSR data."""
+    ordering and symbolic analysis of the free-free pattern), reading the ``"csr_upper"``
+    storage (each upper-triangle entry of the reduced CSR at its compact position)."""
     from holofold.mechanics.sparse_cholesky import SparseCholesky
 
-    return SparseCholesky(red.indptr, red.indices, data_slots=red.keep)
+    compact = np.cumsum(red.rows <= red.cols) - 1  # lower entries: never read
+    return SparseCholesky(red.indptr, red.indices, data_slots=np.maximum(compact, 0))
 
 
 def cholesky_solver(data: np.ndarray, red: ReducedPattern):
-    """``solve(rhs)`` by the supernodal sparse Cholesky of the free-free block of the full CSR
-    ``data`` (the reduction's cached analysis), or None if the block is not positive
-    definite."""
+    """``solve(rhs)`` by the supernodal sparse Cholesky of the free-free block from its upper
+    triangle ``data`` (the ``"csr_upper"`` storage; the reduction's cached analysis), or None
+    if the block is not positive definite."""
     return red.symbolic("cholesky", _cholesky_analysis).factor(data)

@@ -13,8 +13,9 @@ increments are 0 either way).
 Storages of the free-free tangent (:data:`STORAGES`): ``"dense"`` (row-major nf x nf),
 ``"dense_cm"`` (column-major: the Fortran copy LAPACK factorises), ``"dense_upper"`` (its upper
 triangle only, for a Cholesky factorisation; the rest stays zero), ``"banded"`` (LAPACK upper
-band, column-major) and ``"csr"`` (the full CSR data; the reduction keeps :attr:`ReducedPattern.
-keep`).
+band, column-major), ``"csr"`` (the full CSR data; the reduction keeps :attr:`ReducedPattern.
+keep`) and ``"csr_upper"`` (the free-free upper triangle only, the entries of
+:attr:`ReducedPattern.upper_keep` in order: what a sparse Cholesky reads).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ __all__ = [
     "sum_lists",
 ]
 
-STORAGES = ("dense", "dense_cm", "dense_upper", "banded", "csr")
+STORAGES = ("dense", "dense_cm", "dense_upper", "banded", "csr", "csr_upper")
 _PATTERN_CACHE: OrderedDict[bytes, AssemblyPattern] = OrderedDict()
 _PATTERN_CACHE_SIZE = 8
 
@@ -145,6 +146,12 @@ class ReducedPattern:
         return self._symbolic[key]
 
     @cached_property
+    def upper_keep(self) -> np.ndarray:
+        """(nnz_u,) int: the slots of :attr:`keep` in the upper triangle (row <= column), in
+        order: the entries of the ``"csr_upper"`` storage."""
+        return self.keep[self.rows <= self.cols]
+
+    @cached_property
     def band(self) -> Band:
         nf = self.free.size
         A = sp.csr_matrix((np.ones(self.rows.size), self.indices, self.indptr), shape=(nf, nf))
@@ -204,6 +211,8 @@ class ReducedPattern:
             return self.band.size
         if storage == "csr":
             return self.pattern.nnz
+        if storage == "csr_upper":
+            return self.upper_keep.size
         raise ValueError(f"storage must be one of {STORAGES}, got {storage!r}")
 
     def tangent_sums(self, storage: str) -> SumLists:
@@ -226,6 +235,11 @@ class ReducedPattern:
                 lists = sum_lists(self._band_slots, self.band.size)
             elif storage == "csr":
                 lists = pat.data_sums
+            elif storage == "csr_upper":
+                at = np.full(pat.nnz + 1, -1, np.intp)  # full slot -> compact position
+                at[self.upper_keep] = np.arange(self.upper_keep.size)
+                fams = (at[pat.bar_slot], at[pat.spring_slot], at[pat.spring_slot_mirror])
+                lists = sum_lists(fams, self.upper_keep.size)
             else:
                 raise ValueError(f"storage must be one of {STORAGES}, got {storage!r}")
             self._symbolic[key] = lists
