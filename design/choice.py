@@ -295,6 +295,7 @@ def _headline(
     else:
         first = f"No simulated design meets the target (of {n_ok} simulated)."
     return (
-        f"{first} Shown: the nearest design, with the largest worst-case margin{miss}. "
+        f"{first} Shown: the nearest design{' whose panels do not overlap' if strict else ''}, "
+        f"with the largest worst-case margin{miss}. "
         "Loosen the target, widen the feature ranges or simulate more designs."
     )

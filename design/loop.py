@@ -43,7 +43,7 @@ import pandas as pd
 from holofold.design.acquisition import likely_designs
 from holofold.design.batches import grow
 from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed, part_fit
-from holofold.design.choice import Candidate, choose
+from holofold.design.choice import Answer, Candidate, choose
 from holofold.design.describe import PILOT, distributions
 from holofold.design.folder_lock import locks_folder
 from holofold.design.mining import mine_rules
@@ -580,7 +580,7 @@ def run_design(
         objective=str(obj),
         allow_overlap=bool(allow_overlap),
         answer=answer.kind,
-        headline=answer.headline,
+        headline=_headline(answer, pilot_info),
         chosen=_pick(sc, everything, answer.chosen, tgt),
         alternatives=tuple(_pick(sc, everything, c, tgt) for c in answer.alternatives),
         rounds=tuple(history),
@@ -619,6 +619,16 @@ def run_design(
     _check_own_summary(out, summary.to_json())
     _say_chosen(say, summary, tgt, out, sc.columns)
     return DesignOutcome(summary, everything, out)
+
+
+def _headline(answer: Answer, pilot: Mapping | None) -> str:
+    """The answer's sentence, after why the run stopped if its pilot stopped it."""
+    if pilot and pilot["stopped"]:
+        return (
+            f"The run stopped after its pilot of {pilot['rows']} designs: "
+            f"{pilot['reason']} (the designs' range is below). {answer.headline}"
+        )
+    return answer.headline
 
 
 def _replace(summary: DesignSummary, **kw) -> DesignSummary:
