@@ -18,7 +18,10 @@ from pathlib import Path
 
 from holofold.geometry import DEFAULT_BED, Bed
 
-__all__ = ["Bed", "DEFAULT_BED", "PrintablePart", "PartFit", "parse_bed", "part_fit"]
+__all__ = ["Bed", "DEFAULT_BED", "PrintablePart", "PartFit", "parse_bed", "part_fit", "FILM"]
+
+#: a part thinner than this is a film to cut, not a part to print (half a 0.2 mm layer), m
+FILM = 0.1e-3
 
 
 def parse_bed(text: str | Bed | tuple) -> Bed:
@@ -98,13 +101,26 @@ class PartFit:
     def bed_text(self) -> str:
         return f"{1e3 * self.bed[0]:g} x {1e3 * self.bed[1]:g} mm"
 
+    @property
+    def film(self) -> bool:
+        """Thinner than :data:`FILM`: cut from a sheet, not printed."""
+        return self.extent[2] < FILM
+
     def extent_text(self) -> str:
-        x, y, z = (1e3 * v for v in self.extent)
-        return f"{x:.0f} x {y:.0f} x {z:.1f} mm"
+        """``1132 x 126 x 3.53 mm``: three significant digits, no exponent."""
+        from holofold.design.scenarios import format_value
+
+        return " x ".join(format_value(1e3 * v, digits=3) for v in self.extent) + " mm"
 
     @property
     def advice(self) -> str:
         """What to do, in a sentence or two."""
+        if self.film:
+            return (
+                f"It is a film {1e3 * self.extent[2]:.3g} mm thick, thinner than one layer of "
+                "a desktop printer: cut it from a sheet of that thickness (laser or blade, "
+                "the pattern's SVG or DXF), do not print it."
+            )
         if self.fits:
             how = "as it lies" if abs(self.turn) < 1e-9 else f"turned by {self.turn:.0f} degrees"
             return f"It fits the {self.bed_text} bed {how}."
@@ -135,7 +151,7 @@ class PartFit:
             "fits": self.fits,
             "turn_deg": self.turn,
             "print_hours": self.hours,
-            "print_class": self.time_class,
+            "print_class": "not printed: a film" if self.film else self.time_class,
             "pieces": self.pieces,
             "segments": self.segments,
             "problem": self.problem,

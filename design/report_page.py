@@ -314,6 +314,12 @@ def _fabrication(summary: DesignSummary) -> str:
     if f is None:
         return ""
     bed = _esc(f.bed_text)
+    if f.film:
+        return (
+            '<div class="card" id="part"><h3>The part to make</h3>'
+            f'<p><a href="{_esc(quote(f.file, safe="/"))}">{_esc(f.file)}</a>: '
+            f"<b>{_esc(f.extent_text())}</b>.</p><p>{_esc(f.advice)}</p></div>"
+        )
     if f.fits:
         verdict = f'<span class="fits">fits</span> the {bed} bed'
     elif f.pieces:

@@ -57,3 +57,11 @@ def test_a_strip_too_long_for_the_bed_is_printed_in_pieces(tmp_path):
         lo, hi = trimesh.load_mesh(p).bounds
         assert lo[2] == pytest.approx(0, abs=1e-6) and hi[0] <= 600 + 1e-6 and hi[1] <= 500 + 1e-6
     assert f"into {got.pieces} pieces" in got.advice and "assembly.svg" in got.advice
+
+
+def test_a_film_is_cut_not_printed(tmp_path):
+    film = part_fit(_box(tmp_path, 12, 3, 0.02, "film.stl"))
+    assert film.film and film.fits and film.extent_text() == "12 x 3 x 0.02 mm"
+    assert "cut it from a sheet" in film.advice and "do not print" in film.advice
+    assert film.to_json()["print_class"] == "not printed: a film"
+    assert not part_fit(_box(tmp_path, 12, 3, 0.2, "plate.stl")).film
