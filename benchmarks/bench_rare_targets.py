@@ -322,16 +322,17 @@ def loop(ctx: Context, **kw) -> Run:
     import tempfile
 
     import holofold.design.loop as design_loop
+    import holofold.design.verify as design_verify
 
-    real = design_loop._simulate
+    real = design_loop.build_database, design_verify.build_database
 
-    def cached(scenario, designs, folder, workers, progress):
+    def cached(scenario, designs, path, **kw):  # the loop's and the verifier's simulations
         res = ctx.simulate(designs.drop(columns="sample", errors="ignore"))
         return res.assign(sample=designs["sample"].to_numpy())
 
-    params = dict(files=False, seed=ctx.seed, progress=False, workers=1)
+    params = dict(files=False, seed=ctx.seed, progress=False, workers=1, pilot=0)
     params.update(kw)
-    design_loop._simulate = cached
+    design_loop.build_database = design_verify.build_database = cached
     try:
         with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -340,16 +341,14 @@ def loop(ctx: Context, **kw) -> Run:
         ctx.run.log.append(str(exc))
         return ctx.run
     finally:
-        design_loop._simulate = real
+        design_loop.build_database, design_verify.build_database = real
     rounds = out.summary["rounds"]
     ctx.run.rounds = len(rounds)
-    ctx.run.verified = tuple(
-        (round(e["verified_precision"] * e["verified_n"]), e["verified_n"])
-        for h in rounds for e in h["rules"] if e.get("verified_n")
-    )  # fmt: skip
-    rule = out.summary["rule"]
-    if design_loop._verified(rule):
-        ctx.run.passed, ctx.run.rule = True, rule["rule"]
+    verified = [e for h in out.record.rounds for e in h.rules if e.verified is not None]
+    ctx.run.verified = tuple((e.verified.meeting, e.verified.simulated) for e in verified)
+    done = [e for e in verified if design_loop.rule_verified(e.verified)]
+    if done:
+        ctx.run.passed, ctx.run.rule = True, done[0].text
     return ctx.run
 
 

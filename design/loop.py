@@ -737,7 +737,12 @@ def _rounds(
         if r:
             t0 = time.perf_counter()
             s = seed + 7919 * r
-            if strategy == "likely":
+            if r - 1 not in miners:  # no design met the target yet: more at random
+                say(f"[refine] round {r}/{rounds}: {refine} new designs at random (none met "
+                    "the target yet)")  # fmt: skip
+                key = _key("random", refine, s)
+                new = sample_designs(sc, refine, seed=s, start=10**6 * r)
+            elif strategy == "likely":
                 say(f"[refine] round {r}/{rounds}: {refine} new designs where the forest votes "
                     "for the target")  # fmt: skip
                 key = _key("likely", [rule_key(b) for b in boxes], len(table), refine, s)
@@ -758,9 +763,13 @@ def _rounds(
                 f"no rule to mine: {hits} of {len(ok)} simulated designs meet "
                 f"{'the target' if hits == 0 else 'the target, all of them'}"
             )
+            if hits == 0 and r < rounds and len(ok):  # a rare target: keep looking
+                note += "; the next round samples more at random"
             say(f"[mine] round {r}: {note}")
             history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
             times["mine"] += time.perf_counter() - t0
+            if hits == 0 and r < rounds and len(ok):
+                continue
             break
         say(f"[mine] round {r}: rules for {tgt} from {len(table)} designs")
         with warnings.catch_warnings():
