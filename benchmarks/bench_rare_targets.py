@@ -158,9 +158,20 @@ class Simulator:
         return rows
 
     def save(self):
+        """Write the cache, merged with what other runs wrote meanwhile (by feature values)."""
         CACHE.mkdir(parents=True, exist_ok=True)
-        tmp = self.path.with_suffix(".tmp")
-        self.cache.to_parquet(tmp, index=False)
+        frame = self.cache
+        if self.path.is_file():
+            try:
+                disk = pd.read_parquet(self.path)
+            except (OSError, ValueError):
+                disk = None
+            if disk is not None and len(disk):
+                known = set(self.index)
+                extra = [k not in known for k in self._keys(disk)]
+                frame = pd.concat([frame, disk.loc[extra]], ignore_index=True)
+        tmp = self.path.with_suffix(f".{os.getpid()}.tmp")
+        frame.to_parquet(tmp, index=False)
         tmp.replace(self.path)
 
 
