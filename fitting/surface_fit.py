@@ -64,6 +64,15 @@ MIN_SECTOR_DEG = 5.0
 RESTORATION_DAMPING = (1e-2, 1.0, 100.0)
 #: augmented-Lagrangian weight of the preconditioner (dimensionless units)
 _RHO = 1e6
+#: first Levenberg-Marquardt damping of the Gauss-Newton phase (the first step was never taken
+#: at less than 1e-2 in the benchmark's 4 to 4096 panels: every smaller try cost a
+#: factorisation in vain)
+_MU_START = 1e-2
+#: MINRES tolerances (relative): the Gauss-Newton step, and the Newton steps onto the
+#: constraints (restoration and second-order corrections: each is checked on the constraints
+#: themselves, and repeated while they exceed CONSTRAINT_TOL)
+_TOL_STEP = 1e-9
+_TOL_PROJECT = 1e-6
 
 
 class SurfaceFitError(DegenerateGeometryError):
@@ -347,7 +356,8 @@ class _Problem:
         if not jacobian:
             return constraints(X, self.grid, self.scale, jacobian=False)
         c, J = constraints(X, self.grid, self.scale)
-        return c, J * self.h
+        J.data *= self.h  # a fresh matrix: scaled in place
+        return c, J
 
 
 class _KKT:
@@ -359,6 +369,7 @@ class _KKT:
         self.bw = grid.bandwidth
         self.factor = None
         self.n_factor = 0
+        self._jc = self._jct = None  # the last constraint Jacobian and its transpose
         self.minres_its: list[int] = []
 
     def refactor(self, Jb: sp.csr_matrix, Jc: sp.csr_matrix, mu: float) -> None:
@@ -386,9 +397,11 @@ class _KKT:
         self.n_factor += 1
 
     def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
-              tol: float = 1e-9) -> tuple[np.ndarray, int]:  # fmt: skip
+              tol: float = _TOL_STEP) -> tuple[np.ndarray, int]:  # fmt: skip
         n, m = H.shape[0], Jc.shape[0]
-        JcT = Jc.T.tocsr()
+        if Jc is not self._jc:
+            self._jc, self._jct = Jc, Jc.T.tocsr()
+        JcT = self._jct
         cf, order, inv = self.factor, self.order, self.inv
 
         def mv(v):
@@ -441,12 +454,12 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
         for k in range(1, steps + 1):
             if cm < CONSTRAINT_TOL:
                 return X, c, Jc, k - 1, ""
-            d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c)
+            d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c, tol=_TOL_PROJECT)
             if d is None and not fresh:  # a stale factorisation: refresh it and retry
                 ro, Jo = problem.objective(X)
                 H = (Jo.T @ Jo + mu_r * eye).tocsr()
                 kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
-                d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c)
+                d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c, tol=_TOL_PROJECT)
             if d is None:
                 return X, c, Jc, k, "the linear systems of the restoration did not converge"
             # damped Newton: halve the step until the constraint residual falls
@@ -499,7 +512,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
         return X, False, why, its, kkt
     ro, Jo = problem.objective(X)
     # ---- phase 2: feasible Gauss-Newton with second-order corrections
-    mu = 1e-4
+    mu = _MU_START
     F = float(ro @ ro)
     message = f"stopped after {max_iter} Gauss-Newton iterations (the distance was still falling)"
     for _ in range(max_iter):
@@ -514,7 +527,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
         while mu <= 1e6:
             kkt.refactor(Jo[problem.base_rows], Jc, mu)
             H = JtJ + mu * eye
-            d, _ = kkt.solve(H, Jc, g, c)
+            d, _ = kkt.solve(H, Jc, g, c, tol=_TOL_STEP)
             if d is None:
                 mu *= 10
                 continue
@@ -523,7 +536,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
             for _ in range(3):  # second-order corrections onto the constraints
                 if not np.abs(cn).max() >= CONSTRAINT_TOL:
                     break
-                dc, _ = kkt.solve(H, Jc, np.zeros(ndof), cn)
+                dc, _ = kkt.solve(H, Jc, np.zeros(ndof), cn, tol=_TOL_PROJECT)
                 if dc is None:
                     break
                 Xn = Xn + dc.reshape(-1, 3) * h
