@@ -30,13 +30,16 @@ import numpy as np
 from holofold.design.scenarios.base import Column, Scenario, positive
 from holofold.design.scenarios.config import (
     Section,
-    load_name,
-    read_direction,
-    read_dofs,
     read_features,
-    read_loads,
     read_material,
     read_solver,
+)
+from holofold.design.scenarios.pattern_loads import (
+    describe_material_and_loads,
+    loaded_columns,
+    read_supports_and_loads,
+    row_status,
+    write_row_files,
 )
 from holofold.design.simulate import (
     PatternLoad,
@@ -45,9 +48,7 @@ from holofold.design.simulate import (
     simulate_pattern,
 )
 from holofold.geometry import CreasePattern
-from holofold.geometry.vertex_sets import parse_vertex_set
 from holofold.mechanics.materials import Material
-from holofold.mechanics.status import Outcome, Status
 
 __all__ = [
     "PATTERN_FEATURES",
@@ -151,16 +152,8 @@ def check_pattern(setting: PatternScenarioSetting, row) -> list[str]:
 def evaluate_pattern(setting: PatternScenarioSetting, columns: Sequence[str], row) -> dict:
     """The columns of one design and its status."""
     sim = simulate_pattern(_pattern(setting, row), _setting_for(setting, row))
-    out = {f"{o.name}stiff": o.stiffness for o in sim.loads}
-    out["energy"] = sim.fold.energy.total
-    out["mass"] = sim.mass
-    out["overlap"] = math.nan if sim.overlap is None else sim.overlap
-    out["clearance"] = math.nan if sim.clearance is None else min(sim.clearance, 1e3)
-    out["reached"] = sim.fold.reached
-    status = sim.status
-    if not status.converged and status.outcome is Outcome.FAILED:
-        status = Status.not_converged(*status.reasons)
-    return {**{c: out[c] for c in columns}, "status": status}
+    out = {**loaded_columns(sim), "energy": sim.fold.energy.total, "reached": sim.fold.reached}
+    return {**{c: out[c] for c in columns}, "status": row_status(sim.status)}
 
 
 def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
@@ -183,19 +176,7 @@ def write_pattern_files(
     pattern folded as far as its fold got: printable part, FOLD, SVG and DXF for ``cutter``,
     STL/OBJ and the thick solid; without the solids (a note says why) where the panels do not
     allow them."""
-    from holofold.geometry import FabricationSet, write_fabrication_set
-
-    shape = pattern_shape(setting, row)
-    W = float(row["W"])
-    try:
-        return write_fabrication_set(
-            shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
-            crease_thickness=float(row["tcrease"]), units=units, cutter=cutter,
-        )  # fmt: skip
-    except ValueError as exc:
-        warnings.warn(f"no solids: {exc}", stacklevel=2)
-        got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
-        return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
+    return write_row_files(pattern_shape(setting, row), folder, row, units=units, cutter=cutter)
 
 
 def pattern_scenario(
@@ -214,17 +195,10 @@ def pattern_scenario(
         "pattern": f"{setting.source}: {p.n_vertices} vertices, {p.n_faces} panels, "
         f"{1e3 * size[0]:.4g} x {1e3 * size[1]:.4g} mm at scale 1",
         "model": setting.model,
-        "E (Pa)": setting.material.E,
-        "nu": setting.material.nu,
-        "density (kg/m^3)": setting.material.density,
-        "supports": ", ".join(setting.supports) + f" fixed in {setting.support_dofs}"
-        if setting.supports else "none (no loads)",
-    }  # fmt: skip
-    for ld in setting.loads:
-        words[f"load {ld.name}"] = (
-            f"{ld.force:g} N along ({', '.join(f'{v:g}' for v in ld.direction)}) shared by "
-            f"{ld.at}, {ld.increments} increments, from the folded state"
-        )
+        **describe_material_and_loads(
+            setting.material, setting.supports, setting.support_dofs, setting.loads
+        ),
+    }
     cols = tuple(c.name for c in perf)
     return Scenario(
         name=name,
@@ -288,56 +262,15 @@ def _read_pattern(sec: Section) -> tuple[CreasePattern, str, str]:
     return replace(pattern, meta={**pattern.meta, "source": path.name}), path.name, model
 
 
-def _read_load(sec: Section, names: set) -> PatternLoad:
-    for k in ("name", "at", "direction", "force", "increments"):
-        sec.raw(k)
-    sec.done(["name", "at", "direction", "force", "increments"])
-    name = load_name(sec, names, "'press'")
-    at = sec.string("at")
-    if not at:
-        raise sec.error("missing key 'at' (a vertex set such as 'near:50%,50%,4')")
-    if not sec.has("force"):
-        raise sec.error("missing key 'force' (total force, N)")
-    try:
-        return PatternLoad(
-            name=name, at=parse_vertex_set(at), direction=read_direction(sec),
-            force=sec.number("force", low=0.0, low_open=True),
-            increments=sec.number("increments", 5, low=1, high=1000, integer=True),
-        )  # fmt: skip
-    except ValueError as exc:
-        raise sec.error(str(exc)) from None
-
-
 def from_config(doc: Section, name: str, description: str) -> Scenario:
     """The pattern scenario of a parsed scenario file (``kind = "pattern"``)."""
     pattern, source, model = _read_pattern(doc.sub("pattern", required=True))
     E, nu, density = read_material(doc)
-    sup = doc.sub("supports")
-    at = sup.raw("at", [])
-    if isinstance(at, str):
-        at = [at]
-    if not isinstance(at, list) or not all(isinstance(a, str) for a in at):
-        raise sup.error(f"at = {at!r} must be a vertex set or a list of them")
-    for a in at:
-        try:
-            parse_vertex_set(a).select(pattern)
-        except ValueError as exc:
-            raise sup.error(str(exc)) from None
-    dofs = read_dofs(sup)
-    sup.done()
+    at, dofs, loads = read_supports_and_loads(doc, "'press'", pattern)
     tol, max_iter = read_solver(doc)
-    loads = read_loads(doc, _read_load) if doc.has("load") else []
-    for ld in loads:
-        try:
-            ld.at.select(pattern)
-        except ValueError as exc:
-            raise doc.error(f"[load] {ld.name}: {exc}") from None
-    if loads and not at:
-        raise sup.error("loads need supports: at = ['side:-x', ...] (vertex sets held)")
     setting = PatternScenarioSetting(
         pattern=pattern, source=source, material=Material("file", E, nu, density), model=model,
-        supports=tuple(at), support_dofs=dofs, loads=tuple(loads), tol=tol,
-        max_iter=max_iter,
+        supports=at, support_dofs=dofs, loads=loads, tol=tol, max_iter=max_iter,
     )  # fmt: skip
     features = read_features(doc.sub("features"), PATTERN_FEATURES)
     for c in features:

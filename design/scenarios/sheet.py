@@ -41,7 +41,6 @@ gamma = 70 deg, extensions 0.3, 0.6, 0.9 and the loads ``bend`` (3 N in -z) and 
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache, partial
@@ -59,6 +58,7 @@ from holofold.design.scenarios.config import (
     read_material,
     read_solver,
 )
+from holofold.design.scenarios.pattern_loads import write_row_files
 from holofold.design.scenarios.plausible import FORCE, check_lengths, check_plausible
 from holofold.design.scenarios.sheet_families import (
     MIURA_SHEET,
@@ -539,20 +539,9 @@ def write_sheet_files(
     STL/OBJ and the thick solid (meshes in ``units``); if the thick panels overlap too much in
     that state, every file but the solids, with a note saying why.
     """
-    from holofold.geometry import FabricationSet, write_fabrication_set  # trimesh: only for files
-
-    shape = sheet_shape(setting, row, ext)
-    W = float(row["W"])
-    try:
-        return write_fabrication_set(
-            shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
-            crease_thickness=float(row["tcrease"]), units=units, cutter=cutter,
-            thick=setting.thick,
-        )  # fmt: skip
-    except DegenerateGeometryError as exc:
-        warnings.warn(f"no thick.stl: {exc}", stacklevel=2)
-        got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
-        return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
+    return write_row_files(sheet_shape(setting, row, ext), folder, row, units=units,
+                           cutter=cutter, thick=setting.thick, fallback=DegenerateGeometryError,
+                           what="no thick.stl")  # fmt: skip
 
 
 def sheet_scenario(

@@ -26,7 +26,6 @@ size from the fit is not converged.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import partial
@@ -36,13 +35,16 @@ import numpy as np
 from holofold.design.scenarios.base import Column, Scenario, positive
 from holofold.design.scenarios.config import (
     Section,
-    load_name,
-    read_direction,
-    read_dofs,
     read_features,
-    read_loads,
     read_material,
     read_solver,
+)
+from holofold.design.scenarios.pattern_loads import (
+    describe_material_and_loads,
+    loaded_columns,
+    read_supports_and_loads,
+    row_status,
+    write_row_files,
 )
 from holofold.design.simulate import PatternLoad, PatternSetting, simulate_pattern
 from holofold.fitting import (
@@ -56,7 +58,6 @@ from holofold.fitting import (
     read_surface,
 )
 from holofold.geometry import LENGTH_UNITS, CreasePattern
-from holofold.geometry.vertex_sets import parse_vertex_set
 from holofold.mechanics import FOLD_TOLERANCE, aligned_deviation
 from holofold.mechanics.materials import Material
 from holofold.mechanics.status import Status
@@ -176,10 +177,7 @@ def evaluate_surface(setting: SurfaceScenarioSetting, columns: Sequence[str], ro
     sim = simulate_pattern(fit.pattern, _pattern_setting(setting, row, _frame(fit)))
     dev = aligned_deviation(sim.fold.coords[-1], fit.coords)
     out = {"rms_error": fit.rms, "max_error": fit.max, "fold_error": float(dev.max())}
-    out.update({f"{o.name}stiff": o.stiffness for o in sim.loads})
-    out["mass"] = sim.mass
-    out["overlap"] = math.nan if sim.overlap is None else sim.overlap
-    out["clearance"] = math.nan if sim.clearance is None else min(sim.clearance, 1e3)
+    out.update(loaded_columns(sim))
     status = sim.status
     tol = FOLD_TOLERANCE * fit.target.size
     if out["fold_error"] > tol:
@@ -187,9 +185,7 @@ def evaluate_surface(setting: SurfaceScenarioSetting, columns: Sequence[str], ro
             "fold": status, "fit": Status.not_converged(
                 f"the simulated fold ends {out['fold_error']:.3g} m from the fit (tolerance "
                 f"{tol:.3g} m)")})  # fmt: skip
-    if not status.converged and status.is_failed:
-        status = Status.not_converged(*status.reasons)
-    return {**{c: out.get(c, math.nan) for c in columns}, "status": status}
+    return {**{c: out.get(c, math.nan) for c in columns}, "status": row_status(status)}
 
 
 def _frame(fit: SurfaceFit) -> np.ndarray:
@@ -237,19 +233,7 @@ def write_surface_files(setting: SurfaceScenarioSetting, row, folder, units: str
     """The design's fabrication set (:func:`~holofold.geometry.write_fabrication_set`): FOLD,
     SVG, DXF, the folded shell as STL/OBJ, the thick panels and the printable part; without the
     solids (a note says why) where the panels do not allow them."""
-    from holofold.geometry import FabricationSet, write_fabrication_set
-
-    shape = surface_shape(setting, row)
-    W = float(row["W"])
-    try:
-        return write_fabrication_set(
-            shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
-            crease_thickness=float(row["tcrease"]), units=units, cutter=cutter,
-        )  # fmt: skip
-    except ValueError as exc:
-        warnings.warn(f"no solids: {exc}", stacklevel=2)
-        got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
-        return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
+    return write_row_files(surface_shape(setting, row), folder, row, units=units, cutter=cutter)
 
 
 def surface_scenario(
@@ -265,18 +249,11 @@ def surface_scenario(
     t = setting.target
     words = {
         "target": f"{setting.source}: {t.name}, {1e3 * t.size:.4g} mm across",
-        "E (Pa)": setting.material.E,
-        "nu": setting.material.nu,
-        "density (kg/m^3)": setting.material.density,
         "side": setting.side,
-        "supports": ", ".join(setting.supports) + f" fixed in {setting.support_dofs}"
-        if setting.supports else "none (no loads)",
-    }  # fmt: skip
-    for ld in setting.loads:
-        words[f"load {ld.name}"] = (
-            f"{ld.force:g} N along ({', '.join(f'{v:g}' for v in ld.direction)}) shared by "
-            f"{ld.at}, {ld.increments} increments, from the folded state"
-        )
+        **describe_material_and_loads(
+            setting.material, setting.supports, setting.support_dofs, setting.loads
+        ),
+    }
     cols = tuple(c.name for c in perf)
     return Scenario(
         name=name,
@@ -341,51 +318,15 @@ def _read_target(sec: Section) -> tuple[TargetSurface, str, dict]:
     return target, source, extra
 
 
-def _read_load(sec: Section, names: set) -> PatternLoad:
-    for k in ("name", "at", "direction", "force", "increments"):
-        sec.raw(k)
-    sec.done(["name", "at", "direction", "force", "increments"])
-    name = load_name(sec, names, "'Z'")
-    at = sec.string("at")
-    if not at:
-        raise sec.error("missing key 'at' (a vertex set such as 'near:50%,50%,4')")
-    if not sec.has("force"):
-        raise sec.error("missing key 'force' (total force, N)")
-    try:
-        return PatternLoad(
-            name=name, at=parse_vertex_set(at), direction=read_direction(sec),
-            force=sec.number("force", low=0.0, low_open=True),
-            increments=sec.number("increments", 5, low=1, high=1000, integer=True),
-        )  # fmt: skip
-    except ValueError as exc:
-        raise sec.error(str(exc)) from None
-
-
 def from_config(doc: Section, name: str, description: str) -> Scenario:
     """The surface scenario of a parsed scenario file (``kind = "surface"``)."""
     target, source, extra = _read_target(doc.sub("surface", required=True))
     E, nu, density = read_material(doc)
-    sup = doc.sub("supports")
-    at = sup.raw("at", [])
-    if isinstance(at, str):
-        at = [at]
-    if not isinstance(at, list) or not all(isinstance(a, str) for a in at):
-        raise sup.error(f"at = {at!r} must be a vertex set or a list of them")
-    for a in at:
-        try:
-            parse_vertex_set(a)
-        except ValueError as exc:
-            raise sup.error(str(exc)) from None
-    dofs = read_dofs(sup)
-    sup.done()
+    at, dofs, loads = read_supports_and_loads(doc, "'Z'")
     tol, max_iter = read_solver(doc)
-    loads = read_loads(doc, _read_load) if doc.has("load") else []
-    if loads and not at:
-        raise sup.error("loads need supports: at = ['side:-x', 'side:+x'] (vertex sets held)")
     setting = SurfaceScenarioSetting(
         target=target, source=source, material=Material("file", E, nu, density),
-        supports=tuple(at), support_dofs=dofs, loads=tuple(loads), tol=tol, max_iter=max_iter,
-        **extra,
+        supports=at, support_dofs=dofs, loads=loads, tol=tol, max_iter=max_iter, **extra,
     )  # fmt: skip
     features = read_features(doc.sub("features"), SURFACE_FEATURES)
     for c in features:

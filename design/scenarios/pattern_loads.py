@@ -1,0 +1,150 @@
+"""What the crease-pattern kinds share: supports and loads at vertex sets, their columns, files.
+
+The ``pattern`` and ``surface`` kinds (:mod:`~holofold.design.scenarios.pattern_kind`,
+:mod:`~holofold.design.scenarios.surface_kind`) fold a crease pattern and load it with
+:func:`~holofold.design.simulate.simulate_pattern`: their ``[supports]`` and ``[[load]]``
+tables name vertex sets (:mod:`holofold.geometry.vertex_sets`), their rows get a stiffness per
+load, the mass, ``overlap`` and ``clearance`` of the same simulation, and their files (as the
+sheet kind's) are the fabrication set, without the solids where the thick panels cannot be made.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+from holofold.design.scenarios.config import (
+    Section,
+    load_name,
+    read_direction,
+    read_dofs,
+    read_loads,
+)
+from holofold.design.simulate import PatternLoad, PatternSimulation
+from holofold.geometry import CreasePattern
+from holofold.geometry.vertex_sets import parse_vertex_set
+from holofold.mechanics.materials import Material
+from holofold.mechanics.status import Status
+
+__all__ = [
+    "read_supports_and_loads",
+    "describe_material_and_loads",
+    "loaded_columns",
+    "row_status",
+    "write_row_files",
+]
+
+_LOAD_KEYS = ("name", "at", "direction", "force", "increments")
+
+
+def _read_load(sec: Section, names: set, example: str) -> PatternLoad:
+    for k in _LOAD_KEYS:
+        sec.raw(k)
+    sec.done(list(_LOAD_KEYS))
+    name = load_name(sec, names, example)
+    at = sec.string("at")
+    if not at:
+        raise sec.error("missing key 'at' (a vertex set such as 'near:50%,50%,4')")
+    if not sec.has("force"):
+        raise sec.error("missing key 'force' (total force, N)")
+    try:
+        return PatternLoad(
+            name=name, at=parse_vertex_set(at), direction=read_direction(sec),
+            force=sec.number("force", low=0.0, low_open=True),
+            increments=sec.number("increments", 5, low=1, high=1000, integer=True),
+        )  # fmt: skip
+    except ValueError as exc:
+        raise sec.error(str(exc)) from None
+
+
+def read_supports_and_loads(
+    doc: Section, example: str, pattern: CreasePattern | None = None
+) -> tuple[tuple[str, ...], str, tuple[PatternLoad, ...]]:
+    """The ``[supports]`` table (``at``: a vertex set or a list of them, ``dofs``) and the
+    ``[[load]]`` tables of a scenario file: (vertex sets held, their DOFs, loads). Every vertex
+    set is parsed, and selected on ``pattern`` where the pattern is known before the design;
+    loads need supports. ``example`` is a load name for the error that asks for one."""
+    sup = doc.sub("supports")
+    at = sup.raw("at", [])
+    if isinstance(at, str):
+        at = [at]
+    if not isinstance(at, list) or not all(isinstance(a, str) for a in at):
+        raise sup.error(f"at = {at!r} must be a vertex set or a list of them")
+    for a in at:
+        try:
+            held = parse_vertex_set(a)
+            if pattern is not None:
+                held.select(pattern)
+        except ValueError as exc:
+            raise sup.error(str(exc)) from None
+    dofs = read_dofs(sup)
+    sup.done()
+    loads = []
+    if doc.has("load"):
+        loads = read_loads(doc, lambda s, names: _read_load(s, names, example))
+    if pattern is not None:
+        for ld in loads:
+            try:
+                ld.at.select(pattern)
+            except ValueError as exc:
+                raise doc.error(f"[load] {ld.name}: {exc}") from None
+    if loads and not at:
+        raise sup.error("loads need supports: at = ['side:-x', 'side:+x'] (vertex sets held)")
+    return tuple(at), dofs, tuple(loads)
+
+
+def describe_material_and_loads(
+    material: Material, supports: tuple[str, ...], dofs: str, loads: tuple[PatternLoad, ...]
+) -> dict:
+    """The report's lines for the material, the supports and every load."""
+    words = {
+        "E (Pa)": material.E,
+        "nu": material.nu,
+        "density (kg/m^3)": material.density,
+        "supports": ", ".join(supports) + f" fixed in {dofs}" if supports else "none (no loads)",
+    }
+    for ld in loads:
+        words[f"load {ld.name}"] = (
+            f"{ld.force:g} N along ({', '.join(f'{v:g}' for v in ld.direction)}) shared by "
+            f"{ld.at}, {ld.increments} increments, from the folded state"
+        )
+    return words
+
+
+def loaded_columns(sim: PatternSimulation) -> dict[str, float]:
+    """``{name}stiff`` (N/m) of every load, ``mass`` (kg), ``overlap`` (m^3, NaN where not
+    computed) and ``clearance`` (m, at most 1000) of one simulated design."""
+    out = {f"{o.name}stiff": o.stiffness for o in sim.loads}
+    out["mass"] = sim.mass
+    out["overlap"] = math.nan if sim.overlap is None else sim.overlap
+    out["clearance"] = math.nan if sim.clearance is None else min(sim.clearance, 1e3)
+    return out
+
+
+def row_status(status: Status) -> Status:
+    """A design row's status: a failed simulation counts as not converged (the row is kept,
+    its reasons with it)."""
+    if not status.converged and status.is_failed:
+        return Status.not_converged(*status.reasons)
+    return status
+
+
+def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cutter=None,
+                    thick=None, fallback=ValueError, what: str = "no solids"):  # fmt: skip
+    """The fabrication set (:func:`~holofold.geometry.write_fabrication_set`) of a design's
+    folded ``shape`` with the row's ``tpanel``, ``tcrease`` and ``W`` (m); where the solids
+    cannot be made (``fallback``, raised by the writer), every file but the solids with a note
+    saying why, and a warning starting with ``what``."""
+    from holofold.geometry import FabricationSet, write_fabrication_set  # trimesh: only for files
+
+    W = float(row["W"])
+    extra = {} if thick is None else {"thick": thick}
+    try:
+        return write_fabrication_set(
+            shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
+            crease_thickness=float(row["tcrease"]), units=units, cutter=cutter, **extra,
+        )  # fmt: skip
+    except fallback as exc:
+        warnings.warn(f"{what}: {exc}", stacklevel=3)
+        got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
+        return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
