@@ -32,7 +32,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "kernels": ["KERNEL_PATHS", "KernelPath", "KernelWarning", "check_environment"],
         "bars": ["bar_forces", "bar_strain"],
         "compat": ["Profile", "PAPER", "PHYSICAL"],
-        "fold_check": ["FoldCheck", "check_fold", "aligned_deviation", "FOLD_TOLERANCE"],
+        "fold_check": [
+            "FoldCheck",
+            "check_fold",
+            "aligned_deviation",
+            "FOLD_TOLERANCE",
+            "FOLD_STEP_DEG",
+            "FOLD_TIME_LIMIT",
+        ],
         "folding": [
             "fold_pattern",
             "FoldResult",

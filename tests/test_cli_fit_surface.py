@@ -47,3 +47,29 @@ def test_fit_surface_refuses_bad_input_before_writing(dome_mm, tmp_path, capsys)
     assert "built-ins" in capsys.readouterr().err and not out.exists()
     assert main(["fit", "--cells", "8x8", "-o", str(out)]) == 2
     assert "--curve" in capsys.readouterr().err
+
+
+def test_fit_surface_refuses_strip_options_and_back(dome_mm, tmp_path, capsys):
+    out = tmp_path / "none"
+    argv = ["fit", "--surface", str(dome_mm), "--cells", "8x8", "-o", str(out)]
+    assert main([*argv, "--m", "12", "--offset", "0.1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["holofold fit: error: --m, --offset are for --curve (a strip), not --surface"]
+    assert main([*argv, "--metric", "mean"]) == 2
+    assert "--metric is for --curve" in capsys.readouterr().err
+    curve = ["fit", "--curve", "half-circle:radius=2", "--m", "4", "--offset", "0.2",
+             "--strip-width", "0.02", "--extrude", "0.1", "-o", str(out)]  # fmt: skip
+    assert main([*curve, "--cells", "8x8"]) == 2
+    assert "--cells is for --surface" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_fit_surface_over_its_fold_time_limit_is_not_verified(tmp_path, capsys):
+    out = tmp_path / "out"
+    argv = ["fit", "--surface", "sphere-cap:radius=1,rim=0.45", "--cells", "4x4", "-o", str(out),
+            "--fold-time-limit", "1e-9"]  # fmt: skip
+    assert main(argv) == 1
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out.strip().splitlines()[-1])
+    assert summary["ok"] and summary["fold_timed_out"] and not summary["fold_reached"]
+    assert "holofold fit: the fit is not verified: the fold ran over its time limit" in captured.err

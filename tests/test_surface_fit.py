@@ -115,6 +115,27 @@ def test_fit_is_folded_by_the_simulator():
     assert fc.deviation_max < 1e-9 * CAP.size
 
 
+def test_large_extrapolated_steps_reach_the_small_steps_state():
+    """The check's 20-degree steps from the secant predictor end where 3-degree steps from the
+    last state do (the same equilibrium, to 1e-9 of the size), in fewer steps."""
+    fit = fit_surface(CAP, (8, 8), placement=Placement(size=(0.73, 0.78)))
+    big = check_fold(fit)
+    small = check_fold(fit, max_step_deg=3.0, extrapolate=False)
+    assert big.reached and small.reached, (big.reason, small.reason)
+    assert big.steps <= small.steps / 4
+    assert np.abs(big.coords - small.coords).max() < 1e-9 * CAP.size
+
+
+def test_a_fold_over_its_time_limit_is_not_verified():
+    """A check that runs out of time says so (not verified, how far it got), neither folded
+    nor failed for a reason of the fit."""
+    fit = fit_surface(CAP, (8, 8), placement=Placement(size=(0.73, 0.78)))
+    fc = check_fold(fit, time_limit=1e-9)
+    assert fc.timed_out and not fc.reached
+    assert fc.reason.startswith("not verified: the fold ran over its time limit of 1e-09 s at")
+    assert fc.summary["fold_timed_out"] is True
+
+
 def test_a_fit_that_does_not_fold_is_reported():
     """Warped quads are not a rigid fold: the check says the simulation ends away from it."""
     fit = fit_surface(CAP, (6, 6), placement=Placement(size=(0.6, 0.6)))

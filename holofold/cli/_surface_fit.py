@@ -10,7 +10,9 @@ Writes the fabrication set (``pattern.fold``, ``pattern.svg``, ``pattern.dxf``, 
 ``errors.json``; the last line printed is that JSON summary. Unless ``--no-check``, the flat
 pattern is folded by the bar-and-hinge simulator and the fit counts as failed (exit status 1,
 files written, the reason in ``errors.json`` and on stderr) when the simulated shape does not
-reach the fitted one (docs/surface-fit.md §6).
+reach the fitted one, or as not verified (exit status 1 too) when the fold runs over
+``--fold-time-limit`` (docs/surface-fit.md §4). Options of the strip fit (``--m``, ``--offset``,
+...) are refused with ``--surface``, and these with ``--curve``.
 """
 
 from __future__ import annotations
@@ -21,28 +23,46 @@ import sys
 from holofold.cli._fabrication import cutter_options
 from holofold.geometry import MAX_PANELS, ParameterError, check_range
 
-__all__ = ["add_surface_arguments", "run_surface"]
+__all__ = ["SURFACE_ONLY", "add_surface_arguments", "run_surface"]
+
+#: options of the surface fit and their defaults: given with --curve, they are refused
+SURFACE_ONLY = {
+    "cells": None,
+    "gamma": 60.0,
+    "ext": 0.7,
+    "side": "below",
+    "centre": None,
+    "size": None,
+    "angle": 0.0,
+    "no_check": False,
+    "fold_tolerance": None,
+    "fold_time_limit": None,
+}
 
 
 def add_surface_arguments(p) -> None:
+    d = SURFACE_ONLY
     g = p.add_argument_group("surface fit (--surface)")
     g.add_argument("--cells", help="quads along the zig-zag direction x across it, e.g. 16x16")
-    g.add_argument("--gamma", type=float, default=60.0,
+    g.add_argument("--gamma", type=float, default=d["gamma"],
                    help="sector angle of the starting Miura-ori, deg (default 60)")  # fmt: skip
-    g.add_argument("--ext", type=float, default=0.7,
+    g.add_argument("--ext", type=float, default=d["ext"],
                    help="how far the starting Miura-ori is folded, (0, 1)")  # fmt: skip
-    g.add_argument("--side", choices=("below", "above"), default="below",
+    g.add_argument("--side", choices=("below", "above"), default=d["side"],
                    help="which way the corrugation hangs from the fitted side")  # fmt: skip
     g.add_argument("--centre", help="placement centre u,v on the surface's chart, m")
     g.add_argument("--size", help="placement size (folded footprint) Lu,Lv, m (default: the "
                    "whole chart)")  # fmt: skip
-    g.add_argument("--angle", type=float, default=0.0,
+    g.add_argument("--angle", type=float, default=d["angle"],
                    help="placement angle of the zig-zag direction, deg (default 0)")  # fmt: skip
     g.add_argument("--no-check", action="store_true",
                    help="skip folding the flat pattern by simulation")  # fmt: skip
-    g.add_argument("--fold-tolerance", type=float, default=None,
+    g.add_argument("--fold-tolerance", type=float, default=d["fold_tolerance"],
                    help="largest simulated-vs-fitted distance, relative to the target's size "
                    "(default 1e-3)")  # fmt: skip
+    g.add_argument("--fold-time-limit", type=float, default=d["fold_time_limit"],
+                   help="wall seconds the fold by simulation may take before the fit is "
+                   "reported not verified (default 600)")  # fmt: skip
 
 
 def _pair(name: str, text: str | None):
@@ -84,6 +104,9 @@ def run_surface(args) -> int:
     tol = None
     if args.fold_tolerance is not None:
         tol = check_range("--fold-tolerance", args.fold_tolerance, 0.0, None, low_open=True)
+    limit = None
+    if args.fold_time_limit is not None:
+        limit = check_range("--fold-time-limit", args.fold_time_limit, 0.0, None, low_open=True)
     if getattr(args, "printable", False):
         missing = [f"--{n.replace('_', '-')}" for n in ("panel_thickness", "crease_width",
                    "crease_thickness") if getattr(args, n) is None]  # fmt: skip
@@ -101,9 +124,9 @@ def run_surface(args) -> int:
                       ext=args.ext, side=args.side)  # fmt: skip
     check = None
     if not args.no_check and fit.ok:
-        from holofold.mechanics import FOLD_TOLERANCE, check_fold
+        from holofold.mechanics import FOLD_TIME_LIMIT, FOLD_TOLERANCE, check_fold
 
-        fc = check_fold(fit, tolerance=tol or FOLD_TOLERANCE)
+        fc = check_fold(fit, tolerance=tol or FOLD_TOLERANCE, time_limit=limit or FOLD_TIME_LIMIT)
         check = fc.summary
     files = export_surface_files(
         fit, args.output, units=units,
@@ -121,6 +144,8 @@ def run_surface(args) -> int:
     failed = None
     if not fit.ok:
         failed = f"the fit failed: {fit.message}"
+    elif check is not None and check["fold_timed_out"]:
+        failed = f"the fit is {check['fold_reason']}"
     elif check is not None and not check["fold_reached"]:
         failed = f"the fit does not fold: {check['fold_reason']}"
     elif check is not None:

@@ -34,9 +34,26 @@ import math
 from pathlib import Path
 
 from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
-from holofold.cli._surface_fit import add_surface_arguments, run_surface
+from holofold.cli._surface_fit import SURFACE_ONLY, add_surface_arguments, run_surface
 from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
+
+#: options of the strip fit (--curve) and their defaults: given with --surface, they are refused
+STRIP_ONLY = {
+    "curve_units": None,
+    "curve_scale": 1.0,
+    "m": None,
+    "offset": None,
+    "strip_width": None,
+    "extrude": None,
+    "sampling": None,
+    "auto": False,
+    "tolerance": None,
+    "m_range": None,
+    "metric": "max",
+    "max_warp": PUBLISHED_MAX_WARP,
+    "no_overlap": False,
+}
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -60,14 +77,14 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--curve-units",
         choices=tuple(LENGTH_UNITS),
-        default=None,
+        default=STRIP_ONLY["curve_units"],
         help="unit of the numbers of a CSV (default m) or of an SVG's user units (default: "
         "the SVG's own width/height units, else m)",
     )
     p.add_argument(
         "--curve-scale",
         type=float,
-        default=1.0,
+        default=STRIP_ONLY["curve_scale"],
         help="further scale factor applied to the curve (e.g. a 1:10 model; default 1)",
     )
     p.add_argument("--m", type=float, help="number of Miura units (integer >= 2)")
@@ -77,26 +94,26 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--sampling",
         choices=SAMPLINGS,
-        default=None,
+        default=STRIP_ONLY["sampling"],
         help="sample spacing (default: paper for the half circle, else arclength)",
     )
     p.add_argument("--auto", action="store_true", help="choose m and offset for --tolerance")
     p.add_argument("--tolerance", type=float, help="closest-point error tolerance for --auto, m")
     p.add_argument(
         "--m-range",
-        default=None,
+        default=STRIP_ONLY["m_range"],
         help="m values for --auto as start:stop[:step], stop included (default 2:60:2)",
     )
     p.add_argument(
         "--metric",
         choices=("max", "mean"),
-        default="max",
+        default=STRIP_ONLY["metric"],
         help="closest-point error that --auto compares with --tolerance (default max)",
     )
     p.add_argument(
         "--max-warp",
         type=float,
-        default=PUBLISHED_MAX_WARP,
+        default=STRIP_ONLY["max_warp"],
         help="largest relative quad warp --auto accepts (default %(default)s, the most the "
         "published arch designs reach)",
     )
@@ -209,13 +226,23 @@ def _validate(args) -> dict:
     return opts
 
 
+def _refuse_others(args, defaults: dict, mode: str, other: str) -> None:
+    """One line naming the options of ``other`` that were given with ``mode``."""
+    given = [f"--{k.replace('_', '-')}" for k, v in defaults.items() if getattr(args, k) != v]
+    if given:
+        raise ParameterError(f"{', '.join(given)} {'is' if len(given) == 1 else 'are'} for "
+                             f"{other}, not {mode}")  # fmt: skip
+
+
 def run(args) -> int:
     import json
 
     if (args.curve is None) == (args.surface is None):
         raise ParameterError("give one of --curve (a strip) or --surface (a surface fit)")
     if args.surface is not None:
+        _refuse_others(args, STRIP_ONLY, "--surface", "--curve (a strip)")
         return run_surface(args)
+    _refuse_others(args, SURFACE_ONLY, "--curve", "--surface (a surface fit)")
     args.units = args.units or "mm"
 
     from holofold.fitting import (
