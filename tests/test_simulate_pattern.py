@@ -133,6 +133,10 @@ def test_write_simulation_files(tmp_path):
     assert np.allclose(fold["vertices_coords"], sim.pattern.flat)  # the key frame: the CP
     last = np.array(frames[-1]["vertices_coords"])
     assert np.allclose(last, sim.fold.coords[-1])
+    back = g.read_pattern(tmp_path / "out" / "folded.fold")  # the crease pattern, as simulated
+    assert np.allclose(back.flat, sim.pattern.flat) and np.array_equal(back.edges, sim.pattern.edges)  # fmt: skip
+    last = g.read_pattern(tmp_path / "out" / "folded.fold", frame=len(frames))
+    assert np.allclose(last.coords, sim.fold.coords[-1])
     summary = json.loads((tmp_path / "out" / "simulation.json").read_text())
     assert summary["loads"][0]["stiffness_N_m"] == pytest.approx(sim.loads[0].stiffness)
     assert summary["fold"]["verdict"] == "folds rigidly"
