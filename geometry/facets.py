@@ -1,11 +1,14 @@
 """Faces split into triangles where the bar-and-hinge model needs it; added edges are facets.
 
 The models of :mod:`holofold.mechanics.hinges` fan every panel from the mean of its corners.
-That is right for a convex panel of any number of sides, but a spoke of a non-convex panel can
-leave the panel (or cross its side), so :func:`split_faces` triangulates such panels (ear
-clipping by manifold3d, no new vertices) and marks every added edge ``J`` (a join: a facet that
-stays flat, Origami Simulator's yellow triangulation line). ``mode="all"`` triangulates every
-face with more than three vertices, as Origami Simulator does; ``"none"`` leaves them.
+That is right for every panel the mean sees whole (every fan triangle centre-corner-next corner
+turns the panel's way with a real area: convex panels of any number of sides, and most
+non-convex ones), but a spoke of another panel would leave it or cross its side, so
+:func:`split_faces` triangulates those panels (:func:`unfannable_faces`; ear clipping by
+manifold3d, no new vertices) and marks every added edge ``J`` (a join: a facet that stays flat,
+Origami Simulator's yellow triangulation line). A panel whose corner is a hair off straight
+(1e-5 of its size) is fanned, not split into a sliver. ``mode="all"`` triangulates every face
+with more than three vertices, as Origami Simulator does; ``"none"`` leaves them.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ import numpy as np
 
 from holofold.geometry.errors import ParameterError
 
-__all__ = ["split_faces", "nonconvex_faces", "SPLIT_MODES"]
+__all__ = ["split_faces", "nonconvex_faces", "unfannable_faces", "SPLIT_MODES"]
 
 #: which faces :func:`split_faces` triangulates
 SPLIT_MODES = ("as-needed", "all", "none")
@@ -37,6 +40,24 @@ def nonconvex_faces(xy, faces, rel_tol: float = 1e-9) -> np.ndarray:
         d_out = np.roll(p, -1, axis=0) - p
         size2 = float(np.ptp(p, axis=0).max()) ** 2
         if (_cross(d_in, d_out) < -rel_tol * size2).any():
+            bad.append(k)
+    return np.array(bad, np.intp)
+
+
+def unfannable_faces(xy, faces, rel_area: float = 1e-3) -> np.ndarray:
+    """Ids of the counter-clockwise faces that the fan from the mean of their corners does not
+    cover: a fan triangle (mean, corner, next corner) with less than ``rel_area`` x the face's
+    area divided by its corner count (turning the wrong way, or a sliver)."""
+    xy = np.asarray(xy, float)
+    bad = []
+    for k, f in enumerate(faces):
+        if len(f) <= 3:
+            continue
+        p = xy[f]
+        c = p.mean(axis=0)
+        tri = 0.5 * _cross(p - c, np.roll(p, -1, axis=0) - c)
+        total = float(tri.sum())
+        if total <= 0 or (tri < rel_area * total / len(f)).any():
             bad.append(k)
     return np.array(bad, np.intp)
 
@@ -72,7 +93,7 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
     if mode == "all":
         todo = {k for k, f in enumerate(faces) if len(f) > 3}
     else:
-        todo = set(nonconvex_faces(xy, faces).tolist())
+        todo = set(unfannable_faces(xy, faces).tolist())
     if not todo:
         return faces, edges, asg, ang, 0
     import manifold3d

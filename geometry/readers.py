@@ -177,6 +177,7 @@ def finish_pattern(
     faces, edges, asg, ang, n_split = split_faces(xy, faces, edges, asg, ang, split)
     if n_split:
         why = "non-convex" if split == "as-needed" else "with more than 3 vertices"
+        why = "non-convex (not fanned whole from their centre)" if split == "as-needed" else why
         notes.append(f"{n_split} {why} face(s) split into triangles (added edges J)")
     if len(faces) > MAX_PANELS:
         raise FormatError(f"{name}: {len(faces)} panels; at most {MAX_PANELS} are read")

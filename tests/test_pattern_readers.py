@@ -155,6 +155,12 @@ def test_only_non_convex_faces_are_split_and_areas_kept():
     assert sum(_area(xy, f) for f in f2) == pytest.approx(4.0, abs=1e-12)
     assert all(_area(xy, f) > 0 for f in f2)
     assert len(split_faces(xy, p.faces, p.edges, p.assignment, p.fold_angle, "all")[0]) == 6
+    # a corner a hair off straight (1e-6 inward) is fanned whole, not split into a sliver
+    hair = np.array([[0, 0], [2, 0], [2, 1], [1, 1 - 1e-6], [0, 1]], float)
+    assert nonconvex_faces(hair, [np.arange(5)]).tolist() == [0]
+    from holofold.geometry.facets import unfannable_faces
+
+    assert unfannable_faces(hair, [np.arange(5)]).size == 0
     with pytest.raises(ParameterError, match="allowed"):
         split_faces(xy, p.faces, p.edges, p.assignment, p.fold_angle, "some")
 

@@ -134,7 +134,8 @@ def test_write_simulation_files(tmp_path):
     last = np.array(frames[-1]["vertices_coords"])
     assert np.allclose(last, sim.fold.coords[-1])
     back = g.read_pattern(tmp_path / "out" / "folded.fold")  # the crease pattern, as simulated
-    assert np.allclose(back.flat, sim.pattern.flat) and np.array_equal(back.edges, sim.pattern.edges)  # fmt: skip
+    assert np.allclose(back.flat, sim.pattern.flat)
+    assert np.array_equal(back.edges, sim.pattern.edges)
     last = g.read_pattern(tmp_path / "out" / "folded.fold", frame=len(frames))
     assert np.allclose(last.coords, sim.fold.coords[-1])
     summary = json.loads((tmp_path / "out" / "simulation.json").read_text())
