@@ -24,6 +24,14 @@ __all__ = ["Bed", "DEFAULT_BED", "PrintablePart", "PartFit", "parse_bed", "part_
 FILM = 0.1e-3
 
 
+def _mm(v: float) -> str:
+    """A length (m) in mm as the report writes it: whole mm from 100 mm, else 3 digits."""
+    from holofold.design.scenarios import format_value
+
+    mm = 1e3 * v
+    return f"{mm:.0f}" if mm >= 100 else format_value(mm, digits=3)
+
+
 def parse_bed(text: str | Bed | tuple) -> Bed:
     """``"250x210"`` (mm, as ``--bed`` takes it) or a :class:`Bed` or (x, y) in m."""
     if isinstance(text, Bed):
@@ -107,10 +115,9 @@ class PartFit:
         return self.extent[2] < FILM
 
     def extent_text(self) -> str:
-        """``1132 x 126 x 3.53 mm``: three significant digits, no exponent."""
-        from holofold.design.scenarios import format_value
-
-        return " x ".join(format_value(1e3 * v, digits=3) for v in self.extent) + " mm"
+        """``1132 x 126 x 3.53 mm``: whole millimetres from 100 mm, else three significant
+        digits (no exponent)."""
+        return " x ".join(_mm(v) for v in self.extent) + " mm"
 
     @property
     def advice(self) -> str:
@@ -125,7 +132,7 @@ class PartFit:
             how = "as it lies" if abs(self.turn) < 1e-9 else f"turned by {self.turn:.0f} degrees"
             return f"It fits the {self.bed_text} bed {how}."
         a, b = max(self.extent[:2]), min(self.extent[:2])
-        need = f"{1e3 * a:.0f} x {1e3 * b:.0f} mm"
+        need = f"{_mm(a)} x {_mm(b)} mm"
         scale = "Do not scale the file down: that thins the hinges with it."
         if self.pieces:
             return (
