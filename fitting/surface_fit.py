@@ -26,7 +26,6 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
-import scipy.linalg as sl
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from threadpoolctl import threadpool_limits
@@ -41,6 +40,7 @@ from holofold.fitting.quadmesh import (
     sector_angles,
     vertex_conditions,
 )
+from holofold.fitting.spd_factor import SPDFactor
 from holofold.fitting.surfaces import TargetSurface, load_surface
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 from holofold.geometry.miura import check_count, miura_nodes
@@ -363,37 +363,21 @@ class _Problem:
 class _KKT:
     """Saddle-point solves min 1/2 d^T H d + g^T d s.t. Jc d = -c by preconditioned MINRES."""
 
-    def __init__(self, grid: QuadGrid):
-        self.order = grid.band_order
-        self.inv = np.argsort(self.order)
-        self.bw = grid.bandwidth
-        self.factor = None
+    def __init__(self, grid: QuadGrid, sparse: bool | None = None):
+        self.block = SPDFactor(grid.band_order, grid.bandwidth, sparse=sparse)
         self.n_factor = 0
         self._jc = self._jct = None  # the last constraint Jacobian and its transpose
         self.minres_its: list[int] = []
 
     def refactor(self, Jb: sp.csr_matrix, Jc: sp.csr_matrix, mu: float) -> None:
-        A = (Jb.T @ Jb + _RHO * (Jc.T @ Jc)).tocsr()
-        A = A[self.order][:, self.order].tocoo()
-        n, bw = A.shape[0], self.bw
-        up = A.col >= A.row
-        if (A.col[up] - A.row[up]).max(initial=0) > bw:
-            raise AssertionError("band pattern wider than planned")
-        ab = np.zeros((bw + 1, n))
-        ab[bw + A.row[up] - A.col[up], A.col[up]] = A.data[up]
-        # the damping keeps the factorisation positive definite in floating point: at least
-        # 1e-11 of the largest diagonal entry, raised tenfold while Cholesky breaks down
-        mu = max(mu, 1e-11 * float(ab[bw].max()))
-        ab[bw] += mu
-        for _ in range(8):
-            try:  # ab itself is left untouched (overwrite_ab False)
-                self.factor = sl.cholesky_banded(ab, lower=False, check_finite=False)
-                break
-            except np.linalg.LinAlgError:
-                ab[bw] += 9 * mu
-                mu *= 10
-        else:
-            raise SurfaceFitError("the fit's linear systems are singular (the pattern degenerated)")
+        # the damping keeps the factorisation positive definite in floating point (SPDFactor
+        # raises it from at least 1e-11 of the largest diagonal entry while Cholesky breaks down)
+        try:
+            self.block.factor(Jb.T @ Jb + _RHO * (Jc.T @ Jc), mu)
+        except np.linalg.LinAlgError:
+            raise SurfaceFitError(
+                "the fit's linear systems are singular (the pattern degenerated)"
+            ) from None
         self.n_factor += 1
 
     def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
@@ -402,7 +386,7 @@ class _KKT:
         if Jc is not self._jc:
             self._jc, self._jct = Jc, Jc.T.tocsr()
         JcT = self._jct
-        cf, order, inv = self.factor, self.order, self.inv
+        block = self.block.solve
 
         def mv(v):
             x, y = v[:n], v[n:]
@@ -410,7 +394,7 @@ class _KKT:
 
         def prec(r):
             out = np.empty_like(r)
-            out[:n] = sl.cho_solve_banded((cf, False), r[:n][order], check_finite=False)[inv]
+            out[:n] = block(r[:n])
             out[n:] = _RHO * r[n:]
             return out
 
@@ -643,6 +627,7 @@ def fit_surface(
         "placement": {"centre": c.tolist(), "size": s.tolist(), "angle_deg": math.degrees(a)},
         "restoration_damping": mu_r,
         "factorisations": kkt.n_factor,
+        "factorisation": "cholmod" if kkt.block.sparse else "banded",
         "minres_iterations": int(sum(kkt.minres_its)),
     }
     flat = _orient_flat(develop(X, grid), grid)

@@ -166,3 +166,47 @@ def test_too_curved_a_target_fails_with_the_reason():
     fit = fit_surface(saddle, (10, 10), placement=Placement(size=(0.73, 0.73)))
     assert not fit.ok and fit.message
     assert any(w in fit.message for w in ("constraints", "linear systems", "degenerated", "flat"))
+
+
+@pytest.mark.parametrize("sparse", [False, True])
+def test_spd_factor_solves_the_preconditioner_block(sparse):
+    """Both factorisations of J^T J + mu I (banded in the grid's band order; CHOLMOD where
+    installed) solve it to rounding, and a singular matrix gets its damping raised."""
+    from holofold.fitting.spd_factor import SPDFactor, cholmod_available
+
+    if sparse and not cholmod_available():
+        pytest.skip("cvxopt (holofold[cholmod]) is not installed")
+    grid = QuadGrid(5, 7)
+    X = _miura(5, 7) + RNG.normal(scale=1e-3, size=(grid.nv, 3))
+    _, J = constraints(X, grid, planarity_scale(X, grid.quads))
+    A = (J.T @ J).tocsr()  # singular: rigid motions and the mechanism
+    f = SPDFactor(grid.band_order, grid.bandwidth, sparse=sparse)
+    mu = f.factor(A, 1e-3)
+    assert mu == 1e-3
+    b = RNG.normal(size=A.shape[0])
+    x = f.solve(b)
+    scale = abs(A).sum(axis=1).max() * np.linalg.norm(x)  # backward error: rounding
+    assert np.linalg.norm(A @ x + mu * x - b) < 1e-13 * scale
+    raised = f.factor(A, 0.0)  # 1e-11 of the diagonal, raised where Cholesky breaks down
+    assert 0 < raised < 1e-3 * float(A.diagonal().max())
+
+
+def test_cholmod_and_banded_fits_agree():
+    """The fit with CHOLMOD's factorisation is the banded one's (the same iterates: the
+    factorisation is only the preconditioner)."""
+    from holofold.fitting import spd_factor
+
+    if not spd_factor.cholmod_available():
+        pytest.skip("cvxopt (holofold[cholmod]) is not installed")
+    place = Placement(size=(0.73, 0.78))
+    sparse = fit_surface(CAP, (12, 12), placement=place)
+    orig = spd_factor._cvxopt
+    try:
+        spd_factor._cvxopt = lambda: None
+        banded = fit_surface(CAP, (12, 12), placement=place)
+    finally:
+        spd_factor._cvxopt = orig
+    assert sparse.options["factorisation"] == "cholmod"
+    assert banded.options["factorisation"] == "banded"
+    assert sparse.rms == pytest.approx(banded.rms, rel=1e-6)
+    assert np.abs(sparse.coords - banded.coords).max() < 1e-7  # m: MINRES stops at 1e-6-1e-9
