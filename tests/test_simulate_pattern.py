@@ -258,3 +258,24 @@ def test_pattern_scenario_file_refusals(tmp_path, change, message):
     (tmp_path / "bad.toml").write_text(SCENARIO.replace(*change), encoding="utf-8")
     with pytest.raises(ValueError, match=message):
         read_scenario(tmp_path / "bad.toml")
+
+
+@pytest.mark.slow
+def test_holofold_design_on_a_users_pattern(tmp_path, capsys):
+    """A pattern scenario through the whole loop (issue 26): a design meeting the target, its
+    re-simulation the same, its files written."""
+    shutil.copy(OS / "waterbombBase.svg", tmp_path / "wb.svg")
+    (tmp_path / "wb.toml").write_text(SCENARIO, encoding="utf-8")
+    out = tmp_path / "design"
+    target = "tipstiff > 1000"  # about 16 % of the feature box
+    code = main(["design", str(tmp_path / "wb.toml"), "--target", target, "-n", "60",
+                 "--rounds", "3", "--workers", "1", "--no-progress", "-o", str(out)])  # fmt: skip
+    s = json.loads((out / "design.json").read_text())
+    assert code == 0 and s["meets_target"] and s["answer"] in ("rule", "designs")
+    assert s["performance"]["tipstiff"] > 1000
+    again = read_scenario(tmp_path / "wb.toml").evaluate(s["features"])
+    assert again["status"].converged
+    assert again["tipstiff"] == pytest.approx(s["performance"]["tipstiff"], rel=1e-9)
+    for key in ("fold", "svg"):
+        assert (out / s["files"][key]["path"]).is_file(), key
+    assert (out / "report.html").is_file()
