@@ -15,11 +15,14 @@ the unit is stated where the format allows: an OBJ comment, a PLY header comment
 
 from __future__ import annotations
 
+import lazy_loader
 import numpy as np
-import trimesh
 
 from holofold.geometry.pattern import CreasePattern, orient_faces
 from holofold.geometry.units import length_factor
+
+# trimesh (with scipy.spatial and scipy.optimize) costs 0.5-1 s to import; it loads on first use
+trimesh = lazy_loader.load("trimesh")
 
 __all__ = [
     "fan_triangulation",

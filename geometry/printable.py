@@ -42,8 +42,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import lazy_loader
 import numpy as np
-import trimesh
 
 from holofold.geometry.errors import (
     DegenerateGeometryError,
@@ -53,6 +53,9 @@ from holofold.geometry.errors import (
 )
 from holofold.geometry.pattern import CreasePattern
 from holofold.geometry.solid import corner_edges, offset_corners
+
+# trimesh (with scipy.spatial and scipy.optimize) costs 0.5-1 s to import; it loads on first use
+trimesh = lazy_loader.load("trimesh")
 
 __all__ = [
     "PrintableLayout",

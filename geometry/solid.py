@@ -18,11 +18,14 @@ from __future__ import annotations
 
 import warnings
 
+import lazy_loader
 import numpy as np
-import trimesh
 
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError
 from holofold.geometry.pattern import CreasePattern, newell_normals, orient_faces
+
+# trimesh (with scipy.spatial and scipy.optimize) costs 0.5-1 s to import; it loads on first use
+trimesh = lazy_loader.load("trimesh")
 
 __all__ = [
     "shrunk_panels",
