@@ -208,6 +208,8 @@ def _seconds(t) -> str:
     if not _is_number(t) or not math.isfinite(float(t)):
         return _MISSING
     t = float(t)
+    if t < 0.01:  # a stage that found its work done (a resumed verification): no 4.47e-05 s
+        return "&lt;\u00a00.01\u00a0s" if t > 0 else "0\u00a0s"
     if t < 60:
         return f"{t:.3g}\u00a0s"
     minutes, seconds = divmod(round(t), 60)
@@ -415,10 +417,14 @@ def _alternatives(summary: DesignSummary, cols: Mapping) -> str:
             unique.append(p)
     out = ['<section id="alternatives"><h2>Alternatives, side by side</h2>']
     if len(unique) < 2:
-        out.append(
-            "<p>No other design was put forward: the chosen one is the best of each "
-            "verified rule and overall.</p></section>"
+        why = (
+            "the chosen one is the best of each verified rule and overall"
+            if summary.answer == "rule"
+            else "no rule was verified, and the chosen one is the best simulated design"
+            if summary.answer == "designs"
+            else "no simulated design meets the target; the chosen one is the nearest"
         )
+        out.append(f"<p>No other design was put forward: {why}.</p></section>")
         return "".join(out)
     try:
         target_cols = list(parse_target(summary.target).columns)

@@ -165,7 +165,8 @@ def _hull(points: np.ndarray) -> np.ndarray:
 
 def footprint_turns(points: np.ndarray, bed: Bed) -> tuple[tuple[float, float], float]:
     """The smallest-area bounding rectangle's sides (long, short) of 2-D ``points`` (m), and the
-    turn (rad) that fits them on ``bed`` with the most room (nan if none does)."""
+    turn (rad) that fits them on ``bed``: none if they fit as they lie, else the one with the
+    most room (nan if none does)."""
     hull = _hull(np.asarray(points, float))
     edges = np.diff(np.vstack([hull, hull[:1]]), axis=0)
     angles = np.concatenate(
@@ -178,6 +179,8 @@ def footprint_turns(points: np.ndarray, bed: Bed) -> tuple[tuple[float, float], 
     k = int(np.argmin(w * h))
     rect = (float(max(w[k], h[k])), float(min(w[k], h[k])))
     room = np.minimum(bed.width - w, bed.depth - h)
+    if room[len(edges)] >= -1e-12:  # angles[len(edges)] is 0: as it lies, no turn to explain
+        return rect, 0.0
     # a half turn fits as well: turns in [-90, 90) degrees; of the roomiest, the smallest turn
     turns = (angles + math.pi / 2) % math.pi - math.pi / 2
     top = room.max()

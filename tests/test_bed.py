@@ -151,3 +151,10 @@ def test_demo_strip_on_a_desktop_bed():
     assert not seg.whole.fits and seg.fits, seg.problem
     assert 60 <= len(seg.segments) <= 90
     assert all(s.mesh.is_watertight for s in seg.segments)
+
+
+def test_a_part_that_fits_as_it_lies_is_not_turned():
+    """169 x 198 mm on 250 x 210 fits as it lies; a quarter turn has more room but only
+    confuses whoever places the part."""
+    fit = bed_fit(_box(0.169, 0.198), Bed.parse("250x210"))
+    assert fit.fits and fit.angle == 0.0

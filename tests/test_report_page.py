@@ -571,3 +571,19 @@ def test_the_page_in_a_headless_browser(folder, tmp_path):
     red = (pixels[..., 0] > 0.7) & (pixels[..., 1] < 0.3) & (pixels[..., 2] < 0.3)
     blue = (pixels[..., 2] > 0.6) & (pixels[..., 0] < 0.5)
     assert red.sum() > 500 and blue.sum() > 2000
+
+
+def test_no_alternatives_says_why_and_tiny_timings_read_as_such(folder):
+    s = make_summary()
+    s["alternatives"] = []
+    s["timings"]["this_run"]["verify"] = 4.47e-05  # a resumed stage: its work was done
+    page = _visible(report_page_html(folder, s))
+    assert "the chosen one is the best of each verified rule and overall" in page
+    timings = {r[0]: r[1:] for r in _parse(page).tables["timings"][1:]}
+    assert timings["verification (new simulations inside the rule)"][0] == "< 0.01 s"
+    s["answer"], s["chosen"]["rule"] = "designs", None
+    page = _visible(report_page_html(folder, s))
+    assert "no rule was verified, and the chosen one is the best simulated design" in page
+    s["answer"] = "nearest"
+    page = _visible(report_page_html(folder, s))
+    assert "no simulated design meets the target; the chosen one is the nearest" in page
