@@ -702,6 +702,12 @@ def _pictures(folder: Path, summary: DesignSummary) -> tuple[str, int]:
             continue
         path = folder / str(rel)
         caption = _CAPTIONS.get(key, str(key))
+        if key == "design" and (summary.scenario or {}).get("kind") == "gripper":
+            # the gripper's shape is its flat film as cut; heating folds it
+            caption = (
+                "The chosen design, flat as cut (coordinates in mm; creases in red); its state "
+                "closed by heating is the 3D view's and closed.stl's."
+            )
         if not path.is_file():
             out.append(
                 f'<figure><p class="note">picture {_esc(rel)} was not made.</p>'

@@ -587,3 +587,11 @@ def test_no_alternatives_says_why_and_tiny_timings_read_as_such(folder):
     s["answer"] = "nearest"
     page = _visible(report_page_html(folder, s))
     assert "no simulated design meets the target; the chosen one is the nearest" in page
+
+
+def test_the_grippers_picture_is_captioned_flat(folder):
+    s = make_summary()
+    assert "The chosen design, folded" in _visible(report_page_html(folder, s))
+    s["scenario"]["kind"] = "gripper"
+    page = _visible(report_page_html(folder, s))
+    assert "The chosen design, flat as cut" in page and "The chosen design, folded" not in page
