@@ -507,7 +507,7 @@ def plot_folded_design(
         Orthographic view, equal aspect, seen from the front and a little above: suited to a
         strip arch whose curve lies in the x-z plane and whose width runs along y.
     """
-    from matplotlib.ticker import MaxNLocator
+    from matplotlib.ticker import FixedLocator, MaxNLocator
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
     plt = _pyplot()
@@ -543,8 +543,12 @@ def plot_folded_design(
     ax.set_box_aspect(tuple(span + 2 * pad), zoom=1.0)
     ax.set_proj_type("ortho")
     ax.view_init(elev=20, azim=-70)
-    for axis, s in zip((ax.xaxis, ax.yaxis, ax.zaxis), span, strict=True):
-        axis.set_major_locator(MaxNLocator(nbins=max(1, round(6 * s / span.max()))))
+    for axis, s, a, b in zip((ax.xaxis, ax.yaxis, ax.zaxis), span, lo, hi, strict=True):
+        if s < 0.2 * span.max():  # a short axis: its end ticks' labels would pile up
+            step = 10.0 ** math.floor(math.log10(s))  # one tick, within s/2 of the centre
+            axis.set_major_locator(FixedLocator([round((a + b) / 2 / step) * step]))
+        else:
+            axis.set_major_locator(MaxNLocator(nbins=max(1, round(6 * s / span.max()))))
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
     ax.set_zlabel("z [mm]")
