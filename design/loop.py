@@ -46,7 +46,7 @@ from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed, part_fit
 from holofold.design.choice import Answer, Candidate, choose
 from holofold.design.describe import PILOT, distributions
 from holofold.design.folder_lock import locks_folder
-from holofold.design.mining import mine_rules
+from holofold.design.mining import OneClassSplit, mine_rules
 from holofold.design.objective import Objective, parse_objective
 from holofold.design.rounds import Round, VerifiedRule
 from holofold.design.row_status import converged_rows, failed_rows
@@ -732,12 +732,18 @@ def _rounds(
     history: list[Round] = []
     miners: dict = {}
     boxes: list = []
+    around = -1  # the last round whose few hits could not be mined: the next samples around
     for r in range(rounds + 1):
         rdir = out / "rounds" / f"round-{r}"
         if r:
             t0 = time.perf_counter()
             s = seed + 7919 * r
-            if r - 1 not in miners:  # no design met the target yet: more at random
+            if r - 1 not in miners and around == r - 1:  # too few hits to mine: around them
+                say(f"[refine] round {r}/{rounds}: {refine} new designs around the designs "
+                    "that meet the target")  # fmt: skip
+                key = _key("around-hits", [rule_key(b) for b in boxes], refine, s)
+                new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
+            elif r - 1 not in miners:  # no design met the target yet: more at random
                 say(f"[refine] round {r}/{rounds}: {refine} new designs at random (none met "
                     "the target yet)")  # fmt: skip
                 key = _key("random", refine, s)
@@ -772,11 +778,24 @@ def _rounds(
                 continue
             break
         say(f"[mine] round {r}: rules for {tgt} from {len(table)} designs")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", FewRulesWarning)
-            mined = mine_rules(
-                table, tgt, roles=roles, seed=seed, n_rules=top, max_overlap=0.5, source=str(dbf)
-            )
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", FewRulesWarning)
+                mined = mine_rules(
+                    table, tgt, roles=roles, seed=seed, n_rules=top, max_overlap=0.5,
+                    source=str(dbf),
+                )  # fmt: skip
+        except OneClassSplit:  # a few hits, all held out: look around them, as with no rule
+            note = f"no rule yet ({hits} of {len(ok)} designs meet the target, too few to mine)"
+            times["mine"] += time.perf_counter() - t0
+            if r < rounds:
+                boxes, around = [_box_of(ok.loc[tgt.evaluate(ok)], roles)], r
+                say(f"  round {r}: {note}; the next round samples around them")
+                history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
+                continue
+            say(f"  round {r}: {note}")
+            history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
+            break
         records = mined_rules(mined.miner, mined.test_scores)[:top]
         miners[r] = mined
         if records:

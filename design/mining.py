@@ -31,6 +31,7 @@ from holofold.design.targets import Target, parse_target
 
 __all__ = [
     "MinedRules",
+    "OneClassSplit",
     "mine_rules",
     "select_features",
     "mining_estimate",
@@ -53,6 +54,11 @@ MAX_MINING_SECONDS = 300.0
 #: a tree of depth d has a leaf at depth d below d splits of >= 2 rows each: deeper limits
 #: change nothing for the tables mined here (and 1e20 overflowed scikit-learn's C integer)
 MAX_TREE_DEPTH = 1000
+
+
+class OneClassSplit(ValueError):
+    """The training split holds only designs that meet the target, or only ones that do not
+    (a rare target with a handful of hits, all drawn into the held-out rows)."""
 
 
 @dataclass(frozen=True)
@@ -287,7 +293,7 @@ def mine_rules(
         )
     train, _ = split_indices(len(table), test_size=test_size, random_state=seed)
     if y[train].all() or not y[train].any():
-        raise ValueError("the training split holds only one class; change --seed or --test-size")
+        raise OneClassSplit("the training split holds only one class; change --seed or --test-size")
     nbytes, seconds = check_mining_size(len(train), miner.get_params(), force=force)
     if progress is not None and seconds > 10:
         progress(

@@ -544,3 +544,36 @@ def test_overlapping_panels_are_chosen_only_when_allowed_and_then_not_printed_fo
     table = strict.table
     free = table["overlap"] <= 1e-12
     assert t["performance"]["mass"] == pytest.approx(table.loc[free, "mass"].max())
+
+
+def test_hits_too_few_to_mine_are_refined_around_instead_of_ending_the_loop(tmp_path, monkeypatch):
+    """A rare target's few hits can all fall into the held-out rows (OneClassSplit): the loop
+    samples around them, as with hits but no rule, instead of stopping with an error."""
+    import holofold.design.loop as loop
+    from holofold.design import Column, Scenario
+    from holofold.design.mining import OneClassSplit
+
+    cheap = Scenario(
+        name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
+        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
+        performance=(Column("double", "m"),),
+    )  # fmt: skip
+    real, calls = loop.mine_rules, []
+
+    def first_fails(*a, **k):
+        calls.append(1)
+        if len(calls) == 1:
+            raise OneClassSplit("the training split holds only one class")
+        return real(*a, **k)
+
+    monkeypatch.setattr(loop, "mine_rules", first_fails)
+    said = []
+    res = run_design(cheap, "double > 1.9", tmp_path / "o", samples=100, rounds=2, refine=60,
+                     verify=10, top=1, workers=1, progress=False, files=False,
+                     say=said.append)  # fmt: skip
+    r0 = res.summary["rounds"][0]
+    assert r0["rules"] == [] and "too few to mine" in r0["note"]
+    assert any("around the designs that meet the target" in line for line in said)
+    refined = res.table[res.table["origin"] == "refine-1"]
+    assert len(refined) == 60 and refined["a"].min() > 0.7  # around the hits (a > 0.95)
+    assert res.performance["double"] > 1.9
