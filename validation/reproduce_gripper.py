@@ -374,7 +374,8 @@ def plot_ensemble(table: pd.DataFrame, path) -> list[int]:
         ax.set_ylabel("stiff / ensemble median - 1")
         ax.set_title(
             f"{NAMES[P]}: prying stiffness of {len(order)} published rows against "
-            f"{v.shape[1]} holofold runs each (L1 x (1 + k 1e-15){what})"
+            f"{v.shape[1]} holofold runs each\n(L1 x (1 + k 1e-15){what})",
+            fontsize=10,
         )
         ax.legend(loc="upper left", fontsize=8, ncol=3)
     axes[-1].set_xlabel("rows, sorted by the spread of the ensemble")
