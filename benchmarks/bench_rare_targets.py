@@ -276,7 +276,7 @@ def rounds(ctx: Context, samples=500, refine=100, top=3) -> Run:
                     return ctx.run
             around = rules
         elif y.any():
-            around = [_box_of(ctx.sc, good.loc[y], ctx.roles)]
+            around = [_box_of(good.loc[y], ctx.roles)]
         else:
             around = None
         if around is None:

@@ -404,8 +404,8 @@ def run_design(
         Rules kept per round (distinct alternatives).
     strategy : {"likely", "around"}
         Where a refinement round samples: ``"likely"``, where the last round's forest votes for
-        the target (:func:`holofold.design.acquisition.likely_designs`: fewer simulations to a
-        verified rule on rare targets, ``benchmarks/bench_rare_targets.py``); ``"around"``, half
+        the target (:func:`holofold.design.acquisition.likely_designs`; measured against the other
+        strategies in ``benchmarks/rare_targets.md``); ``"around"``, half
         inside the rules and half in them widened by a quarter of each range
         (:func:`refine_designs`; around the designs meeting the target while there is no rule).
     until_verified : bool
