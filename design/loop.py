@@ -788,14 +788,13 @@ def _rounds(
         except OneClassSplit:  # a few hits, all held out: look around them, as with no rule
             note = f"no rule yet ({hits} of {len(ok)} designs meet the target, too few to mine)"
             times["mine"] += time.perf_counter() - t0
-            if r < rounds:
-                boxes, around = [_box_of(ok.loc[tgt.evaluate(ok)], roles)], r
-                say(f"  round {r}: {note}; the next round samples around them")
-                history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
-                continue
-            say(f"  round {r}: {note}")
             history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
-            break
+            if r == rounds:
+                say(f"  round {r}: {note}")
+                break
+            boxes, around = [_box_of(ok.loc[tgt.evaluate(ok)], roles)], r
+            say(f"  round {r}: {note}; the next round samples around them")
+            continue
         records = mined_rules(mined.miner, mined.test_scores)[:top]
         miners[r] = mined
         if records:
