@@ -205,8 +205,9 @@ def choose(
                     masks,
                 )
             )
+    none_allowed = not (ok & allowed).any()  # e.g. every design's thick panels overlap
     if chosen is None:  # nothing meets the target: the smallest shortfall
-        pool = _preferred(ok & allowed, conv) if (ok & allowed).any() else _preferred(ok, conv)
+        pool = _preferred(ok, conv) if none_allowed else _preferred(ok & allowed, conv)
         if pool.any():
             m = target.margin(table.loc[pool])
             m = np.where(np.isnan(m), -np.inf, m)
@@ -229,7 +230,7 @@ def choose(
         n_good,
         left_out,
         len(table),
-        has_overlap and not allow_overlap,
+        has_overlap and not allow_overlap and not none_allowed,
     )
     return Answer(kind, chosen, headline, tuple(alternatives), n_ok, n_meet, left_out)
 
@@ -294,6 +295,12 @@ def _headline(
         )
     else:
         first = f"No simulated design meets the target (of {n_ok} simulated)."
+    if left_out and not strict:  # not one simulated design is buildable
+        return (
+            f"{first} The thick panels of every simulated design overlap; shown: the design "
+            f"with the largest worst-case margin{miss}, overlapping too. Thinner panels or wider "
+            "creases (the feature ranges), or --allow-overlap if the overlap is acceptable."
+        )
     return (
         f"{first} Shown: the nearest design{' whose panels do not overlap' if strict else ''}, "
         f"with the largest worst-case margin{miss}. "

@@ -7,9 +7,10 @@
    conditions is met by none of them, the run stops there and says what the designs reach;
 2. **mine**: rules for the target (random forest), keeping distinct alternatives;
 3. **verify**: simulate fresh designs inside each top rule (95 % Wilson interval);
-4. **refine** (at most ``rounds`` times, until a rule is verified): sample new designs where the
-   last round's forest votes for the target (or inside and around the best rules), add them
-   (and the verification designs) to the database, re-mine and re-verify;
+4. **refine** (until a rule is verified or the ``budget`` of simulations is spent): sample new
+   designs, half where the last round's forest votes for the target and half inside its best
+   rule (or by the other strategies), add them (and the verification designs) to the database,
+   re-mine and re-verify;
 5. **choose** (:mod:`~holofold.design.choice`): from every simulated design, the best under the
    designer's objective inside the best verified rule of all rounds; without a qualifying rule
    the best design meeting the target; without one, the nearest, with its shortfall. A design
@@ -19,8 +20,8 @@
 
 Every simulation lands in a resumable database folder, so running the same call again
 continues where it stopped and recomputes only the cheap stages (mining, choosing, files).
-A larger ``samples``, ``rounds`` or ``verify`` extends the folder: the base sample and each
-rule's verification grow by a batch; refinement and verification folders are named by the
+A larger ``samples``, ``budget``, ``rounds`` or ``verify`` extends the folder: the base sample
+and each rule's verification grow by a batch; refinement and verification folders are named by the
 rules they come from (a changed rule gets its own), and every design simulated in the folder
 by an earlier run stays a candidate.
 """
@@ -66,10 +67,13 @@ from holofold.geometry.units import length_factor
 __all__ = ["run_design", "DesignOutcome", "refine_designs", "choose_design", "STAGES"]
 
 #: where refinement rounds sample (:func:`run_design`'s ``strategy``)
-REFINE_STRATEGIES = ("likely", "around")
+REFINE_STRATEGIES = ("likely", "around", "mixed")
 #: a rule is verified (fresh simulations) once its estimate reaches this precision: a rule the
 #: miner expects below it would not pass (90 % of its fresh designs meeting the target)
 VERIFY_FROM = 0.85
+#: designs simulated with none meeting the target after which the loop stops looking at random
+#: (a rate below 3 / 2000 = 0.15 % at 95 % confidence: loosen the target)
+RANDOM_UP_TO = 2000
 
 
 @dataclass(frozen=True)
@@ -270,13 +274,23 @@ def _pilot_verdict(rows: pd.DataFrame, tgt) -> tuple[int, list[str], str | None]
     return 0, [], None  # each condition met by some, jointly by none: a rare target, go on
 
 
-def _buildable_target(sc: Scenario, tgt, table: pd.DataFrame):
+def _buildable_target(sc: Scenario, tgt, table: pd.DataFrame, say=lambda text: None):
     """The target with ``overlap <= OVERLAP_TOLERANCE``, when the kind computes the overlap
-    (a column of NaN, as a pattern scenario without collisions gives, says nothing)."""
+    (a column of NaN, as a pattern scenario without collisions gives, says nothing). When no
+    design of ``table`` is buildable, the target alone (rules for a box nothing in the table
+    shows to exist would only be looked for at random), said through ``say``."""
     from holofold.design.choice import OVERLAP_TOLERANCE
 
     ok = table.loc[~failed_rows(table)]
-    if not np.isfinite(ok["overlap"].to_numpy(dtype=float)).any():
+    ov = ok["overlap"].to_numpy(dtype=float)
+    if not np.isfinite(ov).any():
+        return tgt
+    if not (ov <= OVERLAP_TOLERANCE).any():
+        say(
+            f"[mine] the thick panels of all {len(ok)} designs overlap (the least by "
+            f"{np.nanmin(ov) * 1e9:.3g} mm^3): rules are mined for the target alone; the "
+            "choice still keeps to designs that do not overlap (--allow-overlap admits them)"
+        )
         return tgt
     return parse_target(f"({tgt}) & overlap <= {OVERLAP_TOLERANCE:g}", sc.performance_names)
 
@@ -361,11 +375,12 @@ def run_design(
     folder: str | os.PathLike,
     *,
     samples: int = 200,
-    rounds: int = 10,
+    rounds: int | None = None,
+    budget: int = 6000,
     refine: int = 50,
     verify: int = 50,
     top: int = 3,
-    strategy: str = "likely",
+    strategy: str = "mixed",
     until_verified: bool = True,
     db: str | os.PathLike | None = None,
     seed: int = 0,
@@ -392,8 +407,14 @@ def run_design(
         Output folder (``design.json``, ``report.html``, ``files/``, ``database/``, ...).
     samples : int
         Designs in the base database (>= 20).
-    rounds : int
-        Refinement rounds at most (0: mine once, as the paper did).
+    rounds : int, optional
+        Refinement rounds at most (0: mine once, as the paper did; default: as many as
+        ``budget`` allows).
+    budget : int
+        Simulations this run may spend at most: the base database, refinement and verification
+        designs (rows of a database given with ``db`` that were there before cost nothing). A
+        refinement round starts only when its ``refine`` designs and one verification fit; a
+        rule is verified only when its ``verify`` designs fit.
     refine : int
         New designs per refinement round.
     verify : int
@@ -402,12 +423,14 @@ def run_design(
         lower estimate first.
     top : int
         Rules kept per round (distinct alternatives).
-    strategy : {"likely", "around"}
-        Where a refinement round samples: ``"likely"``, where the last round's forest votes for
-        the target (:func:`holofold.design.acquisition.likely_designs`; measured against the other
-        strategies in ``benchmarks/rare_targets.md``); ``"around"``, half
-        inside the rules and half in them widened by a quarter of each range
-        (:func:`refine_designs`; around the designs meeting the target while there is no rule).
+    strategy : {"mixed", "likely", "around"}
+        Where a refinement round samples: ``"mixed"`` (default), half where the last round's
+        forest votes for the target and half uniformly inside its best rule; ``"likely"``, all
+        where the forest votes (:func:`holofold.design.acquisition.likely_designs`);
+        ``"around"``, half inside the rules and half in them widened by a quarter of each range
+        (:func:`refine_designs`). A round after one without a rule samples around the designs
+        that meet the target, or at random while none does. Measured against each other and
+        against mining once in ``benchmarks/rare_targets.md``.
     until_verified : bool
         Stop once a rule is verified: at least 90 % of its fresh designs meet the target and
         the 95 % interval's lower end is at least 0.8 (:func:`rule_verified`).
@@ -444,10 +467,11 @@ def run_design(
     bed = parse_bed(bed)
     for name, v, low in (
         ("samples", samples, 20),
-        ("rounds", rounds, 0),
+        ("rounds", 0 if rounds is None else rounds, 0),
         ("verify", verify, 1),
         ("top", top, 1),
-        ("refine", refine, 1 if rounds else 0),
+        ("refine", refine, 1 if rounds != 0 else 0),
+        ("budget", budget, 1),
         ("pilot", pilot, 0),
     ):
         if isinstance(v, bool) or int(v) != v or v < low:
@@ -456,11 +480,12 @@ def run_design(
         raise ValueError(
             f"strategy = {strategy!r} must be one of {', '.join(map(repr, REFINE_STRATEGIES))}"
         )
-    total = samples + rounds * refine + (rounds + 1) * top * verify
-    if total > MAX_SAMPLES:
+    if budget > MAX_SAMPLES:
+        raise ValueError(f"budget = {budget:,} simulations; at most {MAX_SAMPLES:,} in one run")
+    if budget < samples + verify:
         raise ValueError(
-            f"{total:,} simulations asked for (samples + rounds x refine + (rounds + 1) x top x "
-            f"verify); at most {MAX_SAMPLES:,} in one run"
+            f"budget = {budget:,} simulations cannot hold the {samples:,} designs of the database "
+            f"and one verification of {verify:,} (at least {samples + verify:,})"
         )
     workers = check_workers(workers)
     length_factor(mesh_units)
@@ -534,7 +559,7 @@ def run_design(
         if given is None:
             table = table.iloc[:samples]
         times["database"] += time.perf_counter() - t0
-        mine_tgt = _buildable_target(sc, tgt, table) if buildable else tgt
+        mine_tgt = _buildable_target(sc, tgt, table, say) if buildable else tgt
         table, history, miners = _rounds(
             sc,
             mine_tgt,
@@ -544,6 +569,7 @@ def run_design(
             dbf,
             simulate,
             rounds=rounds,
+            budget=budget + have,
             refine=refine,
             verify=verify,
             top=top,
@@ -715,6 +741,7 @@ def _rounds(
     simulate,
     *,
     rounds,
+    budget,
     refine,
     verify,
     top,
@@ -727,34 +754,54 @@ def _rounds(
     used,
     say,
 ):
-    """Stages 2-4: mine, verify and refine; returns the grown table, the rounds and each
-    round's mined rules (round -> MinedRules)."""
+    """Stages 2-4: mine, verify and refine until a rule is verified, ``rounds`` refinement
+    rounds are done or ``budget`` rows of ``table`` would be passed; returns the grown table,
+    the rounds and each round's mined rules (round -> MinedRules)."""
     history: list[Round] = []
     miners: dict = {}
     boxes: list = []
     around = -1  # the last round whose few hits could not be mined: the next samples around
-    for r in range(rounds + 1):
+
+    def more(r: int) -> bool:
+        """Another refinement round after round ``r`` is allowed and fits the budget."""
+        capped = rounds is not None and r >= rounds
+        return not capped and len(table) + refine + verify <= budget
+
+    r = -1
+    while r < 0 or more(r):
+        r += 1
+        of = f"{r}/{rounds}" if rounds is not None else f"{r}"
         rdir = out / "rounds" / f"round-{r}"
         if r:
             t0 = time.perf_counter()
             s = seed + 7919 * r
             if r - 1 not in miners and around == r - 1:  # too few hits to mine: around them
-                say(f"[refine] round {r}/{rounds}: {refine} new designs around the designs "
+                say(f"[refine] round {of}: {refine} new designs around the designs "
                     "that meet the target")  # fmt: skip
                 key = _key("around-hits", [rule_key(b) for b in boxes], refine, s)
                 new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
             elif r - 1 not in miners:  # no design met the target yet: more at random
-                say(f"[refine] round {r}/{rounds}: {refine} new designs at random (none met "
+                say(f"[refine] round {of}: {refine} new designs at random (none met "
                     "the target yet)")  # fmt: skip
                 key = _key("random", refine, s)
                 new = sample_designs(sc, refine, seed=s, start=10**6 * r)
+            elif strategy == "mixed":
+                say(f"[refine] round {of}: {refine} new designs, half where the forest votes "
+                    "for the target, half inside the best rule")  # fmt: skip
+                key = _key("mixed", [rule_key(b) for b in boxes], len(table), refine, s)
+                half = refine // 2
+                vote = likely_designs(sc, miners[r - 1].miner, refine - half, seed=s,
+                                      start=10**6 * r)  # fmt: skip
+                inside = refine_designs(sc, boxes[:1], half, seed=s, widen=0.0,
+                                        start=10**6 * r + refine - half)  # fmt: skip
+                new = pd.concat([vote, inside], ignore_index=True)
             elif strategy == "likely":
-                say(f"[refine] round {r}/{rounds}: {refine} new designs where the forest votes "
+                say(f"[refine] round {of}: {refine} new designs where the forest votes "
                     "for the target")  # fmt: skip
                 key = _key("likely", [rule_key(b) for b in boxes], len(table), refine, s)
                 new = likely_designs(sc, miners[r - 1].miner, refine, seed=s, start=10**6 * r)
             else:
-                say(f"[refine] round {r}/{rounds}: {refine} new designs inside and around the "
+                say(f"[refine] round {of}: {refine} new designs inside and around the "
                     "rules")  # fmt: skip
                 key = _key([rule_key(b) for b in boxes], refine, s)
                 new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
@@ -769,12 +816,18 @@ def _rounds(
                 f"no rule to mine: {hits} of {len(ok)} simulated designs meet "
                 f"{'the target' if hits == 0 else 'the target, all of them'}"
             )
-            if hits == 0 and r < rounds and len(ok):  # a rare target: keep looking
+            look = hits == 0 and more(r) and 0 < len(ok) and len(table) < RANDOM_UP_TO
+            if look:  # a rare target: keep looking
                 note += "; the next round samples more at random"
+            elif hits == 0 and len(table) >= RANDOM_UP_TO:
+                note += (
+                    f" (fewer than 3 in {len(table):,} at 95 % confidence): no more rounds; "
+                    "loosen the target or widen the feature ranges"
+                )
             say(f"[mine] round {r}: {note}")
             history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
             times["mine"] += time.perf_counter() - t0
-            if hits == 0 and r < rounds and len(ok):
+            if look:
                 continue
             break
         say(f"[mine] round {r}: rules for {tgt} from {len(table)} designs")
@@ -789,7 +842,7 @@ def _rounds(
             note = f"no rule yet ({hits} of {len(ok)} designs meet the target, too few to mine)"
             times["mine"] += time.perf_counter() - t0
             history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
-            if r == rounds:
+            if not more(r):
                 say(f"  round {r}: {note}")
                 break
             boxes, around = [_box_of(ok.loc[tgt.evaluate(ok)], roles)], r
@@ -804,7 +857,7 @@ def _rounds(
         rows, failed = int(len(mined.table)), int(mined.n_failed)
         hits = int(mined.meets.sum())
         if not records:
-            if hits and r < rounds:  # a rare target: refine around the designs that meet it
+            if hits and more(r):  # a rare target: refine around the designs that meet it
                 boxes = [_box_of(mined.table.loc[mined.meets], roles)]
                 note = (
                     f"no rule yet ({hits} of {rows} designs meet the target); the next "
@@ -821,11 +874,14 @@ def _rounds(
                 break  # nothing to refine around: more rounds would sample the same
             continue
         t0 = time.perf_counter()
-        worth = _worth_verifying(records, last=r == rounds)
+        worth = _worth_verifying(records, last=not more(r))
         say(f"[verify] round {r}: {len(worth)} of {len(records)} rule(s) (estimate >= "
             f"{VERIFY_FROM}), {verify} fresh designs each")  # fmt: skip
         checks: list = [None] * len(records)
         for i in worth:  # best lower estimate first; the first verified rule ends the round
+            if len(table) + sum(len(v.designs) for v in checks if v) + verify > budget:
+                say(f"  round {r}: the budget of simulations leaves no room to verify more")
+                break
             rec = records[i]
             vdir = rdir / "verify" / f"rule{i + 1}-{rule_key(rec)}"
             checks[i] = verify_rule(sc, rec, tgt, verify, seed=seed + 100 * r + i + 1,
@@ -853,9 +909,11 @@ def _rounds(
         history.append(Round(r, rows, failed, hits, tuple(ranked)))
         boxes = records
         done = [e for e in ranked if e.verified is not None and rule_verified(e.verified)]
-        if until_verified and done and r < rounds:
+        if until_verified and done and more(r):
             say(f"  round {r}: rule {done[0].rank} is verified; no more rounds")
             break
+        if not done and not more(r) and (rounds is None or r < rounds):
+            say(f"  round {r}: the budget of {budget:,} simulations leaves no room for a round")
     return table, history, miners
 
 

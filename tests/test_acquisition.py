@@ -67,3 +67,67 @@ def test_the_loop_stops_once_a_rule_is_verified(tmp_path):
     assert len(again.summary["rounds"]) == 3
     with pytest.raises(ValueError, match="strategy = 'near' must be one of 'likely', 'around'"):
         run_design(_loop_scenario(), "y > 0.5", tmp_path / "q", strategy="near")
+
+
+def test_the_loop_stops_on_its_budget_of_simulations(tmp_path):
+    from holofold.design import run_design
+
+    # every round runs (until_verified=False) until the budget is spent
+    said = []
+    kw = dict(samples=60, refine=20, verify=10, top=1, pilot=0, workers=1, progress=False,
+              files=False, until_verified=False)  # fmt: skip
+    out = run_design(_loop_scenario(), "y > 0.5", tmp_path / "o", budget=200, say=said.append,
+                     **kw)  # fmt: skip
+    spent = len(out.table)
+    assert spent <= 200
+    # another round (20 designs and a verification of 10) would not have fitted
+    assert spent + 20 + 10 > 200
+    assert len(out.summary["rounds"]) >= 4  # no cap on the count of rounds
+    assert any("leaves no room" in s for s in said)
+    # a cap on rounds still holds, inside the budget
+    capped = run_design(_loop_scenario(), "y > 0.5", tmp_path / "p", budget=200, rounds=1, **kw)
+    assert len(capped.summary["rounds"]) == 2
+    with pytest.raises(ValueError, match="cannot hold the 60 designs of the database"):
+        run_design(_loop_scenario(), "y > 0.5", tmp_path / "q", budget=65, **kw)
+    assert not (tmp_path / "q").exists()
+
+
+def _two_regions():
+    # the target y > 0.8 holds at both ends of a (a < 0.1 or a > 0.9): two rules, two regions
+    return Scenario(
+        name="toy-two", description="toy", check=lambda row: [],
+        evaluate=lambda row: {"y": 2 * abs(row["a"] - 0.5), "status": CONVERGED},
+        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
+        performance=(Column("y", "-"),),
+    )  # fmt: skip
+
+
+def test_a_mixed_round_samples_half_by_vote_and_half_inside_the_best_rule(tmp_path):
+    from holofold.design import rule_mask, run_design
+
+    out = run_design(_two_regions(), "y > 0.8", tmp_path / "o", samples=200, rounds=1,
+                     refine=40, verify=10, top=2, pilot=0, workers=1, progress=False, files=False,
+                     until_verified=False, strategy="mixed")  # fmt: skip
+    best = out.record.rounds[0].rules[0].rule
+    new = out.table[out.table["origin"] == "refine-1"].sort_values("sample")
+    assert len(new) == 40
+    inside = np.asarray(rule_mask(new, best), bool)
+    assert inside[20:].all()  # the second half: uniform inside the round's best rule
+    assert new["b"].iloc[20:].std() > 0.15  # spread over the feature the rule leaves free
+    # the first half: where the forest votes, at both ends, so partly outside the best rule
+    assert (new["y"].iloc[:20] > 0.8).mean() >= 0.6
+    assert 3 <= (~inside[:20]).sum() <= 17
+
+
+def test_the_loop_stops_looking_at_random_for_a_target_no_design_meets(tmp_path, monkeypatch):
+    import holofold.design.loop as design_loop
+    from holofold.design import run_design
+
+    monkeypatch.setattr(design_loop, "RANDOM_UP_TO", 100)
+    said = []
+    out = run_design(_loop_scenario(), "y > 2", tmp_path / "o", samples=60, refine=20,
+                     verify=10, pilot=0, workers=1, progress=False, files=False,
+                     say=said.append)  # fmt: skip
+    assert len(out.table) == 100  # 60 + 2 rounds of 20 at random, then it stops
+    assert any("fewer than 3 in 100 at 95 % confidence): no more rounds" in s for s in said)
+    assert out.record.answer == "nearest"

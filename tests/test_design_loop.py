@@ -241,7 +241,8 @@ def test_more_samples_extend_the_database_instead_of_rebuilding_it(designed, tmp
 @pytest.mark.parametrize(
     "argv, match",
     [(["--target", "Zstif > 1"], "unknown column"), (["-n", "5"], "samples = 5"),
-     (["--rounds", "-1"], "rounds = -1"), (["--workers", "0"], "workers")],
+     (["--rounds", "-1"], "rounds = -1"), (["--workers", "0"], "workers"),
+     (["--budget", "100"], "budget = 100 simulations cannot hold")],
 )  # fmt: skip
 def test_design_command_refuses_bad_arguments_before_writing(tmp_path, capsys, argv, match):
     out = tmp_path / "out"
@@ -577,3 +578,26 @@ def test_hits_too_few_to_mine_are_refined_around_instead_of_ending_the_loop(tmp_
     refined = res.table[res.table["origin"] == "refine-1"]
     assert len(refined) == 60 and refined["a"].min() > 0.7  # around the hits (a > 0.95)
     assert res.performance["double"] > 1.9
+
+
+def _always_overlapping(row):
+    return {"double": 2.0 * row["a"], "mass": row["a"] + row["b"],
+            "overlap": (0.1 + row["b"]) * 1e-9, "status": CONVERGED}  # fmt: skip
+
+
+def test_when_no_design_is_buildable_the_rules_are_mined_for_the_target_alone(tmp_path):
+    # every design's thick panels overlap (0.1-1.1 mm^3): a rule for "target and no overlap"
+    # cannot exist, so the loop mines the target itself instead of sampling at random
+    said = []
+    res = run_design(_cheap_scenario(_always_overlapping), "double > 1.8", tmp_path / "o",
+                     samples=100, pilot=0, verify=10, top=1, rounds=1, workers=1,
+                     progress=False, files=False, say=said.append)  # fmt: skip
+    s = res.summary
+    assert s["mined_target"] == "double > 1.8"
+    assert any("thick panels of all 100 designs overlap (the least by 0.1" in x for x in said)
+    verified = [r for rd in res.record.rounds for r in rd.rules if r.verified is not None]
+    assert verified and verified[-1].verified.precision >= 0.9  # a rule for the target
+    # the choice keeps to buildable designs: there is none, and the headline says so
+    assert res.record.answer == "nearest" and s["buildable"] is False
+    assert "The thick panels of every simulated design overlap; shown:" in res.record.headline
+    assert "whose panels do not overlap" not in res.record.headline

@@ -164,7 +164,7 @@ def _argv(draw, files, tmp):
         "design": ({"0": "single-miura", "--target": "axialstiff60 > 3000", "-o": out,
                     "-n": "20", "--verify": "2", "--top": "1", "--workers": "1"},
                    {"0": scen, "--target": targets, "-o": outs, "-n": sizes, "--rounds": sizes,
-                    "--verify": sizes, "--top": sizes, "--db": paths}),
+                    "--budget": sizes, "--verify": sizes, "--top": sizes, "--db": paths}),
         "scenarios": ({"0": "show", "1": "arch"},
                       {"0": st.sampled_from(["list", "show", "nope"]),
                        "1": st.sampled_from(["arch", "canopy", "x", ""])}),

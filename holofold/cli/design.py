@@ -19,13 +19,13 @@ def register(subparsers) -> argparse.ArgumentParser:
             "run stops after it, saying what the designs reach, when none meets the target), "
             "mine design rules for the target, verify the best rules with fresh simulations, "
             "refine where the forest expects the target and mine again until a rule is verified "
-            "(at most --rounds rounds), and choose from every simulated "
+            "or --budget simulations are spent, and choose from every simulated "
             "design the best under --objective inside the best verified rule of all rounds "
             "(without one: the best design meeting the target; without that: the nearest, with "
             "its shortfall). Designs whose thick panels overlap are not chosen unless "
             "--allow-overlap. Always writes OUT/design.json and OUT/report.html, and the "
             "design's fabrication files (FOLD, SVG, STL, OBJ, printable part) with its fit on "
-            "the printer's bed. Re-running resumes; a larger -n, --rounds or --verify extends "
+            "the printer's bed. Re-running resumes; a larger -n, --budget or --verify extends "
             "the folder. Exit status 0: the chosen design meets the target; 1: no simulated "
             "design does (the nearest is shown); 2: bad input."
         ),
@@ -70,22 +70,30 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--db", type=Path, help="database folder (default OUT/database)")
     p.add_argument(
+        "--budget",
+        type=int,
+        default=6000,
+        help="simulations the run may spend at most: database, refinement and verification "
+        "designs (default 6000); the loop stops earlier once a rule is verified: 90 %% of its "
+        "fresh designs meet the target and the 95 %% interval's lower end is at least 0.8",
+    )
+    p.add_argument(
         "--rounds",
         type=int,
-        default=10,
-        help="refinement rounds at most (default 10; 0 mines once, as the paper); the loop stops "
-        "once a rule is verified: 90 %% of its fresh designs meet the target and the 95 %% "
-        "interval's lower end is at least 0.8",
+        default=None,
+        help="refinement rounds at most (default: as many as --budget allows; 0 mines once, "
+        "as the paper)",
     )
     p.add_argument(
         "--refine", type=int, default=50, help="new designs per refinement round (default 50)"
     )
     p.add_argument(
         "--strategy",
-        choices=("likely", "around"),
-        default="likely",
-        help="where a refinement round samples: where the forest votes for the target (likely, "
-        "default) or inside and around the rules (around)",
+        choices=("mixed", "likely", "around"),
+        default="mixed",
+        help="where a refinement round samples: half where the forest votes for the target and "
+        "half inside the best rule (mixed, default), all where the forest votes (likely), or "
+        "inside and around the rules (around)",
     )
     p.add_argument(
         "--all-rounds",
@@ -117,6 +125,7 @@ def run(args) -> int:
         args.output,
         samples=args.samples,
         rounds=args.rounds,
+        budget=args.budget,
         refine=args.refine,
         verify=args.verify,
         top=args.top,
