@@ -366,8 +366,12 @@ def _answer(summary: DesignSummary, cols: Mapping) -> str:
     out = ['<section id="answer"><h2>The answer</h2>']
     kind = summary.answer
     css = {"rule": "", "designs": "", "nearest": " nearest", "none": " nothing"}[kind]
+    title = _KIND_TITLE[kind]
+    pick = summary.chosen
+    if kind == "nearest" and pick is not None and pick.meets and pick.buildable is False:
+        title = "No buildable design meets the target: the best, overlapping"
     out.append(
-        f'<div class="answer{css}"><span class="kind">{_esc(_KIND_TITLE[kind])}</span>'
+        f'<div class="answer{css}"><span class="kind">{_esc(title)}</span>'
         f"{_esc(summary.headline)}</div>"
     )
     obj = summary.objective
@@ -422,6 +426,10 @@ def _alternatives(summary: DesignSummary, cols: Mapping) -> str:
             if summary.answer == "rule"
             else "no rule was verified, and the chosen one is the best simulated design"
             if summary.answer == "designs"
+            else "no buildable design meets the target; the chosen one meets it, overlapping"
+            if summary.chosen is not None
+            and summary.chosen.meets
+            and summary.chosen.buildable is False
             else "no simulated design meets the target; the chosen one is the nearest"
         )
         out.append(f"<p>No other design was put forward: {why}.</p></section>")

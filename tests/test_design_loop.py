@@ -601,3 +601,8 @@ def test_when_no_design_is_buildable_the_rules_are_mined_for_the_target_alone(tm
     assert res.record.answer == "nearest" and s["buildable"] is False
     assert "The thick panels of every simulated design overlap; shown:" in res.record.headline
     assert "whose panels do not overlap" not in res.record.headline
+    from holofold.design.report_page import report_page_html
+
+    page = report_page_html(tmp_path / "o", res.record)
+    assert "No buildable design meets the target: the best, overlapping" in page
+    assert "No design meets the target: the nearest" not in page
