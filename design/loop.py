@@ -569,7 +569,8 @@ def run_design(
             dbf,
             simulate,
             rounds=rounds,
-            budget=budget + have,
+            budget=budget,
+            free=have,
             refine=refine,
             verify=verify,
             top=top,
@@ -742,6 +743,7 @@ def _rounds(
     *,
     rounds,
     budget,
+    free,
     refine,
     verify,
     top,
@@ -755,8 +757,9 @@ def _rounds(
     say,
 ):
     """Stages 2-4: mine, verify and refine until a rule is verified, ``rounds`` refinement
-    rounds are done or ``budget`` rows of ``table`` would be passed; returns the grown table,
-    the rounds and each round's mined rules (round -> MinedRules)."""
+    rounds are done or ``budget`` simulations would be passed (the first ``free`` rows of
+    ``table``, a given database's, cost nothing); returns the grown table, the rounds and each
+    round's mined rules (round -> MinedRules)."""
     history: list[Round] = []
     miners: dict = {}
     boxes: list = []
@@ -765,7 +768,7 @@ def _rounds(
     def more(r: int) -> bool:
         """Another refinement round after round ``r`` is allowed and fits the budget."""
         capped = rounds is not None and r >= rounds
-        return not capped and len(table) + refine + verify <= budget
+        return not capped and len(table) - free + refine + verify <= budget
 
     r = -1
     while r < 0 or more(r):
@@ -879,7 +882,8 @@ def _rounds(
             f"{VERIFY_FROM}), {verify} fresh designs each")  # fmt: skip
         checks: list = [None] * len(records)
         for i in worth:  # best lower estimate first; the first verified rule ends the round
-            if len(table) + sum(len(v.designs) for v in checks if v) + verify > budget:
+            spent = len(table) - free + sum(len(v.designs) for v in checks if v)
+            if spent + verify > budget:
                 say(f"  round {r}: the budget of simulations leaves no room to verify more")
                 break
             rec = records[i]

@@ -362,13 +362,19 @@ def _facts(summary: DesignSummary) -> str:
     return f'<div class="card" id="facts"><h3>{_esc(title)}</h3>{rows}</div>'
 
 
+def _meets_overlapping(summary: DesignSummary) -> bool:
+    """No buildable design met the target, and the one shown meets it with overlapping panels."""
+    pick = summary.chosen
+    shown = pick is not None and pick.meets and pick.buildable is False
+    return summary.answer == "nearest" and shown
+
+
 def _answer(summary: DesignSummary, cols: Mapping) -> str:
     out = ['<section id="answer"><h2>The answer</h2>']
     kind = summary.answer
     css = {"rule": "", "designs": "", "nearest": " nearest", "none": " nothing"}[kind]
     title = _KIND_TITLE[kind]
-    pick = summary.chosen
-    if kind == "nearest" and pick is not None and pick.meets and pick.buildable is False:
+    if _meets_overlapping(summary):
         title = "No buildable design meets the target: the best, overlapping"
     out.append(
         f'<div class="answer{css}"><span class="kind">{_esc(title)}</span>'
@@ -427,9 +433,7 @@ def _alternatives(summary: DesignSummary, cols: Mapping) -> str:
             else "no rule was verified, and the chosen one is the best simulated design"
             if summary.answer == "designs"
             else "no buildable design meets the target; the chosen one meets it, overlapping"
-            if summary.chosen is not None
-            and summary.chosen.meets
-            and summary.chosen.buildable is False
+            if _meets_overlapping(summary)
             else "no simulated design meets the target; the chosen one is the nearest"
         )
         out.append(f"<p>No other design was put forward: {why}.</p></section>")
