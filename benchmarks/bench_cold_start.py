@@ -47,7 +47,8 @@ from pathlib import Path
 
 ROW = "m,tcrease,tpanel,W,offset,stripeWidth,extrude\n12,8e-4,3e-3,2e-3,0.2,0.02,0.1\n"
 ROOT = Path(__file__).resolve().parents[1]
-#: the 156-panel pattern of issue 37's start-up figure (Origami Simulator's waterbomb, MIT)
+#: the pattern of the start-up figure: Origami Simulator's waterbomb (330 panels, MIT; issue 37's
+#: figure was of a 156-panel pattern it does not name)
 PATTERN = Path("/work/os-examples/assets/Tessellations/waterbomb.svg")
 
 
