@@ -10,33 +10,26 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from test_acquisition import _loop_scenario
 
 from holofold.design import (
     STRATEGIES,
-    Column,
     DesignFiles,
     DesignProblem,
     Execution,
     LoopSettings,
     Proposal,
-    Scenario,
     register_strategy,
     run_design,
     sample_designs,
 )
 from holofold.design.strategies import design_key
-from holofold.mechanics.status import CONVERGED
 
 DESIGN = Path(__file__).resolve().parents[1] / "design"
 
 
 def _toy():
-    return Scenario(
-        name="toy-records", description="toy", check=lambda row: [],
-        evaluate=lambda row: {"y": row["a"] + 0.01 * row["b"], "status": CONVERGED},
-        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
-        performance=(Column("y", "-"),),
-    )  # fmt: skip
+    return _loop_scenario()  # y = a + 0.01 b, a and b in [0, 1]
 
 
 def test_records_check_themselves_in_one_line():
