@@ -24,6 +24,14 @@ __all__ = ["Registry"]
 T = TypeVar("T")
 
 
+def _as_is(name, value):
+    return value
+
+
+def _same(name):
+    return name
+
+
 class _Lazy:
     def __init__(self, load):
         self.load = load
@@ -60,8 +68,8 @@ class Registry(Mapping, Generic[T]):
         error: type[Exception] = KeyError,
     ):
         self.what, self.group, self.error = what, group, error
-        self._check = check or (lambda name, value: value)
-        self._key = key or (lambda name: name)
+        self._check = check or _as_is
+        self._key = key or _same
         self._builtin: dict = {}
         self._added: dict = {}
         for name, value in (builtins or {}).items():
