@@ -47,7 +47,8 @@ class DesignProblem:
     scenario : Scenario (a name or a ``.toml`` path is loaded)
     target : Target (an expression over the scenario's performance columns is parsed)
     objective : Objective ("margin", "min COLUMN", "max COLUMN" or None are parsed)
-    bed : Bed ("WxD" in mm or (x, y) in m are parsed)
+    bed : Bed ("WxD" in mm or (x, y) in m are parsed; None: the scenario's ``bed`` if it
+        has one, else :data:`~holofold.design.DEFAULT_BED`)
     allow_overlap : bool
         Let a design whose thick panels overlap be chosen (never by default).
     """
@@ -55,7 +56,7 @@ class DesignProblem:
     scenario: Scenario | str | os.PathLike
     target: Target | str
     objective: Objective | str | None = None
-    bed: Bed | str | tuple = DEFAULT_BED
+    bed: Bed | str | tuple | None = DEFAULT_BED
     allow_overlap: bool = False
 
     def __post_init__(self):
@@ -66,7 +67,8 @@ class DesignProblem:
         put(self, "target", parse_target(text, sc.performance_names))
         put(self, "objective", parse_objective(self.objective, [*sc.performance_names,
                                                                 *sc.feature_names]))  # fmt: skip
-        put(self, "bed", parse_bed(self.bed))
+        bed = self.bed if self.bed is not None else getattr(sc, "bed", None) or DEFAULT_BED
+        put(self, "bed", parse_bed(bed))
         put(self, "allow_overlap", bool(self.allow_overlap))
 
     @property
