@@ -24,7 +24,8 @@ from dataclasses import dataclass, field, fields, replace
 from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed
 from holofold.design.describe import PILOT
 from holofold.design.objective import Objective, parse_objective
-from holofold.design.runner import check_workers
+from holofold.design.row_limits import resolve_row_timeout
+from holofold.design.runner import check_scheduler, check_workers
 from holofold.design.sampling import MAX_SAMPLES
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.strategies import STRATEGIES
@@ -176,6 +177,10 @@ class Execution:
 
     def __post_init__(self):
         object.__setattr__(self, "workers", check_workers(self.workers))
+        if self.scheduler is not None:
+            object.__setattr__(self, "scheduler", check_scheduler(self.scheduler))
+        if self.row_timeout is not None:
+            resolve_row_timeout(None, self.row_timeout)  # refuses a bad limit in one line
 
     def runner(self) -> dict:
         """The keyword arguments of :func:`~holofold.design.build_database` and

@@ -41,6 +41,12 @@ def test_records_check_themselves_in_one_line():
         LoopSettings(budget=220)
     with pytest.raises(ValueError, match="workers = 0 must be >= 1"):
         Execution(workers=0)
+    with pytest.raises(ValueError, match="is not an address"):
+        Execution(scheduler="my laptop")
+    with pytest.raises(ValueError, match="row_timeout|time limit"):
+        Execution(row_timeout=-1)
+    assert Execution(row_timeout="none").runner() == {"workers": 1, "progress": None,
+                                                      "row_timeout": "none"}  # fmt: skip
     with pytest.raises(ValueError, match="unknown length unit|furlong"):
         DesignFiles(mesh_units="furlong")
     with pytest.raises(ValueError, match="unknown column 'z'"):
