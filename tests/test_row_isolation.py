@@ -3,6 +3,7 @@ per row, on the Python API and the evaluate / generate / verify commands."""
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import threading
@@ -146,20 +147,22 @@ def test_limit_interrupts_python_code_in_any_thread(monkeypatch):
     with pytest.raises(RowTimeout):
         call_with_limit(0.05, _spin, 60.0)
     assert call_with_limit(60.0, sum, [1, 2]) == 3
-    # one C call the watchdog cannot cut short: it blocks until the watchdog has fired (an
-    # event, not a clock), runs to its end, and still counts as late
-    fired, real = threading.Event(), row_limits._raise_in
+    # one C call the watchdog cannot cut short (acquiring a lock): it blocks until the watchdog
+    # has fired (an event, not a clock; 60 s a hang bound), runs to its end, and still counts
+    # as late
+    fired, gate, real = threading.Event(), threading.Lock(), row_limits._raise_in
+    gate.acquire()
 
     def raise_in(thread_id, exc_type):
         real(thread_id, exc_type)
         if exc_type is not None:
             fired.set()
+            gate.release()
 
     monkeypatch.setattr(row_limits, "_raise_in", raise_in)
-    ended = []
     with pytest.raises(RowTimeout):
-        call_with_limit(0.02, lambda: ended.append(fired.wait(60.0)))
-    assert ended == [True]  # the C call (Event.wait) returned because the watchdog fired
+        call_with_limit(0.02, functools.partial(gate.acquire, True, 60.0))
+    assert fired.is_set() and gate.locked()  # the acquire got the gate the watchdog released
     monkeypatch.setattr(row_limits, "_raise_in", real)
     _spin(0.05)  # and nothing arrives afterwards
     caught = []
