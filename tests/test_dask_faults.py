@@ -78,7 +78,8 @@ def test_no_workers_for_the_stated_time_is_one_line_and_an_exit(tmp_path):
              "--scheduler", f"tcp://127.0.0.1:{port}"],
             capture_output=True, text=True, timeout=120,
             env={**os.environ, "HOLOFOLD_WORKER_TIMEOUT": "3"},
-        )  # fmt: skip  (timeout: a hang bound; the run gives up after its 3 s limit)
+        )  # fmt: skip
+        # (timeout=120: a hang bound; the run gives up after its 3 s limit)
     finally:
         _stop(sched)
     _one_line(r, f"no Dask worker at tcp://127.0.0.1:{port} for 3 s", "run the same command")

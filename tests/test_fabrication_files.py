@@ -84,6 +84,7 @@ def test_pattern_files_with_the_printable_part_in_mm(tmp_path):
     assert part.is_watertight and part.body_count == 1
     # the flat sheet: 2 x 4 parallelograms of 20 mm x 20 mm sin 60 ... in mm, 2 mm thick
     np.testing.assert_allclose(part.bounds[:, 2], [0.0, 2.0], atol=1e-6)
+
     def cross2(u, v):  # the z component of a 2-D cross product (np.cross of 2-D vectors is
         return u[0] * v[1] - u[1] * v[0]  # deprecated in NumPy 2.0)
 

@@ -91,8 +91,8 @@ def test_design_loop_killed_at_chosen_points_resumes_to_the_same_design(tmp_path
     # every stage: the first database, the refinement, the verification, the report's files;
     # the n-th write of a resumed run is later and later in the loop as earlier runs store
     # their files, so runs killed after or inside their 1st-3rd write reach the last files
-    points = [("row", 1), ("written", 2), ("write", 2), ("row", 40), ("written", 3),
-              ("row", 15), ("write", 3), ("written", 3), ("written", 3), ("written", 3)]  # fmt: skip
+    points = [("row", 1), ("written", 2), ("write", 2), ("row", 40), ("written", 3), ("row", 15)]
+    points += [("write", 3), ("written", 3), ("written", 3), ("written", 3)]
     killed = _kill_at([*argv, "-o", str(tmp_path / "out")], points)
     got = json.loads((tmp_path / "out" / "design.json").read_text())
     for key in ("features", "performance", "rule", "verified_precision", "margins", "rounds"):
