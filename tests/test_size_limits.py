@@ -17,6 +17,7 @@ from holofold.design.mining import (
     mine_rules,
     mining_estimate,
 )
+from holofold.design.rules.miner import FewRulesWarning
 from holofold.design.scenarios import ScenarioFileError
 from holofold.fitting import MAX_M
 from holofold.geometry import MAX_PANELS
@@ -65,8 +66,9 @@ def test_progress_line_before_long_training(table, monkeypatch):
 
     monkeypatch.setattr(mining, "SECONDS_PER_TREE", 1.0)  # pretend: 1 s per tree
     lines = []
-    mine_rules(table, "perf > 0.5", features=["a", "b", "c"], n_estimators=20,
-               progress=lines.append)  # fmt: skip
+    with pytest.warns(FewRulesWarning):  # 20 trees on 48 noisy rows: fewer distinct rules
+        mine_rules(table, "perf > 0.5", features=["a", "b", "c"], n_estimators=20,
+                   progress=lines.append)  # fmt: skip
     assert lines == [lines[0]] and lines[0].startswith("training 20 trees on 48 rows: about 20")
 
 
