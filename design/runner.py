@@ -41,6 +41,7 @@ from holofold.design.row_limits import (
 from holofold.design.row_status import STATE_COLUMNS, status_columns
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.scenarios.base import check_row, single_thread
+from holofold.geometry.fault_points import fault_point
 from holofold.mechanics.kernels import check_environment
 from holofold.mechanics.status import Status
 
@@ -588,7 +589,9 @@ def iter_results(
         par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
         outs = par(delayed(_evaluate_batch)(scenario, [rows[i] for i in t], *args) for t in tasks)
     for task, out in zip(tasks, outs, strict=True):
-        yield from zip(task, out, strict=True)
+        for pos, one in zip(task, out, strict=True):
+            fault_point("row")  # test-only (HOLOFOLD_TEST_FAULT); nothing when unset
+            yield pos, one
 
 
 def progress_bar(total: int, desc: str, enabled: bool | None = None, initial: int = 0):

@@ -15,6 +15,8 @@ import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from holofold.geometry.fault_points import fault_point
+
 __all__ = [
     "check_output_path",
     "check_writable_folder",
@@ -88,7 +90,9 @@ def atomic_write(path, write: Callable[[str], None]) -> Path:
     try:
         write(tmp)
         os.chmod(tmp, 0o666 & ~_umask())
+        fault_point("write")  # test-only (HOLOFOLD_TEST_FAULT); nothing when unset
         os.replace(tmp, path)
+        fault_point("written")
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

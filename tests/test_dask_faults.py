@@ -15,6 +15,7 @@ import pytest
 
 pytest.importorskip("distributed")
 psutil = pytest.importorskip("psutil")
+pytestmark = pytest.mark.processes
 
 SCHEDULER = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
 WORKER = [sys.executable, "-m", "distributed.cli.dask_worker"]
@@ -72,18 +73,16 @@ def test_no_workers_for_the_stated_time_is_one_line_and_an_exit(tmp_path):
     port = _free_port()
     sched = _scheduler(port)
     try:
-        t0 = time.monotonic()
         r = subprocess.run(
             [*CLI, "generate", "single-miura", "-n", "4", "-o", str(tmp_path / "db"),
              "--scheduler", f"tcp://127.0.0.1:{port}"],
             capture_output=True, text=True, timeout=120,
             env={**os.environ, "HOLOFOLD_WORKER_TIMEOUT": "3"},
         )  # fmt: skip
-        took = time.monotonic() - t0
+        # (timeout=120: a hang bound; the run gives up after its 3 s limit)
     finally:
         _stop(sched)
     _one_line(r, f"no Dask worker at tcp://127.0.0.1:{port} for 3 s", "run the same command")
-    assert took < 60
 
 
 @pytest.mark.slow

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import threading
 import time
 from contextlib import contextmanager
 
@@ -13,6 +14,7 @@ import pandas as pd
 import pytest
 
 distributed = pytest.importorskip("distributed")
+pytestmark = pytest.mark.processes
 
 import dask  # noqa: E402
 
@@ -144,9 +146,14 @@ def test_unreachable_scheduler_names_it():
             evaluate_designs(TOY, df, scheduler="tcp://127.0.0.1:1")
 
 
+#: set when the other chunks are written: the first row waits for it (an event, not a clock;
+#: 120 s is a hang bound), so the first chunk finishes after all the others on any machine
+OTHERS_WRITTEN = threading.Event()
+
+
 def _slow_first(row):
     if row["a"] == 1:
-        time.sleep(0.3)  # the first chunk finishes after all the others
+        OTHERS_WRITTEN.wait(120.0)
     if row["a"] == 5:
         raise RuntimeError("unlucky design")
     return {"double": 2 * row["a"], "status": "converged"}
@@ -167,15 +174,19 @@ def _chunk_files(folder):
     return {p.name[:10]: pd.read_parquet(p) for p in sorted((folder / "chunks").glob("*.parquet"))}
 
 
-def _record_writes(monkeypatch, fail_at=None):
-    """Record the chunks ``store.write_chunk`` writes; Ctrl-C instead of writing fail_at."""
+def _record_writes(monkeypatch, fail_at=None, then=None):
+    """Record the chunks ``store.write_chunk`` writes; Ctrl-C instead of writing fail_at;
+    ``then``: ``(n, event)``, set ``event`` once ``n`` chunks are written."""
     written, real = [], store.write_chunk
 
     def recording(df, chunks, k):
         if len(written) + 1 == fail_at:
             raise KeyboardInterrupt
         written.append(f"part-{k:05d}")
-        return real(df, chunks, k)
+        out = real(df, chunks, k)
+        if then is not None and len(written) == then[0]:
+            then[1].set()
+        return out
 
     monkeypatch.setattr(store, "write_chunk", recording)
     return written
@@ -185,8 +196,10 @@ def test_dask_build_writes_each_chunk_when_its_rows_are_done(
     address, tmp_path, monkeypatch, capsys
 ):
     designs = pd.DataFrame({"id": list("pqrstuv"), "a": np.arange(1.0, 8.0)}, index=range(10, 17))
+    OTHERS_WRITTEN.set()  # serial: the first row first
     serial = store.build_database(SLOW_FIRST, designs, tmp_path / "serial", chunk_size=2)
-    written = _record_writes(monkeypatch)
+    OTHERS_WRITTEN.clear()
+    written = _record_writes(monkeypatch, then=(3, OTHERS_WRITTEN))
     db = store.build_database(
         SLOW_FIRST, designs, tmp_path / "dask", chunk_size=2, scheduler=address, progress=True
     )
@@ -228,7 +241,8 @@ def test_interrupted_dask_build_resumes_without_duplicates(address, miura, tmp_p
     assert len(EVALUATED) <= 7  # every row submitted once
     first_run = set(written)
     with distributed.Client(address, set_as_default=False) as client:  # nothing left running
-        for _ in range(50):
+        end = time.monotonic() + 120  # a hang bound: the tasks are cancelled at once
+        while time.monotonic() < end:
             if not client.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)):
                 break
             time.sleep(0.1)

@@ -3,8 +3,6 @@ one line naming the value, the estimate or limit and, where sensible, the overri
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -19,6 +17,7 @@ from holofold.design.mining import (
     mine_rules,
     mining_estimate,
 )
+from holofold.design.rules.miner import FewRulesWarning
 from holofold.design.scenarios import ScenarioFileError
 from holofold.fitting import MAX_M
 from holofold.geometry import MAX_PANELS
@@ -53,10 +52,8 @@ def test_the_estimate_matches_the_measured_constants():
     ],
 )  # fmt: skip
 def test_mining_sizes_are_refused_before_training(table, params, match):
-    t = time.perf_counter()
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises(ValueError, match=match):  # before training (it would take hours)
         mine_rules(table, "perf > 0.5", features=["a", "b", "c"], **params)
-    assert time.perf_counter() - t < 5
 
 
 def test_force_lets_a_large_forest_through_and_progress_is_told():
@@ -69,8 +66,9 @@ def test_progress_line_before_long_training(table, monkeypatch):
 
     monkeypatch.setattr(mining, "SECONDS_PER_TREE", 1.0)  # pretend: 1 s per tree
     lines = []
-    mine_rules(table, "perf > 0.5", features=["a", "b", "c"], n_estimators=20,
-               progress=lines.append)  # fmt: skip
+    with pytest.warns(FewRulesWarning):  # 20 trees on 48 noisy rows: fewer distinct rules
+        mine_rules(table, "perf > 0.5", features=["a", "b", "c"], n_estimators=20,
+                   progress=lines.append)  # fmt: skip
     assert lines == [lines[0]] and lines[0].startswith("training 20 trees on 48 rows: about 20")
 
 
@@ -83,11 +81,9 @@ def test_cli_mine_refuses_a_million_trees_in_one_line(tmp_path, capsys, table):
         (["--depth", "99999999999999999999"], "--depth) = 99999999999999999999 is over"),
         (["--jobs", "100000"], "--jobs) = 100000 threads"),
     ]:
-        t = time.perf_counter()
         assert main(base + extra) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert err[-1].startswith("holofold mine: error: ") and match in err[-1], err
-        assert time.perf_counter() - t < 10
 
 
 def test_sheet_rows_over_the_panel_limit_are_invalid_not_simulated():
@@ -113,10 +109,9 @@ def test_strip_rows_over_the_fit_limit_are_invalid():
 def test_cli_evaluate_canopy_with_a_huge_m_is_refused_at_once(tmp_path, capsys):
     rows = tmp_path / "rows.csv"
     rows.write_text("pattern,m,n,tcrease,tpanel,W\n1,1000000,6,8e-4,3e-3,2e-3\n")
-    t = time.perf_counter()
     assert main(["evaluate", "canopy", str(rows), "-o", str(tmp_path / "r.csv")]) == 2
     assert "6000000 panels is over the limit of 10000" in capsys.readouterr().err
-    assert time.perf_counter() - t < 10
+    assert not (tmp_path / "r.csv").exists()
 
 
 def test_a_sheet_file_whose_largest_sheet_is_over_the_limit_is_refused(tmp_path):
