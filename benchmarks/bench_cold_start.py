@@ -1,30 +1,68 @@
-"""Cold and warm start: the time to a fresh environment's first result (issue 22, item 4).
+"""Cold and warm start, the demo and the command start-up, as whole processes (issues 22, 37).
 
-Each case is a new process of the command line with its own kernel cache folder
-(``HOLOFOLD_KERNEL_CACHE``): ``cold`` starts from an empty folder (the default ``auto`` kernel
-path: numpy while one background process compiles), ``warm`` from the folder the cold run's
-background compile filled, ``cold, compiled`` is an empty folder with ``HOLOFOLD_KERNELS=compiled``
-(the process compiles before its first row: what every fresh environment paid before), and
-``numpy`` never compiles. The commands: ``holofold evaluate arch`` of one row (wall clock of
-the process) and ``holofold demo`` (wall clock to its first simulated row, read from the
-progress of its database, and to the end).
+Every case is a new process of the command line, timed by the wall clock from outside, with
+its own kernel cache folder (``HOLOFOLD_KERNEL_CACHE``) and its own output folder, new for
+every run unless the case says otherwise. The cases run side by side: each repeat runs every
+case once, so a machine whose load drifts meets them alike. Each case prints the median, min
+and max of its runs and the 1-minute load average before its runs (min-max): on a shared
+machine only figures measured at a low load count against a target.
 
-    python benchmarks/bench_cold_start.py [--demo] [--repeat 3]
+``evaluate``: ``holofold evaluate arch`` of one row.
+
+* ``cold``: an empty cache (the default ``auto`` kernel path: numpy while one background
+  process compiles);
+* ``warm``: the cache the cold run's background compile filled;
+* ``numpy``: ``HOLOFOLD_KERNELS=numpy``, never compiles;
+* ``cold, compiled in the process``: an empty cache with ``HOLOFOLD_KERNELS=compiled``.
+
+``demo`` (``--demo``): ``holofold demo``, the time to its first simulated chunk and to its end.
+
+* ``cold, fresh folder``: an empty cache, a new output folder;
+* ``warm, fresh folder``: a ready cache, a new output folder (everything simulated);
+* ``resumed``: the warm run's command again into its own folder: the loop resumes and
+  re-simulates nothing (not a start-up time; shown so it is never mistaken for one).
+
+``simulate`` (``--simulate``): ``holofold simulate PATTERN`` with a ready cache, the whole
+process, beside the same command run inside one process that has run it before (``main``
+called twice, the second timed): their difference is the start-up overhead (interpreter,
+imports, kernel loading, first-call caches), and ``holofold --help`` the bare start-up.
+
+    python benchmarks/bench_cold_start.py [--repeat 7] [--demo] [--simulate PATTERN] [--no-evaluate]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import resource
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 ROW = "m,tcrease,tpanel,W,offset,stripeWidth,extrude\n12,8e-4,3e-3,2e-3,0.2,0.02,0.1\n"
+ROOT = Path(__file__).resolve().parents[1]
+#: the pattern of the start-up figure: Origami Simulator's waterbomb (330 panels, MIT; issue 37's
+#: figure was of a 156-panel pattern it does not name)
+PATTERN = Path("/work/os-examples/assets/Tessellations/waterbomb.svg")
+
+
+EVAL_COLD = "evaluate arch, 1 row: cold (auto: numpy while compiling)"
+COMPILE = "background compile after the cold row (s to ready)"
+EVAL_WARM = "evaluate arch, 1 row: warm (cache ready)"
+EVAL_NUMPY = "evaluate arch, 1 row: numpy (never compiles)"
+EVAL_COMPILED = "evaluate arch, 1 row: cold, compiled in the process"
+DEMO_COLD = "demo: cold (empty cache), fresh folder"
+DEMO_WARM = "demo: warm (cache ready), fresh folder"
+DEMO_RESUMED = "demo: resumed (re-run into the warm run's folder, simulates nothing)"
+HELP = "holofold --help (bare start-up)"
+SIM = "simulate: whole process (cache ready)"
+SIM_IN = "simulate: in a process that ran it before"
 
 
 def _holofold() -> list[str]:
@@ -39,7 +77,36 @@ def _env(cache: Path, kernels: str = "auto") -> dict:
     return env
 
 
-def _wait_ready(cache: Path, timeout: float = 900.0) -> float:
+def _load() -> float:
+    return os.getloadavg()[0]
+
+
+@dataclass
+class Case:
+    """The runs of one case: seconds (or tuples of seconds) and the load before each."""
+
+    runs: list = field(default_factory=list)
+    loads: list = field(default_factory=list)
+    cpu: list = field(default_factory=list)
+
+    def add(self, fn, *args):
+        self.loads.append(_load())
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        value = fn(*args)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        self.cpu.append(r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime)
+        self.runs.append(value)
+        return value
+
+    def line(self, name: str, part: int | None = None) -> str:
+        vals = [v if part is None else v[part] for v in self.runs]
+        med, lo, hi = statistics.median(vals), min(vals), max(vals)
+        load = f"{min(self.loads):.1f}-{max(self.loads):.1f}"
+        cpu = statistics.median(self.cpu)
+        return f"| {name} | {med:.2f} | {lo:.2f} | {hi:.2f} | {cpu:.2f} | {len(vals)} | {load} |"
+
+
+def _wait_ready(cache: Path, timeout: float = 1800.0) -> float:
     t0 = time.perf_counter()
     while not any(cache.glob("kernels-*/ready")):
         if any(cache.glob("kernels-*/failed")) or time.perf_counter() - t0 > timeout:
@@ -48,28 +115,32 @@ def _wait_ready(cache: Path, timeout: float = 900.0) -> float:
     return time.perf_counter() - t0
 
 
-def evaluate_one(work: Path, cache: Path, kernels: str) -> float:
-    rows = work / "row.csv"
-    rows.write_text(ROW)
+def _run(cmd: list[str], cache: Path, kernels: str, cwd: Path) -> float:
     t0 = time.perf_counter()
-    subprocess.run(
-        [*_holofold(), "evaluate", "arch", str(rows), "-o", str(work / "out.csv")],
-        env=_env(cache, kernels), check=True, capture_output=True, cwd=work,
-    )  # fmt: skip
+    subprocess.run(cmd, env=_env(cache, kernels), check=True, capture_output=True, cwd=cwd)
     return time.perf_counter() - t0
 
 
-def demo(work: Path, cache: Path, kernels: str) -> tuple[float, float]:
-    """(seconds to the first simulated row, seconds to the end) of ``holofold demo``."""
-    out = work / "demo"
+def evaluate_one(work: Path, cache: Path, kernels: str) -> float:
+    work.mkdir(parents=True, exist_ok=True)
+    rows = work / "row.csv"
+    rows.write_text(ROW)
+    cmd = [*_holofold(), "evaluate", "arch", str(rows), "-o", str(work / "out.csv")]
+    return _run(cmd, cache, kernels, work)
+
+
+def demo(out: Path, cache: Path, kernels: str = "auto") -> tuple[float, float]:
+    """(seconds to the first simulated chunk, seconds to the end) of ``holofold demo -o out``
+    (the end twice where no new chunk appears: a resumed run)."""
+    before = set(out.glob("**/chunks/part-*.parquet"))
     t0 = time.perf_counter()
     proc = subprocess.Popen(
-        [*_holofold(), "demo", "-o", str(out)], env=_env(cache, kernels), cwd=work,
+        [*_holofold(), "demo", "-o", str(out)], env=_env(cache, kernels), cwd=out.parent,
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )  # fmt: skip
     first = None
     while proc.poll() is None:
-        if first is None and any(out.glob("**/chunks/part-*.parquet")):
+        if first is None and set(out.glob("**/chunks/part-*.parquet")) - before:
             first = time.perf_counter() - t0
         time.sleep(0.05)
     if proc.returncode:
@@ -78,43 +149,98 @@ def demo(work: Path, cache: Path, kernels: str) -> tuple[float, float]:
     return (end if first is None else first), end
 
 
+_IN_PROCESS = """
+import sys, time
+from holofold.cli import main
+args = sys.argv[1:]
+main(args[:-1] + [args[-1] + "-a"])
+t = time.perf_counter()
+main(args[:-1] + [args[-1] + "-b"])
+print(time.perf_counter() - t)
+"""
+
+
+def simulate_in_process(pattern: Path, work: Path, cache: Path) -> float:
+    """Seconds of ``holofold simulate`` inside a process that has run it once before."""
+    work.mkdir(parents=True, exist_ok=True)
+    out = subprocess.run(
+        [sys.executable, "-c", _IN_PROCESS, "simulate", str(pattern), "-o", str(work / "out")],
+        env=_env(cache), check=False, capture_output=True, text=True, cwd=work,
+    )  # fmt: skip
+    try:
+        return float(out.stdout.strip().splitlines()[-1])
+    except (ValueError, IndexError):
+        raise RuntimeError(f"in-process simulate failed: {out.stderr[-500:]}") from None
+
+
+def _table(cases: dict) -> None:
+    print("wall seconds, whole processes; CPU: the median CPU s of the process and the children")
+    print("it waited for (not the detached background compile); load: the 1-minute load average")
+    print("before the runs, min-max")
+    print("| case | median | min | max | CPU | runs | load |")
+    print("|---|---:|---:|---:|---:|---:|---|")
+    for name, c in cases.items():
+        if name.startswith("demo"):
+            print(c.line(name + ": first chunk", 0))
+            print(c.line(name + ": end", 1))
+        else:
+            print(c.line(name))
+    whole, inner = cases.get(SIM), cases.get(SIM_IN)
+    if whole and inner:
+        over = [w - i for w, i in zip(whole.runs, inner.runs, strict=True)]
+        print(f"| simulate start-up overhead (whole - in process, per repeat) | "
+              f"{statistics.median(over):.2f} | {min(over):.2f} | {max(over):.2f} | - | "
+              f"{len(over)} | {min(whole.loads):.1f}-{max(whole.loads):.1f} |")  # fmt: skip
+    sys.stdout.flush()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--demo", action="store_true", help="also time holofold demo")
+    ap.add_argument("--simulate", nargs="?", const=str(PATTERN), default=None,
+                    help="also time holofold simulate of a pattern (waterbomb)")  # fmt: skip
+    ap.add_argument("--no-evaluate", action="store_true", help="skip holofold evaluate")
     args = ap.parse_args()
-    print(f"load average at start: {os.getloadavg()[0]:.1f}; {os.cpu_count()} cores")
-    print(
-        "| case | evaluate arch, 1 row (s) |"
-        + (" demo: first chunk / end (s) |" if args.demo else "")
-    )
-    print("|---|---|" + ("---|" if args.demo else ""))
-    results: dict[str, list] = {}
-    for _ in range(args.repeat):
-        with tempfile.TemporaryDirectory() as tmp:
-            tmp = Path(tmp)
-            cache = tmp / "cache"
-            results.setdefault("cold (auto: numpy while compiling)", []).append(
-                evaluate_one(tmp, cache, "auto"))  # fmt: skip
-            compile_s = _wait_ready(cache)
-            results.setdefault("warm (compiled, cache ready)", []).append(
-                evaluate_one(tmp, cache, "auto"))  # fmt: skip
-            results.setdefault("numpy (never compiles)", []).append(
-                evaluate_one(tmp, cache, "numpy"))  # fmt: skip
-            results.setdefault("cold, compiled in the process (before)", []).append(
-                evaluate_one(tmp, tmp / "cache2", "compiled"))  # fmt: skip
-            results.setdefault("background compile, from the cold run (s)", []).append(compile_s)
+    print(f"load average at start: {os.getloadavg()}; {os.cpu_count()} cores; "
+          f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")  # fmt: skip
+    cases: dict[str, Case] = {}
+
+    def case(name: str) -> Case:
+        return cases.setdefault(name, Case())
+
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        ready = tmp / "ready-cache"  # one compiled cache for the warm cases
+        evaluate_one(tmp / "prime", ready, "auto")
+        compile_s = _wait_ready(ready)
+        if args.simulate:
+            pattern = Path(args.simulate).resolve()
+            sim = [*_holofold(), "simulate", str(pattern)]
+            _run([*sim, "-o", str(tmp / "sim-prime")], ready, "auto", tmp)
+        for r in range(args.repeat):
+            rep = tmp / f"r{r}"
+            rep.mkdir(parents=True)
+            if not args.no_evaluate:
+                cold, compiled = rep / "cache-cold", rep / "cache-compiled"
+                case(EVAL_COLD).add(evaluate_one, rep / "e1", cold, "auto")
+                case(COMPILE).add(_wait_ready, cold)
+                case(EVAL_WARM).add(evaluate_one, rep / "e2", cold, "auto")
+                case(EVAL_NUMPY).add(evaluate_one, rep / "e3", cold, "numpy")
+                case(EVAL_COMPILED).add(evaluate_one, rep / "e4", compiled, "compiled")
             if args.demo:
-                results.setdefault("demo cold", []).append(demo(tmp, tmp / "cache3", "auto"))
-                results.setdefault("demo warm", []).append(demo(tmp, tmp / "cache3", "auto"))
-    for case, vals in results.items():
-        if case.startswith("demo"):
-            first = statistics.median(v[0] for v in vals)
-            end = statistics.median(v[1] for v in vals)
-            print(f"| {case} | | {first:.1f} / {end:.1f} |")
-        else:
-            print(f"| {case} | {statistics.median(vals):.1f} (min {min(vals):.1f}) |"
-                  + (" |" if args.demo else ""))  # fmt: skip
+                case(DEMO_COLD).add(demo, rep / "demo-cold", rep / "cache-demo")
+                _wait_ready(rep / "cache-demo")  # its background compile ends before the next
+                case(DEMO_WARM).add(demo, rep / "demo-warm", ready)
+                case(DEMO_RESUMED).add(demo, rep / "demo-warm", ready)
+            if args.simulate:
+                case(HELP).add(_run, [*_holofold(), "--help"], ready, "auto", rep)
+                case(SIM).add(_run, [*sim, "-o", str(rep / "sim")], ready, "auto", rep)
+                case(SIM_IN).add(simulate_in_process, pattern, rep / "sim-in", ready)
+            print(f"\nafter {r + 1} of {args.repeat} repeats:", flush=True)
+            _table(cases)
+        print(f"(a first background compile took {compile_s:.1f} s wall)")
+    print(json.dumps({"load_average_end": os.getloadavg()}))
 
 
 if __name__ == "__main__":

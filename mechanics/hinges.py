@@ -21,6 +21,7 @@ stress free in the state it was built in (docs/bar-and-hinge.md §1.5).
 from __future__ import annotations
 
 import weakref
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -141,20 +142,48 @@ def _edge_ids(pattern: CreasePattern, a: np.ndarray, b: np.ndarray) -> np.ndarra
     return ids
 
 
+@dataclass(frozen=True, eq=False)
+class PatternTopology:
+    """Index arrays of a pattern's faces and edges, the record the builders work over.
+
+    Corners are the face loops concatenated (nc = sum of the face sizes), face by face. All
+    arrays are intp except ``interior`` (bool).
+
+    ``sizes`` (nf,) corners per face; ``verts`` (nc,) vertex of each corner; ``face`` (nc,) its
+    face; ``nxt``, ``prv`` (nc,) the next and previous corner of its face; ``side`` (nc,) the
+    edge joining corner q to the next corner; ``first``, ``last`` (ne,) the first and last face
+    visiting each edge (-1 where none); ``interior`` (ne,) edges with two faces;
+    ``edge_corners`` (ne, 2) the corners q whose side from the previous corner (``side[prv[q]]``)
+    is the edge, the earlier corner first (-1 where the edge has fewer).
+    """
+
+    sizes: np.ndarray
+    verts: np.ndarray
+    face: np.ndarray
+    nxt: np.ndarray
+    prv: np.ndarray
+    side: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
+    interior: np.ndarray
+    edge_corners: np.ndarray
+
+    @property
+    def n_corners(self) -> int:
+        return len(self.verts)
+
+
 _TOPOLOGY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _topology(pattern: CreasePattern) -> dict:
-    """Index arrays of a pattern's faces and edges (cached per pattern object).
-
-    ``side[q]`` is the edge joining corner q to the next corner of its face.
-    """
+def pattern_topology(pattern: CreasePattern) -> PatternTopology:
+    """The :class:`PatternTopology` of a pattern (cached per pattern object)."""
     topo = _TOPOLOGY.get(pattern)
     if topo is None:
         sizes, verts, start, face, nxt, prv = _flat_faces(pattern)
         side = _edge_ids(pattern, verts, verts[nxt])
         first, last, count = _edge_faces(pattern, side, face)
-        topo = dict(
+        topo = PatternTopology(
             sizes=sizes,
             verts=verts,
             face=face,
@@ -164,9 +193,23 @@ def _topology(pattern: CreasePattern) -> dict:
             first=first,
             last=last,
             interior=count == 2,
+            edge_corners=_edge_corners(side[prv], count),
         )
         _TOPOLOGY[pattern] = topo
     return topo
+
+
+def _edge_corners(side_in: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """(ne, 2): the first two corners q (ascending) with ``side_in[q]`` = the edge, -1 where
+    none."""
+    ne = len(count)
+    order = np.argsort(side_in, kind="stable")  # corners grouped by edge, ascending within
+    start = np.concatenate([[0], np.cumsum(count)[:-1]]).astype(np.intp)
+    out = np.full((ne, 2), -1, np.intp)
+    has1, has2 = count >= 1, count >= 2
+    out[has1, 0] = order[start[has1]]
+    out[has2, 1] = order[start[has2] + 1]
+    return out
 
 
 def _edge_faces(pattern, side_edge: np.ndarray, side_face: np.ndarray):
@@ -254,7 +297,7 @@ def build_concentrated(
     nu_panel = _scalar(nu_panel, "nu_panel", -1.0, 0.5, low_open=True, high_open=True)
     _scalar(nu_crease, "nu_crease", -1.0, 0.5, low_open=True, high_open=True)
     nv, ne, nf = pattern.n_vertices, pattern.n_edges, pattern.n_faces
-    interior = _topology(pattern)["interior"]
+    interior = pattern_topology(pattern).interior
     W = _per_item(crease_width, ne, "crease_width", interior)
     tc = _per_item(crease_thickness, ne, "crease_thickness", interior)
     tp = _per_item(panel_thickness, nf, "panel_thickness")
@@ -329,15 +372,97 @@ def _bincount(group: np.ndarray, weights: np.ndarray, n: int) -> np.ndarray:
     return np.bincount(ids, weights=weights.ravel(), minlength=S * n).reshape(S, n)
 
 
+@dataclass(frozen=True, eq=False)
+class ConcentratedLayout:
+    """The index arrays of :func:`build_concentrated`'s model of one pattern, the same for every
+    design of it (read-only, shared by the structures built from it). ``bars`` (nb, 2),
+    ``bar_type`` (nb,) int8, ``quads`` (ns, 4) springs before polarity, ``spring_role`` (ns,)
+    int8, ``spring_crease`` (ns,), ``triangles`` (nt, 3), ``tri_crease``, ``tri_panel`` (nt,),
+    ``crease_ids`` (nci,) interior edges, ``crease_nodes`` (nci, 2) their end vertices,
+    ``panel_centres`` (nf,), ``node_vertex`` (nn,)."""
+
+    bars: np.ndarray
+    bar_type: np.ndarray
+    quads: np.ndarray
+    spring_role: np.ndarray
+    spring_crease: np.ndarray
+    triangles: np.ndarray
+    tri_crease: np.ndarray
+    tri_panel: np.ndarray
+    crease_ids: np.ndarray
+    crease_nodes: np.ndarray
+    panel_centres: np.ndarray
+    node_vertex: np.ndarray
+
+
+_LAYOUT: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
+
+
+def concentrated_layout(pattern: CreasePattern) -> ConcentratedLayout:
+    """The :class:`ConcentratedLayout` of a pattern (cached per pattern object)."""
+    lay = _LAYOUT.get(pattern)
+    if lay is not None:
+        return lay
+    nv, nf = pattern.n_vertices, pattern.n_faces
+    t = pattern_topology(pattern)
+    verts, face, nxt, prv = t.verts, t.face, t.nxt, t.prv
+    cnode = nv + face  # centre node of each corner's panel
+    # bars: edges, then spokes
+    bars = np.vstack([pattern.edges.astype(np.intp), np.column_stack([verts, cnode])])
+    bar_type = np.concatenate(
+        [
+            np.full(pattern.n_edges, BarType.PANEL_EDGE, np.int8),
+            np.full(len(verts), BarType.PANEL_SPOKE, np.int8),
+        ]
+    )
+    # springs: hinges on interior edges, then panel springs on spokes
+    cid = np.flatnonzero(t.interior)
+    e = pattern.edges[cid].astype(np.intp)
+    hinge = np.column_stack([nv + t.first[cid], e[:, 0], e[:, 1], nv + t.last[cid]])
+    panel = np.column_stack([verts[nxt], verts, cnode, verts[prv]])
+    role = np.concatenate(
+        [
+            np.full(len(cid), SpringRole.HINGE, np.int8),
+            np.full(len(panel), SpringRole.PANEL, np.int8),
+        ]
+    )
+    # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1)
+    triangles = np.column_stack([cnode, verts, verts[prv]]).astype(np.intp)
+    fields = dict(
+        bars=bars.astype(np.intp),
+        bar_type=bar_type,
+        quads=np.vstack([hinge, panel]).astype(np.intp),
+        spring_role=role,
+        spring_crease=np.concatenate([cid, np.full(len(panel), -1)]).astype(np.intp),
+        triangles=triangles,
+        tri_crease=np.full(len(triangles), -1, np.intp),
+        tri_panel=face.astype(np.intp),
+        crease_ids=cid,
+        crease_nodes=e,
+        panel_centres=(nv + np.arange(nf)).astype(np.intp),
+        node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]).astype(np.intp),
+    )
+    lay = ConcentratedLayout(**{k: _frozen(v) for k, v in fields.items()})
+    _LAYOUT[pattern] = lay
+    return lay
+
+
 def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_width, profile, sups):
     """The structures of :func:`build_concentrated` for S designs: ``X`` (S, nv, 3), ``W``,
     ``tc`` (S, ne), ``tp`` (S, nf), ``E_panel``, ``E_crease`` (S,), ``panel_width`` None or
     (S, nf), ``sups`` S supports (or None); values checked by the callers."""
     S = X.shape[0]
-    nv, ne, nf = pattern.n_vertices, pattern.n_edges, pattern.n_faces
-    t = _topology(pattern)
-    sizes, verts, face, nxt, prv = t["sizes"], t["verts"], t["face"], t["nxt"], t["prv"]
-    side_edge, first, last, interior = t["side"], t["first"], t["last"], t["interior"]
+    ne, nf = pattern.n_edges, pattern.n_faces
+    t = pattern_topology(pattern)
+    lay = concentrated_layout(pattern)
+    sizes, verts, face, nxt = t.sizes, t.verts, t.face, t.nxt
+    side_edge, last, interior = t.side, t.last, t.interior
+    bars, cid = lay.bars, lay.crease_ids
 
     Xv = X[:, verts]
     centres = np.empty((S, nf, 3))
@@ -345,11 +470,7 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
         centres[:, :, c] = _bincount(face, Xv[:, :, c], nf)
     centres = centres / sizes[:, None]
     nodes = np.concatenate([X, centres], axis=1)
-    cnode = nv + face  # centre node of each corner's panel
 
-    # bars: edges, then spokes
-    spokes = np.column_stack([verts, cnode])
-    bars = np.vstack([pattern.edges.astype(np.intp), spokes])
     L = np.linalg.norm(nodes[:, bars[:, 1]] - nodes[:, bars[:, 0]], axis=-1)
     edge_len, spoke_len = L[:, :ne], L[:, ne:]
 
@@ -365,25 +486,9 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
         bar_area[:, :ne] = 2.0 * A_p[:, last]
     else:
         bar_area[:, :ne] = _bincount(side_edge, A_p[:, face], ne)
-    bar_type = np.concatenate(
-        [np.full(ne, BarType.PANEL_EDGE, np.int8), np.full(len(spokes), BarType.PANEL_SPOKE)]
-    )
 
-    # springs: hinges on interior edges, then panel springs on spokes
-    cid = np.flatnonzero(interior)
-    e = pattern.edges[cid]
-    hinge = np.column_stack([nv + first[cid], e[:, 0], e[:, 1], nv + last[cid]])
-    panel = np.column_stack([verts[nxt], verts, cnode, verts[prv]])
-    quads = np.vstack([hinge, panel]).astype(np.intp)
     k_hinge = E_crease[:, None] * tc[:, cid] ** 3 * edge_len[:, cid] / (12.0 * W[:, cid])
     k_panel = E_panel[:, None] * tp[:, face] ** 3 * spoke_len
-    role = np.concatenate(
-        [np.full(len(cid), SpringRole.HINGE, np.int8), np.full(len(panel), SpringRole.PANEL)]
-    )
-    crease_of = np.concatenate([cid, np.full(len(panel), -1)])
-
-    # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1)
-    triangles = np.column_stack([cnode, verts, verts[prv]]).astype(np.intp)
 
     # the checks Structure makes that a valid input can still fail (coordinates that overflow,
     # coincident nodes), once for the batch: the first design refused raises Structure's error
@@ -396,19 +501,16 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
         raise ValueError(f"bar {int(np.argmin(L[i]))} has zero rest length")
     nn = nodes.shape[1]
     # per design: spring polarity from its geometry and its rest angles, for all at once
-    springs_all = _orient_batch(nodes, quads, profile.polarity_z_only)
+    springs_all = _orient_batch(nodes, lay.quads, profile.polarity_z_only)
     rest_all = dihedral_angle(nodes, springs_all)
-    bars = bars.astype(np.intp)
-    crease_of = crease_of.astype(np.intp)
-    creases = CreaseModel(kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=e)
+    creases = CreaseModel(
+        kind=CONCENTRATED, ids=cid, springs=np.arange(len(cid))[:, None], nodes=lay.crease_nodes
+    )
     shared = dict(
-        bars=bars, bar_type=bar_type.astype(np.int8), spring_role=role.astype(np.int8),
-        spring_crease=crease_of,
-        triangles=triangles, tri_crease=np.full(len(triangles), -1, np.intp),
-        tri_panel=face.astype(np.intp), creases=creases,
-        panel_centres=(nv + np.arange(nf)).astype(np.intp),
-        node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]).astype(np.intp),
-        profile=profile,
+        bars=bars, bar_type=lay.bar_type, spring_role=lay.spring_role,
+        spring_crease=lay.spring_crease, triangles=lay.triangles, tri_crease=lay.tri_crease,
+        tri_panel=lay.tri_panel, creases=creases, panel_centres=lay.panel_centres,
+        node_vertex=lay.node_vertex, profile=profile,
     )  # fmt: skip
     out = []
     for i in range(S):
@@ -435,8 +537,52 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
 
 
 # --------------------------------------------------------------------------- compliant
-def _unit(v):
-    return v / np.linalg.norm(v)
+# crease bars 0..9 of a compliant crease: their types and the slots (bars) of its 6 springs
+_CREASE_BAR_TYPE = np.array([2, 3, 3, 2, 4, 4, 2, 3, 3, 2], np.int8)
+_CREASE_SPRING_BARS = np.array([1, 2, 4, 5, 7, 8], np.intp)
+_CREASE_SPRING_ROLE = np.array(
+    [
+        SpringRole.CREASE_DIAGONAL,
+        SpringRole.CREASE_DIAGONAL,
+        SpringRole.CREASE_CENTRE,
+        SpringRole.CREASE_CENTRE,
+        SpringRole.CREASE_DIAGONAL,
+        SpringRole.CREASE_DIAGONAL,
+    ],  # fmt: skip
+    np.int8,
+)
+
+
+def _shrunk_corners(X, t: PatternTopology, W, approximate: bool) -> np.ndarray:
+    """(nc, 3) the panel corners moved off their creases by half the crease width
+    (docs/bar-and-hinge.md §4.1): along the other side where one side is a crease, by the sum
+    of both offsets where both are; corners with collinear sides or no crease stay."""
+    verts, nxt, prv = t.verts, t.nxt, t.prv
+    e_prev = t.side[prv]  # C(j-1)-C(j)
+    e_next = e_prev[nxt]  # C(j)-C(j+1)
+    cp, cn = t.interior[e_prev], t.interior[e_next]
+    p = X[verts]
+    d1 = X[verts[nxt]] - p
+    d2 = X[verts[prv]] - p
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v1 = d1 / np.linalg.norm(d1, axis=1)[:, None]  # towards the next vertex
+        v2 = d2 / np.linalg.norm(d2, axis=1)[:, None]  # towards the previous vertex
+        sin_b = np.linalg.norm(_cross(v1, v2), axis=1)
+        Wp, Wn = W[e_prev][:, None], W[e_next][:, None]
+        both = 0.5 * Wn * v2 + 0.5 * Wp * v1
+        if not approximate:
+            both = both / sin_b[:, None]
+        off = np.where(
+            (cp & cn)[:, None],
+            both,
+            np.where(
+                cp[:, None], Wp / (2.0 * sin_b[:, None]) * v1, Wn / (2.0 * sin_b[:, None]) * v2
+            ),
+        )
+    moved = (cp | cn) & ~(sin_b <= 1e-12)
+    corner = p.copy()
+    corner[moved] = p[moved] + off[moved]
+    return corner
 
 
 def build_compliant(
@@ -499,10 +645,9 @@ def build_compliant(
     diagonal_rate = _scalar(diagonal_rate, "diagonal_rate", 0.0, None, low_open=True)
     split_factor = _scalar(split_factor, "split_factor", 0.0, 1.0)
     ne, nf = pattern.n_edges, pattern.n_faces
-    t = _topology(pattern)
-    sizes, verts, face, nxt, prv = t["sizes"], t["verts"], t["face"], t["nxt"], t["prv"]
-    side_edge = t["side"][prv]  # side j joins C(j-1)-C(j)
-    interior = t["interior"]
+    t = pattern_topology(pattern)
+    sizes, verts, face, nxt, prv = t.sizes, t.verts, t.face, t.nxt, t.prv
+    interior = t.interior
     W = _per_item(crease_width, ne, "crease_width", interior)
     tc = _per_item(crease_thickness, ne, "crease_thickness", interior)
     tp = _per_item(panel_thickness, nf, "panel_thickness")
@@ -510,81 +655,74 @@ def build_compliant(
 
     # A. shrunk panel copies (one node per corner, numbered like the corners)
     nc0 = len(verts)
-    corner = X[verts].copy()
-    for q in range(nc0):
-        e_prev = side_edge[q]  # C(j-1)-C(j)
-        e_next = side_edge[nxt[q]]  # C(j)-C(j+1)
-        cp, cn = interior[e_prev], interior[e_next]
-        if not (cp or cn):
-            continue
-        p = X[verts[q]]
-        v1 = _unit(X[verts[nxt[q]]] - p)  # towards the next vertex
-        v2 = _unit(X[verts[prv[q]]] - p)  # towards the previous vertex
-        sin_b = np.linalg.norm(np.cross(v1, v2))
-        if sin_b <= 1e-12:
-            continue  # collinear sides: not moved
-        if cp and cn:
-            W1, W2 = W[e_next], W[e_prev]
-            off = 0.5 * W1 * v2 + 0.5 * W2 * v1
-            if not profile.approximate_corner_offset:
-                off = off / sin_b
-        elif cp:  # crease on the previous side: slide along the next side
-            off = W[e_prev] / (2.0 * sin_b) * v1
-        else:
-            off = W[e_next] / (2.0 * sin_b) * v2
-        corner[q] = p + off
+    corner = _shrunk_corners(X, t, W, profile.approximate_corner_offset)
     # perimeter bars: bar q joins corner nodes prv[q] and q
     perim = np.sort(np.column_stack([prv, np.arange(nc0)]), axis=1)
 
-    # B. crease regions
+    # B. crease regions: 3 nodes, 10 bars, 6 triangles, 6 springs on bars per crease
     cid = np.flatnonzero(interior)
     nci = len(cid)
-    side_of = {}
-    for q in range(nc0):
-        side_of.setdefault(int(side_edge[q]), []).append(q)
-    new_nodes = []
-    crease_nodes = np.zeros((nci, 7), np.intp)
-    cbars, cbar_type, cbar_slot_spring = [], [], []
-    ctris = []
-    crease_edge_bars = np.zeros((nci, 2), np.intp)
-    for r, e in enumerate(cid):
-        b1, b2 = side_of[int(e)]  # earlier panel first (corners are in panel order)
-        n11, n12 = perim[b1]
-        n21, n22 = perim[b2]
-        if np.linalg.norm(corner[n11] - corner[n21]) > np.linalg.norm(corner[n11] - corner[n22]):
-            n21, n22 = n22, n21
-        p1 = 0.5 * (corner[n11] + corner[n21])
-        p2 = 0.5 * (corner[n12] + corner[n22])
-        c = 0.25 * (corner[n11] + corner[n12] + corner[n21] + corner[n22])
-        base = nc0 + 3 * r
-        ip1, ip2, ic = base, base + 1, base + 2
-        new_nodes += [p1, p2, c]
-        crease_nodes[r] = [n11, n12, n21, n22, ip1, ip2, ic]
-        crease_edge_bars[r] = [b1, b2]
-        rows = [
-            (2, (n11, ip1), None),
-            (3, (n11, ic), (n12, ic, n11, ip1)),
-            (3, (n12, ic), (ip2, ic, n12, n11)),
-            (2, (n12, ip2), None),
-            (4, (ip1, ic), (n11, ic, ip1, n21)),
-            (4, (ip2, ic), (n12, ip2, ic, n22)),
-            (2, (n21, ip1), None),
-            (3, (n21, ic), (ip1, ic, n21, n22)),
-            (3, (n22, ic), (ip2, n22, ic, n21)),
-            (2, (n22, ip2), None),
-        ]
-        for t, bar, spr in rows:
-            cbars.append(sorted(bar))
-            cbar_type.append(t)
-            cbar_slot_spring.append(spr)
-        ctris += [
-            (ic, ip1, n11),
-            (n21, ip1, ic),
-            (n21, ic, n22),
-            (n22, ip2, ic),
-            (n12, ic, ip2),
-            (n12, ic, n11),
-        ]
+    b1, b2 = t.edge_corners[cid].T  # earlier panel first (corners are in panel order)
+    n11, n12 = perim[b1].T
+    n21, n22 = perim[b2].T
+    swap = np.linalg.norm(corner[n11] - corner[n21], axis=1) > np.linalg.norm(
+        corner[n11] - corner[n22], axis=1
+    )
+    n21, n22 = np.where(swap, n22, n21), np.where(swap, n21, n22)
+    p1 = 0.5 * (corner[n11] + corner[n21])
+    p2 = 0.5 * (corner[n12] + corner[n22])
+    c = 0.25 * (corner[n11] + corner[n12] + corner[n21] + corner[n22])
+    ip1 = nc0 + 3 * np.arange(nci, dtype=np.intp)
+    ip2, ic = ip1 + 1, ip1 + 2
+    new_nodes = np.stack([p1, p2, c], axis=1).reshape(-1, 3)
+    crease_nodes = np.column_stack([n11, n12, n21, n22, ip1, ip2, ic]).astype(np.intp)
+    crease_edge_bars = np.column_stack([b1, b2]).astype(np.intp)
+    cbars = np.sort(
+        np.stack(
+            [
+                (n11, ip1),
+                (n11, ic),
+                (n12, ic),
+                (n12, ip2),
+                (ip1, ic),
+                (ip2, ic),
+                (n21, ip1),
+                (n21, ic),
+                (n22, ic),
+                (n22, ip2),
+            ],  # fmt: skip
+            axis=-1,
+        ).transpose(1, 2, 0),  # (nci, 10, 2)
+        axis=-1,
+    ).reshape(-1, 2)
+    cbar_type = np.tile(_CREASE_BAR_TYPE, nci)
+    # the springs on crease bars 1, 2, 4, 5, 7, 8 of each crease (the reference's slots)
+    slot_quads = np.stack(
+        [
+            (n12, ic, n11, ip1),
+            (ip2, ic, n12, n11),
+            (n11, ic, ip1, n21),
+            (n12, ip2, ic, n22),
+            (ip1, ic, n21, n22),
+            (ip2, n22, ic, n21),
+        ],  # fmt: skip
+        axis=-1,
+    ).transpose(1, 2, 0)  # (nci, 6, 4)
+    ctris = (
+        np.stack(
+            [
+                (ic, ip1, n11),
+                (n21, ip1, ic),
+                (n21, ic, n22),
+                (n22, ip2, ic),
+                (n12, ic, ip2),
+                (n12, ic, n11),
+            ],  # fmt: skip
+            axis=-1,
+        )
+        .transpose(1, 2, 0)
+        .reshape(-1, 3)
+    )
     n_cnodes = nc0 + 3 * nci
 
     # C. panel fans (centres of the shrunk panels)
@@ -592,9 +730,9 @@ def build_compliant(
     np.add.at(centres, face, corner)
     centres /= sizes[:, None]
     cnode = n_cnodes + face
-    nodes = np.vstack([corner, np.array(new_nodes).reshape(-1, 3), centres])
+    nodes = np.vstack([corner, new_nodes, centres])
     spokes = np.column_stack([np.arange(nc0), cnode])
-    bars = np.vstack([perim, np.array(cbars, np.intp).reshape(-1, 2), spokes])
+    bars = np.vstack([perim, cbars, spokes]).astype(np.intp)
     L = np.linalg.norm(nodes[bars[:, 1]] - nodes[bars[:, 0]], axis=1)
     nb = len(bars)
     b_crease0 = nc0
@@ -602,38 +740,31 @@ def build_compliant(
     bar_type = np.concatenate(
         [
             np.full(nc0, BarType.PANEL_EDGE, np.int8),
-            np.array(cbar_type, np.int8),
+            cbar_type,
             np.full(nc0, BarType.PANEL_SPOKE, np.int8),
         ]
     )
 
     # springs by slot (bar id)
+    cb = b_crease0 + 10 * np.arange(nci)
     slot_spr = np.full((nb, 4), -1, np.intp)
-    for r in range(nci):
-        n11, n12, n21, n22, ip1, ip2, ic = crease_nodes[r]
-        b1, b2 = crease_edge_bars[r]
-        slot_spr[b1] = (ic, n11, n12, cnode[b1])
-        slot_spr[b2] = (ic, n22, n21, cnode[b2])
-        for t in range(10):
-            s = cbar_slot_spring[10 * r + t]
-            if s is not None:
-                slot_spr[b_crease0 + 10 * r + t] = s
+    slot_spr[b1] = np.column_stack([ic, n11, n12, cnode[b1]])
+    slot_spr[b2] = np.column_stack([ic, n22, n21, cnode[b2]])
+    slot_spr[(cb[:, None] + _CREASE_SPRING_BARS).ravel()] = slot_quads.reshape(-1, 4)
     slot_spr[b_spoke0:] = np.column_stack([prv, np.arange(nc0), cnode, nxt])
     slots = np.flatnonzero(slot_spr[:, 0] >= 0)
     slot_to_spring = np.full(nb, -1, np.intp)
     slot_to_spring[slots] = np.arange(len(slots))
     crease_springs = np.zeros((nci, 8), np.intp)
-    crease_springs[:, 0] = slot_to_spring[crease_edge_bars[:, 0]]
-    crease_springs[:, 1] = slot_to_spring[crease_edge_bars[:, 1]]
-    for col, t in zip(range(2, 8), (1, 2, 4, 5, 7, 8), strict=True):
-        crease_springs[:, col] = slot_to_spring[b_crease0 + 10 * np.arange(nci) + t]
+    crease_springs[:, :2] = slot_to_spring[crease_edge_bars]
+    crease_springs[:, 2:] = slot_to_spring[cb[:, None] + _CREASE_SPRING_BARS]
     orient = np.ones(len(slots), bool)
     if profile.raw_crease_polarity:  # the reference's raw crease springs (compat)
         orient[crease_springs.ravel()] = False
     springs = orient_springs(nodes, slot_spr[slots], z_only=profile.polarity_z_only, where=orient)
 
     # stiffness and areas
-    ell = L[crease_edge_bars[:, 0]] if nci else np.zeros(0)
+    ell = L[crease_edge_bars[:, 0]]
     Wc, tcc = W[cid], tc[cid]
     k1 = E_crease * tcc**3 / (4.0 * Wc)
     spring_k = np.zeros(len(slots))
@@ -641,18 +772,9 @@ def build_compliant(
     crease_of = np.full(len(slots), -1, np.intp)
     spring_k[crease_springs[:, :2]] = (k1[:, None] * L[crease_edge_bars]).reshape(nci, 2)
     role[crease_springs[:, :2]] = SpringRole.CREASE_EDGE
-    cb = b_crease0 + 10 * np.arange(nci)
-    for col, t, rl in (
-        (2, 1, SpringRole.CREASE_DIAGONAL),
-        (3, 2, SpringRole.CREASE_DIAGONAL),
-        (4, 4, SpringRole.CREASE_CENTRE),
-        (5, 5, SpringRole.CREASE_CENTRE),
-        (6, 7, SpringRole.CREASE_DIAGONAL),
-        (7, 8, SpringRole.CREASE_DIAGONAL),
-    ):
-        rate = diagonal_rate if rl == SpringRole.CREASE_DIAGONAL else 1.0
-        spring_k[crease_springs[:, col]] = rate * k1 * L[cb + t]
-        role[crease_springs[:, col]] = rl
+    rate = np.where(_CREASE_SPRING_ROLE == SpringRole.CREASE_DIAGONAL, diagonal_rate, 1.0)
+    spring_k[crease_springs[:, 2:]] = rate * k1[:, None] * L[cb[:, None] + _CREASE_SPRING_BARS]
+    role[crease_springs[:, 2:]] = _CREASE_SPRING_ROLE
     crease_of[crease_springs.ravel()] = np.repeat(cid, 8)
     spk_slots = slots >= b_spoke0
     spoke_len = L[b_spoke0:]
@@ -670,13 +792,12 @@ def build_compliant(
     bar_area[b_spoke0:] = A_p[face]
     A1 = ell * tcc / (2.0 * (1.0 - nu_crease**2))
     A2 = (ell**2 + Wc**2) ** 1.5 * tcc / (4.0 * (1.0 + nu_crease) * ell * Wc)
-    for t in range(10):
-        bar_area[cb + t] = A1 if cbar_type[t] == 2 else A2
+    bar_area[b_crease0:b_spoke0] = np.where(
+        _CREASE_BAR_TYPE == BarType.CREASE_ACROSS, A1[:, None], A2[:, None]
+    ).ravel()
     bar_E = np.where(np.isin(bar_type, (1, 5)), E_panel, E_crease)
 
-    triangles = np.vstack(
-        [np.array(ctris, np.intp).reshape(-1, 3), np.column_stack([cnode, np.arange(nc0), nxt])]
-    )
+    triangles = np.vstack([ctris, np.column_stack([cnode, np.arange(nc0), nxt])]).astype(np.intp)
     nct = 6 * nci
     node_vertex = np.concatenate([verts, np.full(3 * nci, -1), np.full(nf, -2)])
     return Structure(

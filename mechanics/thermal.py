@@ -24,6 +24,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 import scipy.linalg as sla
@@ -64,6 +65,28 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 _DENSE_MAX = 1500  # use dense Cholesky up to this many unknowns
+
+
+class CompiledPieces(NamedTuple):
+    """The fixed arguments of ``_compiled.thermal_system`` in its order (a named tuple: the
+    kernel takes it spread). Per triangle (nt,): ``Lab``, ``Lac`` rest side lengths (m),
+    ``half_ab_ac`` 0.5 Lab Lac (m^2), ``k_th`` conductivity x thickness (W/K), ``side`` the
+    air-link perimeter term (nt, L); ``slots`` (9 nt,) dense positions of the element matrices;
+    ``k_env`` air conductivity (W/(m K)), ``layers`` air layers, ``h`` air thickness (m, (nt,)
+    or scalar); ``ptr``, ``idx``, ``data`` the node-triangle incidence (CSR)."""
+
+    Lab: np.ndarray
+    Lac: np.ndarray
+    half_ab_ac: np.ndarray
+    k_th: np.ndarray
+    slots: np.ndarray
+    side: np.ndarray
+    k_env: float
+    layers: float
+    h: np.ndarray
+    ptr: np.ndarray
+    idx: np.ndarray
+    data: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -160,16 +183,24 @@ class ThermalModel:
         )  # fmt: skip
 
     @cached_property
-    def compiled_pieces(self) -> tuple:
+    def compiled_pieces(self) -> CompiledPieces:
         """The fixed arguments of ``_compiled.thermal_system`` (reference geometry)."""
         _, _, Lac, half_ab_ac, _, side = self.reference_pieces
         inc = self.node_incidence
-        return (
-            np.ascontiguousarray(self.rest_edges[:, 0]), np.ascontiguousarray(Lac[:, 0]),
-            half_ab_ac, self.conductivity * self.thickness, self.dense_slots,
-            np.ascontiguousarray(side), float(self.env_conductivity), float(self.env_layers),
-            self.air_thickness, inc.indptr, inc.indices, inc.data,
-        )  # fmt: skip
+        return CompiledPieces(
+            Lab=np.ascontiguousarray(self.rest_edges[:, 0]),
+            Lac=np.ascontiguousarray(Lac[:, 0]),
+            half_ab_ac=half_ab_ac,
+            k_th=self.conductivity * self.thickness,
+            slots=self.dense_slots,
+            side=np.ascontiguousarray(side),
+            k_env=float(self.env_conductivity),
+            layers=float(self.env_layers),
+            h=self.air_thickness,
+            ptr=inc.indptr,
+            idx=inc.indices,
+            data=inc.data,
+        )
 
     @cached_property
     def dense_slots(self) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -29,6 +30,16 @@ def test_unknown_subcommand_exits_nonzero():
     )
     assert proc.returncode == 2
     assert "invalid choice" in proc.stderr
+
+
+def test_demo_time_is_the_same_in_readme_and_help():
+    """One demo time: README.md gives the figure ``holofold --help`` gives (issue 37)."""
+    from holofold.cli import demo
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    assert f"In {demo.DEMO_TIME} (" in " ".join(readme.split())
+    for lazy in (True, False):  # ``holofold --help`` reads the help line from the source
+        assert demo.DEMO_TIME in " ".join(build_parser(lazy=lazy).format_help().split())
 
 
 def test_demo_default_target_is_the_library_one():
