@@ -47,12 +47,29 @@ def parse_bed(text: str | Bed | tuple) -> Bed:
 @dataclass(frozen=True)
 class PrintablePart:
     """The part a design prints: its crease pattern with the flat layout, and the panel
-    thickness, hinge (crease) thickness and hinge width it is printed with, m."""
+    thickness, hinge (crease) thickness and hinge width it is printed with, m; ``thick`` the
+    thickness technique of its panels (:data:`holofold.geometry.TECHNIQUES`) and ``path`` the
+    fold states their bevels are cut for."""
 
     pattern: object
     panel_thickness: float
     crease_thickness: float
     crease_width: float
+    thick: str = "centred"
+    path: tuple = ()
+
+    def panels(self):
+        """The :class:`~holofold.geometry.ThickPanels` of ``thick`` (None: centred), bevelled
+        for the fold ``path`` (states of the pattern; a Miura sheet's own path by default)."""
+        if self.thick == "centred":
+            return None
+        from holofold.geometry.thick import miura_path, thick_panels
+
+        path = self.path
+        if not path and self.pattern.meta.get("kind") == "miura":
+            path = tuple(miura_path(self.pattern, 10))
+        return thick_panels(self.pattern, self.panel_thickness, self.crease_width, self.thick,
+                            path=path)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -147,6 +164,26 @@ class PartFit:
             f"(its length and width features). {scale}"
         )
 
+    def line(self) -> str:
+        """One line for the command line: file, extent, bed fit, pieces, print time."""
+        from holofold.geometry.bed import print_time_text
+
+        if self.film:
+            return f"{self.file}: {self.extent_text()}, a film: cut it, do not print it"
+        if self.fits:
+            verdict = f"fits the {self.bed_text} bed whole (1 piece)"
+        elif self.pieces:
+            verdict = (
+                f"does not fit the {self.bed_text} bed whole: cut into {self.pieces} pieces "
+                f"that each fit ({self.segments}/, assembly.svg)"
+            )
+        else:
+            verdict = f"does not fit the {self.bed_text} bed and is not cut ({self.problem})"
+        return (
+            f"{self.file}: {self.extent_text()}, {verdict}; print time "
+            f"{print_time_text(self.hours)}"
+        )
+
     def to_json(self) -> dict:
         return {
             "file": self.file,
@@ -158,12 +195,18 @@ class PartFit:
             "fits": self.fits,
             "turn_deg": self.turn,
             "print_hours": self.hours,
+            "print_time": "not printed: a film" if self.film else self._time_text(),
             "print_class": "not printed: a film" if self.film else self.time_class,
             "pieces": self.pieces,
             "segments": self.segments,
             "problem": self.problem,
             "advice": self.advice,
         }
+
+    def _time_text(self) -> str:
+        from holofold.geometry.bed import print_time_text
+
+        return print_time_text(self.hours)
 
     @classmethod
     def from_json(cls, d) -> PartFit:
@@ -214,7 +257,7 @@ def part_fit(
 
         try:
             seg = segment_part(part.pattern, part.panel_thickness, part.crease_thickness,
-                               part.crease_width, bed)  # fmt: skip
+                               part.crease_width, bed, panels=part.panels())  # fmt: skip
         except DegenerateGeometryError as exc:  # a cut the geometry could not make
             seg = None
             problem = f"cutting it into bed-sized pieces failed: {exc}"
@@ -226,7 +269,7 @@ def part_fit(
         elif seg is not None:
             problem = seg.problem
     elif not fit.fits:
-        problem = "the part cannot be cut into pieces here"
+        problem = "this kind of part has no flat layout to cut into pieces"
     return PartFit(rel.replace(os.sep, "/"), tuple(float(v) for v in fit.extent),
                    float(fit.volume), (bed.width, bed.depth), turn, float(fit.print_hours),
                    fit.time_class, pieces, folder.replace(os.sep, "/"), problem)  # fmt: skip

@@ -337,13 +337,13 @@ def _fabrication(summary: DesignSummary) -> str:
             f"<code>{_esc(f.segments)}/segment_01.stl</code> ... "
             f"<code>segment_{f.pieces:02d}.stl</code>, each placed on the bed.</p>"
         )
-    from holofold.geometry.bed import INFILL, PRINT_RATE, SOLID_SKIN
+    from holofold.geometry.bed import INFILL, PRINT_RATE, SOLID_SKIN, print_time_text
 
     return (
         '<div class="card" id="part"><h3>The part to print</h3>'
         f'<p><a href="{href}">{_esc(f.file)}</a>: <b>{_esc(f.extent_text())}</b>; {verdict}.</p>'
         f"<p>{_esc(f.advice)}</p>{pieces}"
-        f"<p>Print time: <b>{_esc(f.time_class)}</b> (about {f.hours:.2g}&nbsp;h: the volume "
+        f"<p>Print time: <b>{_esc(print_time_text(f.hours))}</b> ({_esc(f.time_class)}: the volume "
         f"a slicer deposits, solid to {SOLID_SKIN * 1e3:g}&nbsp;mm and {INFILL:.0%} infill "
         f"above, at {PRINT_RATE * 1e9:g}&nbsp;mm<sup>3</sup>/s, calibrated with PrusaSlicer; "
         "the slicer gives the real time)."

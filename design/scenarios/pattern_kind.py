@@ -35,9 +35,11 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
+    crease_view,
     describe_material_and_loads,
     loaded_columns,
     read_supports_and_loads,
+    row_part,
     row_status,
     write_row_files,
 )
@@ -156,17 +158,39 @@ def evaluate_pattern(setting: PatternScenarioSetting, columns: Sequence[str], ro
     return {**{c: out[c] for c in columns}, "status": row_status(sim.status)}
 
 
-def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
-    """The design's pattern folded as far as its fold got (flat layout kept), m."""
+def _fold(setting: PatternScenarioSetting, row):
     from holofold.mechanics.folding import fold_pattern
 
     s = _setting_for(setting, row)
-    fold = fold_pattern(
+    return fold_pattern(
         _pattern(setting, row), s.fold, panel_thickness=s.panel_thickness,
         crease_thickness=s.crease_thickness, crease_width=s.crease_width, E=s.material.E,
         nu=s.material.nu, model=s.model,
     )  # fmt: skip
-    return fold.folded()
+
+
+def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
+    """The design's pattern folded as far as its fold got (flat layout kept), m."""
+    return _fold(setting, row).folded()
+
+
+def pattern_part(setting: PatternScenarioSetting, row):
+    """The printable part: the pattern's flat layout at the row's scale, with the row's
+    thicknesses and hinge width (:func:`~holofold.design.scenarios.pattern_loads.row_part`)."""
+    return row_part(_pattern(setting, row), row)
+
+
+def pattern_view(setting: PatternScenarioSetting, row):
+    """The 3D view: flat, up to four states of the fold path, the vertex sets held and the
+    loads (:func:`~holofold.design.scenarios.pattern_loads.crease_view`)."""
+    fold = _fold(setting, row)
+    k = len(fold.coords)
+    pick = np.unique(np.linspace(0, k - 1, min(k, 4)).round().astype(int))
+    pick = pick[fold.fractions[pick] > 0] if k > 1 else pick
+    labels = tuple(f"fold {fold.fractions[i]:.0%}" for i in pick)
+    bending = f"{fold.verdict}: {fold.note}" if fold.note else fold.verdict
+    return crease_view(fold.pattern, fold.coords[pick], labels, setting.supports, setting.loads,
+                       facts=(("fold", bending),))  # fmt: skip
 
 
 def write_pattern_files(
@@ -212,6 +236,8 @@ def pattern_scenario(
         source=source,
         shape=partial(pattern_shape, setting),
         write_files=partial(write_pattern_files, setting),
+        view=partial(pattern_view, setting),
+        part=partial(pattern_part, setting),
         row_timeout=PATTERN_ROW_TIMEOUT,
     )
 

@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
+
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -32,6 +34,9 @@ __all__ = [
     "loaded_columns",
     "row_status",
     "write_row_files",
+    "row_part",
+    "crease_view",
+    "surface_lines",
 ]
 
 _LOAD_KEYS = ("name", "at", "direction", "force", "increments")
@@ -148,3 +153,81 @@ def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cut
         warnings.warn(f"{what}: {exc}", stacklevel=3)
         got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
         return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
+
+
+def row_part(pattern: CreasePattern, row):
+    """The printable part of a design whose crease pattern is ``pattern`` (its flat layout;
+    a pattern read flat is its own layout), printed with the row's ``tpanel``, ``tcrease`` and
+    ``W`` (:class:`~holofold.design.buildability.PrintablePart`); None without a flat layout."""
+    from dataclasses import replace
+
+    from holofold.design.buildability import PrintablePart
+
+    if pattern.flat is None:
+        z = pattern.coords[:, 2]
+        if float(np.ptp(z)) > 1e-9 * max(float(np.ptp(pattern.coords, axis=0).max()), 1e-12):
+            return None
+        pattern = replace(pattern, flat=pattern.coords[:, :2].copy())
+    return PrintablePart(pattern, float(row["tpanel"]), float(row["tcrease"]), float(row["W"]))
+
+
+def _flat_frame(pattern: CreasePattern) -> np.ndarray:
+    if pattern.flat is not None:
+        return np.column_stack([pattern.flat, np.zeros(pattern.n_vertices)])
+    return np.asarray(pattern.coords, float)
+
+
+def crease_view(
+    pattern: CreasePattern,
+    states: np.ndarray,
+    labels: tuple[str, ...],
+    supports: tuple[str, ...],
+    loads: tuple[PatternLoad, ...],
+    *,
+    curve: np.ndarray | None = None,
+    curve_name: str = "target curve",
+    facts: tuple[tuple[str, str], ...] = (),
+):
+    """The 3D view (:class:`~holofold.design.view.DesignView`) of a crease-pattern design:
+    the flat layout, then ``states`` (k, nv, 3) m with their ``labels``; the vertex sets held
+    and the loads (one arrow per loaded vertex) selected on ``pattern``; ``curve`` (P, 3) m the
+    target drawn over every state."""
+    from holofold.design.view import DesignView, Load
+
+    frames = np.concatenate([_flat_frame(pattern)[None], np.asarray(states, float)])
+    held = (
+        np.unique(np.concatenate([parse_vertex_set(a).select(pattern) for a in supports]))
+        if supports
+        else np.zeros(0, int)
+    )
+    arrows = tuple(
+        Load(int(v), tuple(float(x) for x in ld.direction), f"{ld.name}: {ld.force:g} N shared")
+        for ld in loads
+        for v in ld.at.select(pattern)
+    )
+    return DesignView(
+        frames=frames, labels=("flat", *labels), faces=[list(f) for f in pattern.faces],
+        edges=pattern.edges, kinds="".join(str(a)[0] for a in pattern.assignment),
+        supports=held, loads=arrows, curve=curve, curve_name=curve_name, facts=facts,
+    )  # fmt: skip
+
+
+def surface_lines(chart, domain, lines: int = 9, samples: int = 25) -> np.ndarray:
+    """One polyline (P, 3) m over a charted surface: ``lines`` u-lines then ``lines`` v-lines
+    of the ``domain`` (u0, u1, v0, v1), run back and forth so that the pen never lifts
+    (the viewer draws a target as one line). ``chart(u, v)`` -> (points, normals)."""
+    u0, u1, v0, v1 = domain
+    us, vs = np.linspace(u0, u1, lines), np.linspace(v0, v1, lines)
+    ts_u, ts_v = np.linspace(v0, v1, samples), np.linspace(u0, u1, samples)
+    uu, vv = [], []
+    for k, u in enumerate(us):
+        t = ts_u if k % 2 == 0 else ts_u[::-1]
+        uu.append(np.full(samples, u))
+        vv.append(t)
+    for k, v in enumerate(vs[::-1] if lines % 2 else vs):
+        t = ts_v[::-1] if lines % 2 else ts_v
+        t = t if k % 2 == 0 else t[::-1]
+        uu.append(t)
+        vv.append(np.full(samples, v))
+    pts, _ = chart(np.concatenate(uu), np.concatenate(vv))
+    return np.asarray(pts, float)
