@@ -391,7 +391,7 @@ def run_design(
     cutter=None,
     objective: str | Objective | None = None,
     allow_overlap: bool = False,
-    bed: str | Bed | tuple = DEFAULT_BED,
+    bed: str | Bed | tuple | None = None,
     pilot: int = PILOT,
     say: Callable[[str], None] = lambda text: None,
 ) -> DesignOutcome:
@@ -454,7 +454,8 @@ def run_design(
     allow_overlap : bool
         Let a design whose thick panels overlap be chosen (never by default).
     bed : "WxD" in mm, Bed or (x, y) in m
-        The printer's bed the part's fit is judged on (default 250 x 210 mm).
+        The printer's bed the part's fit is judged on (None: the scenario's ``bed``, else
+        250 x 210 mm).
     pilot : int
         Designs simulated first (0: no pilot); the run stops after them, with the columns'
         distributions, when none meets the target and a condition is met by none.
@@ -464,7 +465,7 @@ def run_design(
     sc = load_scenario(scenario)
     tgt = parse_target(target, sc.performance_names)
     obj = parse_objective(objective, [*sc.performance_names, *sc.feature_names])
-    bed = parse_bed(bed)
+    bed = parse_bed(bed if bed is not None else (sc.bed or DEFAULT_BED))
     for name, v, low in (
         ("samples", samples, 20),
         ("rounds", 0 if rounds is None else rounds, 0),
@@ -645,6 +646,8 @@ def run_design(
         write_report_page(out, summary)
     _check_own_summary(out, summary.to_json())
     _say_chosen(say, summary, tgt, out, sc.columns)
+    if summary.fabrication is not None:
+        say(f"part: {summary.fabrication.line()}")
     return DesignOutcome(summary, everything, out)
 
 

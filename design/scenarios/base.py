@@ -230,6 +230,9 @@ class Scenario:
         The runner's default time limit per row, seconds (a row past it is recorded as
         ``failed: timeout ...``; see :mod:`~holofold.design.row_limits`); None: the default of
         the scenario's ``kind`` (:data:`ROW_TIMEOUTS`).
+    bed : str
+        The printer's bed of the scenario file's ``bed`` key ("250x210", mm; ``--bed`` wins),
+        or ``""`` (the default bed).
     """
 
     name: str
@@ -249,6 +252,7 @@ class Scenario:
     evaluate_batch: Callable[[list], list] | None = None
     batch_key: Callable[[Mapping[str, float]], object] | None = None
     row_timeout: float | None = None
+    bed: str = ""
 
     def __post_init__(self):
         if self.row_timeout is None:

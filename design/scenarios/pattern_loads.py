@@ -135,7 +135,8 @@ def row_status(status: Status) -> Status:
 
 
 def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cutter=None,
-                    thick=None, fallback=ValueError, what: str = "no solids"):  # fmt: skip
+                    thick=None, fallback=ValueError, what: str = "no solids",
+                    path=None):  # fmt: skip
     """The fabrication set (:func:`~holofold.geometry.write_fabrication_set`) of a design's
     folded ``shape`` with the row's ``tpanel``, ``tcrease`` and ``W`` (m); where the solids
     cannot be made (``fallback``, raised by the writer), every file but the solids with a note
@@ -144,6 +145,8 @@ def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cut
 
     W = float(row["W"])
     extra = {} if thick is None else {"thick": thick}
+    if path is not None:
+        extra["path"] = path
     try:
         return write_fabrication_set(
             shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
