@@ -116,6 +116,26 @@ def choose_thickness(
     return ThicknessChoice("centred", centred.overlap, centred.clearance, tuple(tried))
 
 
+def _mm(v: float) -> str:
+    """A length (m) in mm as the report writes it: whole mm from 100 mm, else 3 digits."""
+    from holofold.design.scenarios import format_value
+
+    mm = 1e3 * v
+    return f"{mm:.0f}" if mm >= 100 else format_value(mm, digits=3)
+
+
+def parse_bed(text: str | Bed | tuple) -> Bed:
+    """``"250x210"`` (mm, as ``--bed`` takes it) or a :class:`Bed` or (x, y) in m."""
+    if isinstance(text, Bed):
+        return text
+    if isinstance(text, tuple):
+        return Bed(*map(float, text))
+    try:
+        return Bed.parse(str(text))
+    except ValueError as exc:
+        raise ValueError(f"--bed {text!r}: {exc}") from None
+
+
 @dataclass(frozen=True)
 class PrintablePart:
     """The part a design prints: its crease pattern with the flat layout, and the panel
