@@ -35,12 +35,15 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
+    THICK_COLUMN,
     crease_view,
     describe_material_and_loads,
+    fold_way,
     loaded_columns,
     read_supports_and_loads,
     row_part,
     row_status,
+    row_thickness,
     write_row_files,
 )
 from holofold.design.simulate import (
@@ -123,6 +126,7 @@ def pattern_columns(setting: PatternScenarioSetting) -> tuple[Column, ...]:
         Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
         Column("overlap", "m^3", "intersection volume of the folded thick panels"),
         Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
+        THICK_COLUMN,
         Column("reached", "-", "fold fraction reached"),
     ]
     return tuple(cols)
@@ -177,7 +181,17 @@ def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
 def pattern_part(setting: PatternScenarioSetting, row):
     """The printable part: the pattern's flat layout at the row's scale, with the row's
     thicknesses and hinge width (:func:`~holofold.design.scenarios.pattern_loads.row_part`)."""
-    return row_part(_pattern(setting, row), row)
+    from dataclasses import replace
+
+    part = row_part(_pattern(setting, row), row)
+    if part is None:
+        return None
+    fold = _fold(setting, row)
+    shape, way = fold.folded(), fold_way(fold)
+    got = row_thickness(shape, row, way)
+    if got is None or got.technique == "centred" or shape.flat is None:
+        return part
+    return replace(part, pattern=shape, thick=got.technique, path=tuple(way))
 
 
 def pattern_view(setting: PatternScenarioSetting, row):
@@ -200,7 +214,12 @@ def write_pattern_files(
     pattern folded as far as its fold got: printable part, FOLD, SVG and DXF for ``cutter``,
     STL/OBJ and the thick solid; without the solids (a note says why) where the panels do not
     allow them."""
-    return write_row_files(pattern_shape(setting, row), folder, row, units=units, cutter=cutter)
+    fold = _fold(setting, row)
+    shape, way = fold.folded(), fold_way(fold)
+    got = row_thickness(shape, row, way)
+    thick = None if got is None else got.technique
+    return write_row_files(shape, folder, row, units=units, cutter=cutter, thick=thick,
+                           path=None if got is None else [*way, shape])  # fmt: skip
 
 
 def pattern_scenario(

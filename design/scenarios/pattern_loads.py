@@ -15,6 +15,8 @@ import warnings
 
 import numpy as np
 
+from holofold.design.buildability import THICK_CODES
+from holofold.design.scenarios.base import Column
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -37,6 +39,9 @@ __all__ = [
     "row_part",
     "crease_view",
     "surface_lines",
+    "THICK_COLUMN",
+    "row_thickness",
+    "fold_way",
 ]
 
 _LOAD_KEYS = ("name", "at", "direction", "force", "increments")
@@ -118,12 +123,38 @@ def describe_material_and_loads(
 
 def loaded_columns(sim: PatternSimulation) -> dict[str, float]:
     """``{name}stiff`` (N/m) of every load, ``mass`` (kg), ``overlap`` (m^3, NaN where not
-    computed) and ``clearance`` (m, at most 1000) of one simulated design."""
+    computed), ``clearance`` (m, at most 1000) and ``thick`` (the technique's code) of one
+    simulated design."""
     out = {f"{o.name}stiff": o.stiffness for o in sim.loads}
     out["mass"] = sim.mass
     out["overlap"] = math.nan if sim.overlap is None else sim.overlap
     out["clearance"] = math.nan if sim.clearance is None else min(sim.clearance, 1e3)
+    out["thick"] = float(THICK_CODES[sim.thick])
     return out
+
+
+#: the ``thick`` column of the crease-pattern kinds
+THICK_COLUMN = Column(
+    "thick", "-", "thickness technique of the folded panels: 0 centred, 1 offset, 2 tapered "
+    "(the first that folds without collision)", choices=(0.0, 1.0, 2.0),
+)  # fmt: skip
+
+
+def row_thickness(state: CreasePattern, row, path=()):
+    """The row's thick panels in ``state`` (:func:`~holofold.design.buildability.
+    choose_thickness` with ``thick = "auto"``, over ``path``)."""
+    from holofold.design.buildability import choose_thickness
+
+    try:
+        return choose_thickness(state, float(row["tpanel"]), float(row["W"]), path=tuple(path))
+    except ValueError:
+        return None
+
+
+def fold_way(fold, states: int = 3) -> list:
+    """Up to ``states`` states of a fold path between its start and end."""
+    k = len(fold.coords)
+    return [fold.folded(int(i)) for i in np.unique(np.linspace(0, k - 1, states + 2).round())[1:-1]]
 
 
 def row_status(status: Status) -> Status:

@@ -40,12 +40,14 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
+    THICK_COLUMN,
     crease_view,
     describe_material_and_loads,
     loaded_columns,
     read_supports_and_loads,
     row_part,
     row_status,
+    row_thickness,
     surface_lines,
     write_row_files,
 )
@@ -135,6 +137,7 @@ def surface_columns(setting: SurfaceScenarioSetting) -> tuple[Column, ...]:
         Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
         Column("overlap", "m^3", "intersection volume of the folded thick panels"),
         Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
+        THICK_COLUMN,
     ]
     return tuple(cols)
 
@@ -234,7 +237,14 @@ def surface_shape(setting: SurfaceScenarioSetting, row) -> CreasePattern:
 def surface_part(setting: SurfaceScenarioSetting, row):
     """The printable part: the fitted pattern's flat layout with the row's thicknesses and
     hinge width (:func:`~holofold.design.scenarios.pattern_loads.row_part`)."""
-    return row_part(surface_shape(setting, row), row)
+    from dataclasses import replace
+
+    shape = surface_shape(setting, row)
+    part = row_part(shape, row)
+    got = row_thickness(shape, row)
+    if part is None or got is None:
+        return part
+    return replace(part, thick=got.technique)
 
 
 def surface_view(setting: SurfaceScenarioSetting, row):
@@ -269,7 +279,10 @@ def write_surface_files(setting: SurfaceScenarioSetting, row, folder, units: str
     """The design's fabrication set (:func:`~holofold.geometry.write_fabrication_set`): FOLD,
     SVG, DXF, the folded shell as STL/OBJ, the thick panels and the printable part; without the
     solids (a note says why) where the panels do not allow them."""
-    return write_row_files(surface_shape(setting, row), folder, row, units=units, cutter=cutter)
+    shape = surface_shape(setting, row)
+    got = row_thickness(shape, row)
+    return write_row_files(shape, folder, row, units=units, cutter=cutter,
+                           thick=None if got is None else got.technique)  # fmt: skip
 
 
 def surface_scenario(
