@@ -445,6 +445,12 @@ def segment_part(
             faces=np.asarray(solid.tri_verts, np.int64),
             process=False,
         )
+        closed = trimesh.Trimesh(mesh.vertices, mesh.faces)  # as an STL reads back: merged
+        if not closed.is_watertight or closed.body_count != 1:
+            raise DegenerateGeometryError(
+                f"piece {k + 1} is not one closed body once its vertices are merged (parts of "
+                "it touch along an edge)"
+            )
         if flip:  # hinge face down, as the whole part prints
             mesh.apply_transform(np.diag([1.0, -1.0, -1.0, 1.0]))
         mesh.apply_translation((0.0, 0.0, -mesh.bounds[0][2]))

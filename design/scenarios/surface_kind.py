@@ -265,7 +265,7 @@ def surface_view(setting: SurfaceScenarioSetting, row):
     return crease_view(
         pat,
         fit.coords[None],
-        (f"fitted, ext {float(row['ext']):g}",),
+        (f"fitted, ext {float(row['ext']):.3g}",),
         setting.supports,
         setting.loads,
         curve=lines,
