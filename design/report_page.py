@@ -22,6 +22,7 @@ import base64
 import html
 import math
 import numbers
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from urllib.parse import quote
@@ -277,6 +278,23 @@ _KIND_TITLE = {
 }
 
 
+_NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+
+
+def _condition_text(cond: str, names, cols: Mapping) -> str:
+    """A condition on one column with its numbers in the column's display unit
+    (``rms_error < 5e-05`` on a length in m: ``rms_error < 0.05 mm``), escaped; as written
+    otherwise."""
+    col = cols.get(names[0]) if len(names) == 1 else None
+    if col is None or not getattr(col, "unit", "") or col.unit == "-":
+        return _esc(cond)
+    out, last = [], 0
+    for m in _NUMBER.finditer(cond):
+        out += [_esc(cond[last : m.start()]), _shown(float(m.group(0)), col)]
+        last = m.end()
+    return "".join(out) + _esc(cond[last:])
+
+
 def _condition_rows(pick: Pick, target: str, cols: Mapping) -> list:
     """Per target condition: the chosen design's value, its margin and met / missed."""
     rows = []
@@ -301,7 +319,7 @@ def _condition_rows(pick: Pick, target: str, cols: Mapping) -> list:
             )
         rows.append(
             [
-                f"<code>{_esc(cond)}</code>",
+                f"<code>{_condition_text(cond, names, cols)}</code>",
                 (value, "num"),
                 (margin, "num"),
                 _margin_bar(m) if math.isfinite(m) else "",

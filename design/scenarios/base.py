@@ -129,8 +129,20 @@ class Column:
     required: bool = True
     default: float | None = None
     display: str = ""
+    names: tuple[str, ...] = ()
+
+    def level_name(self, value) -> str:
+        """The name of a categorical level (``names`` aligned with ``choices``), or ""."""
+        for c, n in zip(self.choices, self.names, strict=False):
+            if float(c) == float(value):
+                return n
+        return ""
 
     def __post_init__(self):
+        if self.names and len(self.names) != len(self.choices):
+            raise ValueError(
+                f"column {self.name!r}: {len(self.names)} names for {len(self.choices)} choices"
+            )
         if self.display and self.display != self.unit:
             allowed = DISPLAY_UNITS.get(self.unit, {self.unit: 1.0})
             if self.display not in allowed:

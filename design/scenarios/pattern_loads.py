@@ -137,6 +137,7 @@ def loaded_columns(sim: PatternSimulation) -> dict[str, float]:
 THICK_COLUMN = Column(
     "thick", "-", "thickness technique of the folded panels: 0 centred, 1 offset, 2 tapered "
     "(the first that folds without collision)", choices=(0.0, 1.0, 2.0),
+    names=("centred", "offset", "tapered"),
 )  # fmt: skip
 
 

@@ -121,7 +121,9 @@ GAMMA_70 = 70.0 / 180.0 * math.pi  #: the canopy's Miura sector angle, rad
 #: ``pattern``, ``m``, ``n`` are features unless the setting fixes them, ``gama`` only when the
 #: setting has no sector angle; ``creaseE``/``panelE`` are optional (default: the setting's E).
 SHEET_FEATURES = (
-    Column("pattern", "-", "1 = Miura-ori, 2 = TMP", choices=(1.0, 2.0)),
+    Column(
+        "pattern", "-", "1 = Miura-ori, 2 = TMP", choices=(1.0, 2.0), names=("Miura-ori", "TMP")
+    ),
     Column("m", "-", "panels along x (TMP: even)", choices=(24.0, 30.0, 36.0)),
     Column("n", "-", "panels along y (TMP: multiple of 3)", choices=(6.0, 9.0, 12.0)),
     Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3, display="mm"),
@@ -287,7 +289,8 @@ def sheet_columns(setting: SheetSetting, extras: bool = True) -> tuple[Column, .
         cols.append(Column("thick", "-", "thickness technique of the panels: 0 centred, "
                            "1 offset, 2 tapered (with thick = 'auto' the first that folds "
                            f"from flat to Ext = {most:g} without collision)",
-                           choices=(0.0, 1.0, 2.0)))  # fmt: skip
+                           choices=(0.0, 1.0, 2.0),
+                           names=("centred", "offset", "tapered")))  # fmt: skip
     return tuple(cols)
 
 

@@ -1,4 +1,5 @@
-"""``holofold demo``: ``holofold design`` on the paper's arch, end to end, in under a minute."""
+"""``holofold demo``: ``holofold design`` on the paper's arch, end to end, in under half a minute
+(README; benchmarks/speed_targets.md)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ TARGET = "Zstiff > 100 & error < 0.1"
 def register(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "demo",
-        help="end-to-end demo: 'holofold design' on the paper's arch (about a minute)",
+        help="end-to-end demo: 'holofold design' on the paper's arch (under half a minute on "
+        "two cores)",
         description=(
             "Run the design loop on the shipped arch scenario (a Miura strip over a half "
             "circle of radius 2 m): a database of arch designs, rules for the target, their "
