@@ -192,3 +192,40 @@ def test_pattern_command_takes_a_bed_and_the_slicer_slices_the_pieces(tmp_path, 
     for f in sorted((out / "segments").glob("segment_*.stl"))[:3]:
         layers, minutes, z = _slice([exe], f)
         assert layers == 10 and z[-1] == pytest.approx(2.0) and minutes
+
+
+def _roof_solid(n: int = 21, thick: float = 4.0) -> trimesh.Trimesh:
+    """A hyperbolic-paraboloid roof 300 x 300 mm, z = (x^2 - y^2) / 600 mm, thickened by
+    ``thick`` mm downwards into a closed solid (what OpenSCAD exports), in mm."""
+    x = np.linspace(-150.0, 150.0, n)
+    X, Y = np.meshgrid(x, x)
+    top = np.column_stack([X.ravel(), Y.ravel(), ((X**2 - Y**2) / 600.0).ravel()])
+    quads = [(i * n + j, i * n + j + 1, i * n + j + n + 1, i * n + j + n)
+             for i in range(n - 1) for j in range(n - 1)]  # fmt: skip
+    tri = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+    k = len(top)
+    faces = [*tri.tolist(), *(tri[:, ::-1] + k).tolist()]
+    idx = np.arange(k).reshape(n, n)
+    ring = [*idx[0, :], *idx[1:, -1], *idx[-1, -2::-1], *idx[-2:0:-1, 0]]
+    for a, b in zip(ring, ring[1:] + ring[:1], strict=True):
+        faces += [[b, a, a + k], [b, a + k, b + k]]
+    solid = trimesh.Trimesh(np.vstack([top, top - [0.0, 0.0, thick]]), np.array(faces))
+    trimesh.repair.fix_normals(solid)
+    return solid
+
+
+def test_a_closed_cad_solid_gives_its_upper_skin(tmp_path):
+    """A closed solid is read as its upward faces over the best-fit plane, said in one warning:
+    the 800 triangles of the roof's top skin, the surface through the hypar's saddle point."""
+    from holofold.fitting import read_surface
+
+    solid = _roof_solid()
+    assert solid.is_watertight
+    path = tmp_path / "roof.stl"
+    solid.export(path)
+    with pytest.warns(UserWarning, match=r"closed solid: its 800 upward faces") as said:
+        target = read_surface(path, "mm")
+    assert len(said) == 1
+    assert target.domain == pytest.approx((-0.15, 0.15, -0.15, 0.15), abs=1e-9)
+    pts = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1 * 0.1 / 0.6], [0.0, 0.1, -0.1 * 0.1 / 0.6]])
+    assert np.abs(target.distance(pts)).max() < 2e-4  # on the top skin (chords of 15 mm)
