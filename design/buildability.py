@@ -86,7 +86,8 @@ def choose_thickness(
 ) -> ThicknessChoice:
     """The thick panels of a design folded to ``state`` (a CreasePattern with its flat layout;
     ``path`` other states on the way from flat): with ``thick = "auto"`` centred, offset, then
-    tapered panels, the first whose panels do not overlap (by more than 0.001 mm^3), else the
+    tapered panels, the first whose panels do not overlap (by more than 0.001 mm^3; centred
+    ones also with no negative clearance: panels sharing no vertex apart), else the
     centred ones (the measure the loop's overlap rule was calibrated on); a technique name:
     that one. ``no_neighbour`` caps the clearance where every pair of panels shares a vertex."""
     from holofold.geometry import printability
@@ -111,7 +112,8 @@ def choose_thickness(
                 continue
             low = gap - (thickness if name == "offset" else 0.0) if gap < no_neighbour else gap
             got = ThicknessChoice(name, float(over.volume.max()), low)
-        if got.overlap <= _CLEAR or len(order) == 1:
+        clear = got.overlap <= _CLEAR and (name != "centred" or not got.clearance < 0)
+        if clear or len(order) == 1:
             return ThicknessChoice(got.technique, got.overlap, got.clearance, tuple(tried))
     return ThicknessChoice("centred", centred.overlap, centred.clearance, tuple(tried))
 

@@ -203,6 +203,16 @@ class PatternSimulation:
         return bool(self.clearance is not None and self.clearance < 0)
 
     @property
+    def panel_bending(self) -> float:
+        """The largest bend of a panel in the last state, degrees: |fold angle| over the
+        panels' own lines (F and J edges inside the sheet: a facet or a triangulation line)."""
+        p = self.fold.pattern
+        inside = np.isin(p.assignment, ("F", "J")) & p.interior
+        if not inside.any():
+            return 0.0
+        return float(np.abs(np.asarray(self.fold.fold_angles[-1], float)[inside]).max())
+
+    @property
     def status(self) -> Status:
         """Converged when the fold reached its fraction and every load converged."""
         parts = {"fold": self.fold.status, **{f"load {o.name}": o.status for o in self.loads}}
@@ -213,6 +223,12 @@ class PatternSimulation:
         f = self.fold
         text = f"{f.verdict}: reached {100 * f.reached:.0f} % of {100 * f.requested:.0f} % "
         text += f"(fold progress {100 * f.progress:.0f} %); {f.note}"
+        bend = self.panel_bending
+        if bend > 5.0:
+            text += (
+                f"; panels bend by up to {bend:.0f} deg across their facet lines (the pattern "
+                "does not fold with flat panels)"
+            )
         if self.thick != "centred":
             text += (
                 f"; {self.thick} panels fold without collision"
@@ -318,8 +334,9 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
             overlap, clearance, closest = pr.overlap, pr.clearance, pr.closest
         except ValueError:  # panels too small for the crease width: no thick panels
             pass
+        clash = overlap is not None and (overlap > 1e-12 or (clearance or 0.0) < 0)
         if overlap is not None and (s.thick not in ("auto", "centred")
-                                    or (s.thick == "auto" and overlap > 1e-12)):  # fmt: skip
+                                    or (s.thick == "auto" and clash)):  # fmt: skip
             from holofold.design.buildability import choose_thickness
 
             k = len(fold.coords)
@@ -423,6 +440,7 @@ def _summary(sim: PatternSimulation) -> dict:
         "mass_kg": sim.mass,
         "overlap_m3": sim.overlap,
         "thick": sim.thick,
+        "panel_bending_deg": sim.panel_bending,
         "clearance_m": _num(sim.clearance) if sim.clearance is not None else None,
         "seconds": sim.seconds,
     }

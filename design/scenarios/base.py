@@ -170,8 +170,14 @@ class Column:
         return value / self.display_factor
 
     def format(self, value: float, digits: int = 3) -> str:
-        """:func:`format_value` of ``value`` (SI) in this column's display unit."""
-        return format_value(value, self, digits=digits)
+        """:func:`format_value` of ``value`` (SI) in this column's display unit; a named
+        categorical level with its name (``1 (offset)``)."""
+        text = format_value(value, self, digits=digits)
+        try:
+            name = self.level_name(value) if self.names else ""
+        except (TypeError, ValueError):
+            name = ""
+        return f"{text} ({name})" if name else text
 
     def out_of_range(self, value: float) -> str | None:
         """A warning text if ``value`` is outside the paper's sampling range, else None."""
