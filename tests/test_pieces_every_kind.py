@@ -229,3 +229,23 @@ def test_a_closed_cad_solid_gives_its_upper_skin(tmp_path):
     assert target.domain == pytest.approx((-0.15, 0.15, -0.15, 0.15), abs=1e-9)
     pts = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.1 * 0.1 / 0.6], [0.0, 0.1, -0.1 * 0.1 / 0.6]])
     assert np.abs(target.distance(pts)).max() < 2e-4  # on the top skin (chords of 15 mm)
+
+
+def test_margins_rules_and_sources_say_units_names_and_relative_paths():
+    from holofold.design.report_page import _condition_text
+    from holofold.design.rules.text import box_text
+    from holofold.design.scenarios.base import Column
+    from holofold.design.scenarios.files import shipped_scenarios
+    from holofold.design.scenarios.sheet import SHEET_FEATURES
+
+    cols = {"rms_error": Column("rms_error", "m", "", display="mm"),
+            "k": Column("k", "N/m", "")}  # fmt: skip
+    assert _condition_text("rms_error < 5e-05", ("rms_error",), cols) == "rms_error &lt; 0.05 mm"
+    assert _condition_text("3000 < k < 4000", ("k",), cols) == "3000 N/m &lt; k &lt; 4000 N/m"
+    pattern = SHEET_FEATURES[0]
+    text = box_text([(2.0,)], ["pattern"], categorical=("pattern",), columns={"pattern": pattern})
+    assert text == "pattern = 2 (TMP)" and pattern.format(1.0) == "1 (Miura-ori)"
+    with pytest.raises(ValueError, match="1 names for 2 choices"):
+        Column("c", "-", choices=(1.0, 2.0), names=("a",))
+    sc = read_scenario(shipped_scenarios()["arch"])
+    assert sc.source == "holofold/design/scenarios/shipped/arch.toml"
