@@ -68,7 +68,7 @@ def add_bed_argument(p) -> None:
 
 def bed_of(args):
     """The :class:`~holofold.geometry.Bed` of ``--bed`` (checked before any work)."""
-    from holofold.design.buildability import DEFAULT_BED, parse_bed
+    from holofold.design import DEFAULT_BED, parse_bed
 
     text = getattr(args, "bed", None)
     return DEFAULT_BED if text is None else parse_bed(text)
@@ -78,7 +78,7 @@ def say_part(files, bed, part, units: str, root) -> dict | None:
     """If ``files`` (a fabrication set) holds ``printable``: its fit on ``bed``, cut into pieces
     when larger (``part``: a :class:`~holofold.design.buildability.PrintablePart`), said in one
     line; its JSON record (None without a printable part)."""
-    from holofold.design.buildability import part_fit
+    from holofold.design import part_fit
 
     path = next((f.path for f in files.files if f.key == "printable"), None)
     if path is None:

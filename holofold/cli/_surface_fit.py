@@ -154,7 +154,7 @@ def run_surface(args) -> int:
               f"({check['fold_seconds']:.1f} s)")  # fmt: skip
     part = None
     if getattr(args, "printable", False) and fit.ok:
-        from holofold.design.buildability import PrintablePart
+        from holofold.design import PrintablePart
 
         part = PrintablePart(fit.pattern, args.panel_thickness, args.crease_thickness,
                              args.crease_width, thick=args.thick)  # fmt: skip

@@ -305,7 +305,7 @@ def run(args) -> int:
     )
     part = None
     if args.printable and fit.flat is not None:
-        from holofold.design.buildability import PrintablePart
+        from holofold.design import PrintablePart
 
         part = PrintablePart(fit.flat_pattern, args.panel_thickness, args.crease_thickness,
                              args.crease_width, thick=args.thick)  # fmt: skip

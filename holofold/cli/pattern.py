@@ -145,7 +145,7 @@ def run(args) -> int:
     for note in written.notes:
         print(f"  note: {note}")
     if args.printable and pattern.flat is not None:
-        from holofold.design.buildability import PrintablePart
+        from holofold.design import PrintablePart
 
         part = PrintablePart(pattern, args.thickness, args.crease_thickness, args.crease_width,
                              thick=args.thick)  # fmt: skip

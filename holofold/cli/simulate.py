@@ -163,7 +163,7 @@ def _read_sized(read_pattern, args, given):
     ``--size`` or ``--scale`` sets the size anyway, else naming ``--unit`` and ``--size``."""
     import warnings
 
-    from holofold.geometry.readers import PatternWarning
+    from holofold.geometry import PatternWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
