@@ -445,7 +445,8 @@ def segment_part(
             faces=np.asarray(solid.tri_verts, np.int64),
             process=False,
         )
-        closed = trimesh.Trimesh(mesh.vertices, mesh.faces)  # as an STL reads back: merged
+        # as its STL (mm) reads back: vertices merged
+        closed = trimesh.Trimesh(np.asarray(mesh.vertices) * _MM, mesh.faces)
         if not closed.is_watertight or closed.body_count != 1:
             raise DegenerateGeometryError(
                 f"piece {k + 1} is not one closed body once its vertices are merged (parts of "
