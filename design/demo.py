@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 from holofold.design.loop import run_design
 from holofold.design.scenarios import shipped_scenarios
+from holofold.design.settings import DesignProblem, Execution, LoopSettings
 
 __all__ = ["DEMO_TARGET", "run_demo"]
 
@@ -36,8 +37,9 @@ def run_demo(
 
     Every argument is checked before the folder is created.
     """
-    out = run_design(
-        shipped_scenarios()["arch"], target, folder, samples=samples, rounds=rounds,
-        refine=refine, verify=verify, seed=seed, workers=workers, say=say, until_verified=False,
-    )  # fmt: skip
+    problem = DesignProblem(shipped_scenarios()["arch"], target)
+    settings = LoopSettings(samples=samples, rounds=rounds, refine=refine, verify=verify,
+                            seed=seed, until_verified=False)  # fmt: skip
+    execution = Execution(workers=workers, say=say)
+    out = run_design(problem, folder=folder, settings=settings, execution=execution)
     return out.summary

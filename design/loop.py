@@ -33,41 +33,60 @@ import math
 import os
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from holofold.design.acquisition import likely_designs
 from holofold.design.batches import grow
-from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed, part_fit
+from holofold.design.buildability import Bed, part_fit
 from holofold.design.choice import Answer, Candidate, choose
-from holofold.design.describe import PILOT, distributions
-from holofold.design.folder_lock import locks_folder
+from holofold.design.describe import distributions
+from holofold.design.folder_lock import folder_lock
 from holofold.design.mining import OneClassSplit, mine_rules
 from holofold.design.objective import Objective, parse_objective
 from holofold.design.rounds import Round, VerifiedRule
 from holofold.design.row_status import converged_rows, failed_rows
 from holofold.design.rulefile import mined_rules, write_rules
 from holofold.design.rules import Condition, FewRulesWarning, Rule
-from holofold.design.runner import check_workers
-from holofold.design.sampling import MAX_SAMPLES, sample_designs
-from holofold.design.scenarios import Scenario, load_scenario
+from holofold.design.sampling import sample_designs
+from holofold.design.scenarios import Scenario
+from holofold.design.settings import (
+    DesignFiles,
+    DesignProblem,
+    Execution,
+    LoopSettings,
+    made,
+    split_options,
+)
 from holofold.design.store import build_database, load_database
+from holofold.design.strategies import (
+    STRATEGIES,
+    RefineRequest,
+    around_hits,
+    at_random,
+    refine_designs,
+)
 from holofold.design.summary import STAGES, DesignSummary, Pick, Timings
 from holofold.design.tables import ColumnRoles, write_table
 from holofold.design.targets import parse_target
-from holofold.design.verify import as_rule, rule_key, rule_ranges, verify_rule
+from holofold.design.verify import as_rule, rule_key, verify_rule
 from holofold.geometry.outputs import write_json
-from holofold.geometry.units import length_factor
 
-__all__ = ["run_design", "DesignOutcome", "refine_designs", "choose_design", "STAGES"]
-
-#: where refinement rounds sample (:func:`run_design`'s ``strategy``)
-REFINE_STRATEGIES = ("likely", "around", "mixed")
+__all__ = [
+    "run_design",
+    "DesignLoop",
+    "LoopState",
+    "DesignOutcome",
+    "refine_designs",
+    "choose_design",
+    "STAGES",
+]
 #: a rule is verified (fresh simulations) once its estimate reaches this precision: a rule the
 #: miner expects below it would not pass (90 % of its fresh designs meeting the target)
 VERIFY_FROM = 0.85
@@ -111,48 +130,6 @@ class DesignOutcome:
     def met(self) -> bool:
         """The chosen design meets the target."""
         return self.record.chosen is not None and self.record.chosen.meets
-
-
-# ---------------------------------------------------------------------- sampling
-def refine_designs(
-    scenario: Scenario,
-    rules: Sequence[Rule | Mapping],
-    n: int,
-    *,
-    seed: int,
-    start: int = 0,
-    widen: float = 0.25,
-) -> pd.DataFrame:
-    """``n`` new designs inside and around the boxes of ``rules`` (:class:`Rule` records or
-    their JSON form; shared equally).
-
-    Half of each rule's designs lie inside its box, half in the box widened by ``widen`` of
-    each feature's range on both sides (clipped to the scenario's range), so the database also
-    learns where the rule's edges really are. Categorical features keep the rule's levels.
-    """
-    cols = {c.name: c for c in scenario.features}
-    parts = []
-    k = len(rules)
-    counts = [n // k + (1 if i < n % k else 0) for i in range(k)]
-    for i, (rule, m) in enumerate(zip(rules, counts, strict=True)):
-        inside = rule_ranges(scenario, rule)
-        wide = {}
-        for name, r in inside.items():
-            c = cols[name]
-            if isinstance(r, list):
-                wide[name] = r
-                continue
-            pad = widen * (c.high - c.low)
-            wide[name] = (max(c.low, r[0] - pad), min(c.high, r[1] + pad))
-        for j, ranges in enumerate((inside, wide)):
-            size = m // 2 + (m % 2 if j == 0 else 0)
-            if size:
-                parts.append(
-                    sample_designs(scenario, size, seed=seed * 1000 + 2 * i + j, ranges=ranges)
-                )
-    out = pd.concat(parts, ignore_index=True)
-    out["sample"] = np.arange(start, start + len(out))
-    return out
 
 
 # ---------------------------------------------------------------------- choosing
@@ -236,13 +213,6 @@ def _box_of(hits: pd.DataFrame, roles: ColumnRoles) -> Rule:
                 Condition(name, gt=float(np.nextafter(col.min(), -np.inf)), le=float(col.max()))
             )
     return Rule(tuple(conds), rank=0)
-
-
-def _key(*parts) -> str:
-    """8 hex digits naming what a refinement's designs come from (its rules, size and seed)."""
-    import hashlib
-
-    return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()[:8]
 
 
 def _fmt(p) -> str:
@@ -368,287 +338,426 @@ def _earlier_rows(sc: Scenario, roots: Sequence[Path], used: set) -> pd.DataFram
     return pd.concat(parts, ignore_index=True) if parts else None
 
 
-@locks_folder("folder")  # one run per design folder (its databases are locked on their own)
 def run_design(
-    scenario: Scenario | str | os.PathLike,
-    target: str,
-    folder: str | os.PathLike,
+    problem: DesignProblem | Scenario | str | os.PathLike,
+    target: str | None = None,
+    folder: str | os.PathLike | None = None,
     *,
-    samples: int = 200,
-    rounds: int | None = None,
-    budget: int = 6000,
-    refine: int = 50,
-    verify: int = 50,
-    top: int = 3,
-    strategy: str = "mixed",
-    until_verified: bool = True,
-    db: str | os.PathLike | None = None,
-    seed: int = 0,
-    workers: int = 1,
-    progress: bool | None = None,
-    files: bool = True,
-    mesh_units: str = "mm",
-    cutter=None,
-    objective: str | Objective | None = None,
-    allow_overlap: bool = False,
-    bed: str | Bed | tuple | None = None,
-    pilot: int = PILOT,
-    say: Callable[[str], None] = lambda text: None,
+    settings: LoopSettings | None = None,
+    execution: Execution | None = None,
+    output: DesignFiles | None = None,
+    **options,
 ) -> DesignOutcome:
     """Run the design loop (module docstring) into ``folder``; resumable and extendable.
 
     Parameters
     ----------
-    scenario : Scenario, scenario name or path of a ``.toml`` scenario file
-    target : str
-        Target expression over the scenario's performance columns, e.g.
+    problem : DesignProblem, or the scenario (a Scenario, its name or a ``.toml`` path)
+        What is asked (:class:`~holofold.design.DesignProblem`: scenario, target, objective,
+        bed, ``allow_overlap``). Given a scenario, ``target`` is its target expression, e.g.
         ``"Zstiff > 100 & error < 0.05"``.
+    target : str, optional
+        With a scenario: the target expression over its performance columns.
     folder : path
-        Output folder (``design.json``, ``report.html``, ``files/``, ``database/``, ...).
-    samples : int
-        Designs in the base database (>= 20).
-    rounds : int, optional
-        Refinement rounds at most (0: mine once, as the paper did; default: as many as
-        ``budget`` allows).
-    budget : int
-        Simulations this run may spend at most: the base database, refinement and verification
-        designs (rows of a database given with ``db`` that were there before cost nothing). A
-        refinement round starts only when its ``refine`` designs and one verification fit; a
-        rule is verified only when its ``verify`` designs fit.
-    refine : int
-        New designs per refinement round.
-    verify : int
-        Fresh designs simulated per verified rule and round. A rule is verified when its
-        estimate reaches :data:`VERIFY_FROM` (in the last round at least the best one), best
-        lower estimate first.
-    top : int
-        Rules kept per round (distinct alternatives).
-    strategy : {"mixed", "likely", "around"}
-        Where a refinement round samples: ``"mixed"`` (default), half where the last round's
-        forest votes for the target and half uniformly inside its best rule; ``"likely"``, all
-        where the forest votes (:func:`holofold.design.acquisition.likely_designs`);
-        ``"around"``, half inside the rules and half in them widened by a quarter of each range
-        (:func:`refine_designs`). A round after one without a rule samples around the designs
-        that meet the target, or at random while none does. Measured against each other and
-        against mining once in ``benchmarks/rare_targets.md``.
-    until_verified : bool
-        Stop once a rule is verified: at least 90 % of its fresh designs meet the target and
-        the 95 % interval's lower end is at least 0.8 (:func:`rule_verified`).
-    db : path, optional
-        Database folder to use instead of ``folder/database`` (reused and extended). A folder
-        made by ``holofold generate`` (with its ``meta.json``) gives all its rows, extended with
-        new batches inside it when it has fewer than ``samples``.
-    seed : int
-    workers : int
-        Worker processes for the simulations.
-    files : bool
-        Write the chosen design's fabrication files, pictures and the report page.
-    mesh_units : {"mm", "m"}
-        Length unit of the mesh files (STL, OBJ); FOLD stays in m, SVG and DXF in mm.
-    cutter : CutterOptions, optional
-        How the SVG and DXF of the flat pattern are drawn (a
-        :class:`~holofold.geometry.CutterOptions`; default Origami Simulator's convention).
-    objective : str or Objective, optional
-        ``"margin"`` (default: the largest worst-case margin to the target), ``"min COLUMN"``
-        or ``"max COLUMN"`` (any performance or feature column).
-    allow_overlap : bool
-        Let a design whose thick panels overlap be chosen (never by default).
-    bed : "WxD" in mm, Bed or (x, y) in m
-        The printer's bed the part's fit is judged on (None: the scenario's ``bed``, else
-        250 x 210 mm).
-    pilot : int
-        Designs simulated first (0: no pilot); the run stops after them, with the columns'
-        distributions, when none meets the target and a condition is met by none.
-    say : callable
-        Receives one line of progress per stage.
+        Output folder (``design.json``, ``report.html``, ``files/``, ``database/``, ...); one run
+        at a time holds it.
+    settings : LoopSettings, optional
+        How the loop searches (samples, budget, refine, verify, strategy, pilot, rounds, top,
+        until_verified, seed; :class:`~holofold.design.LoopSettings` gives each its meaning).
+    execution : Execution, optional
+        How it runs (workers, progress, scheduler, row_timeout, ``say`` for the progress lines).
+    output : DesignFiles, optional
+        What it writes (db, files, mesh_units, cutter).
+    **options
+        Any field of the four records by name (the loop's former keyword arguments:
+        ``samples=200``, ``workers=2``, ``objective="min mass"``, ``files=False``, ...); each
+        replaces the field of the record given, or of the default one.
+
+    The rows of a database given with ``db`` that were there before cost nothing against the
+    budget. Every simulation lands in a resumable folder: the same call again continues.
     """
-    sc = load_scenario(scenario)
-    tgt = parse_target(target, sc.performance_names)
-    obj = parse_objective(objective, [*sc.performance_names, *sc.feature_names])
-    bed = parse_bed(bed if bed is not None else (sc.bed or DEFAULT_BED))
-    for name, v, low in (
-        ("samples", samples, 20),
-        ("rounds", 0 if rounds is None else rounds, 0),
-        ("verify", verify, 1),
-        ("top", top, 1),
-        ("refine", refine, 1 if rounds != 0 else 0),
-        ("budget", budget, 1),
-        ("pilot", pilot, 0),
-    ):
-        if isinstance(v, bool) or int(v) != v or v < low:
-            raise ValueError(f"{name} = {v!r} must be an integer >= {low}")
-    if strategy not in REFINE_STRATEGIES:
-        raise ValueError(
-            f"strategy = {strategy!r} must be one of {', '.join(map(repr, REFINE_STRATEGIES))}"
+    if folder is None:
+        raise TypeError("run_design() needs the output folder")
+    with folder_lock(folder):  # a run refused before it writes leaves no folder behind
+        by = split_options(options)
+        if isinstance(problem, DesignProblem):
+            if target is not None:
+                raise TypeError("run_design(problem, ...): the target is the problem's")
+            problem = made(DesignProblem, problem, by[DesignProblem])
+        else:
+            problem = DesignProblem(problem, target, **by[DesignProblem])
+        loop = DesignLoop(
+            problem,
+            made(LoopSettings, settings, by[LoopSettings]),
+            made(Execution, execution, by[Execution]),
+            made(DesignFiles, output, by[DesignFiles]),
+            Path(folder),
         )
-    if budget > MAX_SAMPLES:
-        raise ValueError(f"budget = {budget:,} simulations; at most {MAX_SAMPLES:,} in one run")
-    if budget < samples + verify:
-        raise ValueError(
-            f"budget = {budget:,} simulations cannot hold the {samples:,} designs of the database "
-            f"and one verification of {verify:,} (at least {samples + verify:,})"
-        )
-    workers = check_workers(workers)
-    length_factor(mesh_units)
-    out = Path(folder)
-    dbf = Path(db) if db is not None else out / "database"
-    roles = _roles(sc)
-    if not roles.features:
-        raise ValueError(f"scenario {sc.name!r} varies no feature: give ranges in [features]")
-    # buildable by default: rules are mined and verified for the target with panels that do not
-    # overlap (the choice filters on it too); the margins and the objective use the target alone
-    buildable = (
-        "overlap" in sc.performance_names and not allow_overlap and "overlap" not in tgt.columns
-    )
-    out.mkdir(parents=True, exist_ok=True)
-    ledger = _Ledger(out)
-    times = dict.fromkeys(STAGES, 0.0)
-    used: set = set()
+        return loop.run()
 
-    def simulate(designs: pd.DataFrame, path: Path) -> pd.DataFrame:
-        # sampled designs the scenario's check refuses are failed rows, not a refused run
-        used.add(path.resolve())
-        return build_database(
-            sc, designs, path, workers=workers, progress=progress, on_invalid="skip"
-        )
 
-    def base(start: int, count: int) -> pd.DataFrame:
-        return sample_designs(sc, count, seed=seed, start=start)
+@dataclass
+class LoopState:
+    """What one :class:`DesignLoop` has found so far (its steps read and grow it; none is
+    handed on).
 
-    # 1. database: the pilot first
-    t0 = time.perf_counter()
-    parts, have = [], 0
-    given = _given_database(dbf, sc)
-    if given is not None:  # a database the user made (holofold generate): all its rows
-        used.add(dbf.resolve())
-        parts.append(given.assign(origin="database"))
-        have = len(given)
-    first = min(samples, pilot) if pilot else samples
-    stored = _stored_rows(dbf, "base-", have)
-    if have < first:
-        what = f"pilot: {first - have}" if pilot else f"{samples - have}"
-        say(f"[database] {what} designs of {sc.name}{_on_disk(stored, first - have)}")
-    rows, _ = grow(dbf, first, base, simulate, prefix="base-", covered=have)
-    parts.append(rows.assign(origin="database"))
-    table = pd.concat([p for p in parts if len(p)], ignore_index=True)
-    pilot_info = None
-    if pilot:
-        hits, unmet, stop = _pilot_verdict(table, tgt)
-        pilot_info = {
-            "rows": int(len(table)),
-            "meeting": hits,
-            "stopped": stop is not None,
-            "reason": stop or "",
-            "unmet": unmet,
-        }
-        if stop is not None:
-            say(f"  pilot: {stop} ({len(table)} designs); stopping before the rest")
-    times["database"] += time.perf_counter() - t0
-    history: list[Round] = []
-    miners: dict = {}
-    mine_tgt = tgt
-    if not (pilot_info and pilot_info["stopped"]):
-        t0 = time.perf_counter()
-        if len(table) < samples:
-            more = samples - len(table)
-            say(
-                f"[database] {more} more designs of {sc.name}"
-                f"{_on_disk(stored - len(table) + have, more)}"
+    ``table`` every design simulated by the run (with ``origin``); ``free`` its first rows that
+    came from a given database (no cost against the budget); ``history`` the rounds;
+    ``miners`` round -> MinedRules; ``boxes`` the rules (or the box of the designs meeting the
+    target) the next refinement samples by; ``around`` the last round whose few hits could not
+    be mined; ``times`` seconds per stage; ``used`` the folders this run read;
+    ``pilot`` the pilot's verdict; ``mine_target`` the target rules are mined for.
+    """
+
+    table: pd.DataFrame | None = None
+    free: int = 0
+    history: list = field(default_factory=list)
+    miners: dict = field(default_factory=dict)
+    boxes: list = field(default_factory=list)
+    around: int = -1
+    times: dict = field(default_factory=lambda: dict.fromkeys(STAGES, 0.0))
+    used: set = field(default_factory=set)
+    pilot: dict | None = None
+    mine_target: object = None
+
+
+class DesignLoop:
+    """The loop over one folder: :meth:`database`, then rounds of :meth:`refine`,
+    :meth:`mine` and :meth:`verify` (:meth:`search`), then :meth:`choose` and :meth:`write`,
+    each a step over :attr:`state` (a :class:`LoopState`)."""
+
+    def __init__(self, problem: DesignProblem, settings: LoopSettings, execution: Execution,
+                 output: DesignFiles, folder: Path):  # fmt: skip
+        self.problem, self.settings, self.execution, self.output = (
+            problem, settings, execution, output
+        )  # fmt: skip
+        self.sc, self.say, self.out = problem.scenario, execution.say, Path(folder)
+        self.dbf = Path(output.db) if output.db is not None else self.out / "database"
+        self.roles = _roles(self.sc)
+        if not self.roles.features:
+            raise ValueError(
+                f"scenario {self.sc.name!r} varies no feature: give ranges in [features]"
             )
-            rows, _ = grow(dbf, samples, base, simulate, prefix="base-", covered=len(table))
-            table = pd.concat([table, rows.assign(origin="database")], ignore_index=True)
-        if given is None:
-            table = table.iloc[:samples]
-        times["database"] += time.perf_counter() - t0
-        mine_tgt = _buildable_target(sc, tgt, table, say) if buildable else tgt
-        table, history, miners = _rounds(
-            sc,
-            mine_tgt,
-            roles,
-            table,
-            out,
-            dbf,
-            simulate,
-            rounds=rounds,
-            budget=budget,
-            free=have,
-            refine=refine,
-            verify=verify,
-            top=top,
-            strategy=strategy,
-            until_verified=until_verified,
-            seed=seed,
-            workers=workers,
-            progress=progress,
-            times=times,
-            used=used,
-            say=say,
-        )
+        self.state = LoopState(mine_target=problem.target)
 
-    # 5. choose, from everything simulated in the folder
-    t0 = time.perf_counter()
-    earlier = _earlier_rows(sc, [dbf, out / "rounds"], used)
-    everything = table if earlier is None else pd.concat([table, earlier], ignore_index=True)
-    if earlier is not None:
-        say(
-            f"[choose] {len(earlier)} designs simulated by earlier runs in {out} join the "
-            "candidates"
-        )
-    say(f"[choose] {obj.words}" + (", thick panels not overlapping" if buildable else ""))
-    rules = [r for h in history for r in h.rules]
-    answer = choose(everything, tgt, obj, rules, allow_overlap=allow_overlap)
-    everything = everything.reset_index(drop=True)
-    times["choose"] = time.perf_counter() - t0
-    say(f"  {answer.headline}")
+    def run(self) -> DesignOutcome:
+        self.out.mkdir(parents=True, exist_ok=True)
+        ledger = _Ledger(self.out)
+        if self.database():
+            self.search()
+        answer, everything = self.choose()
+        return self.write(answer, everything, ledger)
 
-    summary = DesignSummary(
-        scenario=_scenario_summary(sc),
-        target=str(tgt),
-        mined_target=str(mine_tgt),
-        objective=str(obj),
-        allow_overlap=bool(allow_overlap),
-        answer=answer.kind,
-        headline=_headline(answer, pilot_info),
-        chosen=_pick(sc, everything, answer.chosen, tgt),
-        alternatives=tuple(_pick(sc, everything, c, tgt) for c in answer.alternatives),
-        rounds=tuple(history),
-        database=_counts(everything, dbf, out),
-        pilot=pilot_info,
-        distributions=tuple(distributions(everything, _target_columns(sc, tgt, obj))),
-    )
-    write_table(everything, out / "designs.parquet")
-    if files and answer.chosen is not None:
+    # ------------------------------------------------------------------ helpers
+    @contextmanager
+    def _timed(self, stage: str):
         t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.state.times[stage] += time.perf_counter() - t0
+
+    def _simulate(self, designs: pd.DataFrame, path: Path) -> pd.DataFrame:
+        # sampled designs the scenario's check refuses are failed rows, not a refused run
+        self.state.used.add(path.resolve())
+        return build_database(self.sc, designs, path, on_invalid="skip",
+                              **self.execution.runner())  # fmt: skip
+
+    def _base(self, start: int, count: int) -> pd.DataFrame:
+        return sample_designs(self.sc, count, seed=self.settings.seed, start=start)
+
+    def _round_dir(self, r: int) -> Path:
+        return self.out / "rounds" / f"round-{r}"
+
+    def more(self, r: int) -> bool:
+        """Another refinement round after round ``r`` is allowed and fits the budget."""
+        s = self.settings
+        capped = s.rounds is not None and r >= s.rounds
+        spent = len(self.state.table) - self.state.free
+        return not capped and spent + s.refine + s.verify <= s.budget
+
+    # ------------------------------------------------------------------ 1. database
+    def database(self) -> bool:
+        """The pilot, then the rest of the base sample; False when the pilot stops the run."""
+        s, st, say = self.settings, self.state, self.say
+        with self._timed("database"):
+            parts, have = [], 0
+            given = _given_database(self.dbf, self.sc)
+            if given is not None:  # a database the user made (holofold generate): all its rows
+                st.used.add(self.dbf.resolve())
+                parts.append(given.assign(origin="database"))
+                have = len(given)
+            st.free = have
+            first = min(s.samples, s.pilot) if s.pilot else s.samples
+            stored = _stored_rows(self.dbf, "base-", have)
+            if have < first:
+                what = f"pilot: {first - have}" if s.pilot else f"{s.samples - have}"
+                say(f"[database] {what} designs of {self.sc.name}{_on_disk(stored, first - have)}")
+            rows, _ = grow(self.dbf, first, self._base, self._simulate, prefix="base-",
+                           covered=have)  # fmt: skip
+            parts.append(rows.assign(origin="database"))
+            st.table = pd.concat([p for p in parts if len(p)], ignore_index=True)
+            if s.pilot:
+                st.pilot = _pilot_info(st.table, self.problem.target, say)
+        if st.pilot and st.pilot["stopped"]:
+            return False
+        with self._timed("database"):
+            if len(st.table) < s.samples:
+                more = s.samples - len(st.table)
+                on_disk = _on_disk(stored - len(st.table) + have, more)
+                say(f"[database] {more} more designs of {self.sc.name}{on_disk}")
+                rows, _ = grow(self.dbf, s.samples, self._base, self._simulate, prefix="base-",
+                               covered=len(st.table))  # fmt: skip
+                st.table = pd.concat([st.table, rows.assign(origin="database")],
+                                     ignore_index=True)  # fmt: skip
+            if given is None:
+                st.table = st.table.iloc[: s.samples]
+        if self.problem.buildable:
+            st.mine_target = _buildable_target(self.sc, self.problem.target, st.table, say)
+        return True
+
+    # ------------------------------------------------------------------ 2-4. rounds
+    def search(self) -> None:
+        """Mine, verify and refine until a rule is verified, ``rounds`` refinement rounds are
+        done or the budget would be passed."""
+        r = -1
+        while r < 0 or self.more(r):
+            r += 1
+            if r:
+                self.refine(r)
+            step = self.mine(r)
+            if step is True:
+                continue
+            if step is False or self.verify(r, step):
+                break
+
+    def refine(self, r: int) -> None:
+        """New designs for round ``r``: by the settings' strategy after a round with rules,
+        around the designs meeting the target after one whose few hits could not be mined, at
+        random while none meets it."""
+        s, st = self.settings, self.state
+        with self._timed("refine"):
+            last = st.miners.get(r - 1)
+            if last is None:
+                how = around_hits if st.around == r - 1 else at_random
+            else:
+                how = STRATEGIES[s.strategy]
+            ask = RefineRequest(self.sc, s.refine, s.seed + 7919 * r, 10**6 * r,
+                                tuple(st.boxes), last and last.miner, len(st.table))  # fmt: skip
+            new = how(ask)
+            of = f"{r}/{s.rounds}" if s.rounds is not None else f"{r}"
+            self.say(f"[refine] round {of}: {s.refine} new designs{new.words}")
+            res = self._simulate(new.designs, self.dbf / f"refine-{r}-{new.key}")
+            st.table = pd.concat([st.table, res.assign(origin=f"refine-{r}")], ignore_index=True)
+
+    def mine(self, r: int) -> list | bool:
+        """Rules for the target from every design so far: the rules to verify, or True to go
+        on to the next round without any, False to stop."""
+        s, st, say, tgt = self.settings, self.state, self.say, self.state.mine_target
+        with self._timed("mine"):
+            ok = st.table.loc[~failed_rows(st.table)]
+            hits = int(tgt.evaluate(ok).sum()) if len(ok) else 0
+            if hits in (0, len(ok)):  # nothing to tell apart: no rule to mine
+                return self._nothing_to_mine(r, ok, hits)
+            say(f"[mine] round {r}: rules for {tgt} from {len(st.table)} designs")
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", FewRulesWarning)
+                    mined = mine_rules(st.table, tgt, roles=self.roles, seed=s.seed,
+                                       n_rules=s.top, max_overlap=0.5,
+                                       source=str(self.dbf))  # fmt: skip
+            except OneClassSplit:  # a few hits, all held out: look around them, as with no rule
+                note = f"no rule yet ({hits} of {len(ok)} designs meet the target, too few to mine)"
+                st.history.append(Round(r, len(ok), len(st.table) - len(ok), hits, (), note))
+                if not self.more(r):
+                    say(f"  round {r}: {note}")
+                    return False
+                st.boxes, st.around = [_box_of(ok.loc[tgt.evaluate(ok)], self.roles)], r
+                say(f"  round {r}: {note}; the next round samples around them")
+                return True
+            records = mined_rules(mined.miner, mined.test_scores)[: s.top]
+            st.miners[r] = mined
+            if records:
+                self._round_dir(r).mkdir(parents=True, exist_ok=True)
+                write_rules(self._round_dir(r) / "rules.json", records, self.sc.columns)
+        return records or self._no_rule(r, mined)
+
+    def _nothing_to_mine(self, r: int, ok: pd.DataFrame, hits: int) -> bool:
+        st, n = self.state, len(self.state.table)
+        note = (
+            f"no rule to mine: {hits} of {len(ok)} simulated designs meet "
+            f"{'the target' if hits == 0 else 'the target, all of them'}"
+        )
+        look = hits == 0 and self.more(r) and 0 < len(ok) and n < RANDOM_UP_TO
+        if look:  # a rare target: keep looking
+            note += "; the next round samples more at random"
+        elif hits == 0 and n >= RANDOM_UP_TO:
+            note += (
+                f" (fewer than 3 in {n:,} at 95 % confidence): no more rounds; "
+                "loosen the target or widen the feature ranges"
+            )
+        self.say(f"[mine] round {r}: {note}")
+        st.history.append(Round(r, len(ok), n - len(ok), hits, (), note))
+        return look
+
+    def _no_rule(self, r: int, mined) -> bool:
+        rows, failed, hits = int(len(mined.table)), int(mined.n_failed), int(mined.meets.sum())
+        if hits and self.more(r):  # a rare target: refine around the designs that meet it
+            self.state.boxes = [_box_of(mined.table.loc[mined.meets], self.roles)]
+            note = (
+                f"no rule yet ({hits} of {rows} designs meet the target); the next "
+                "round samples around them"
+            )
+        else:
+            note = (
+                f"no rule reaches the miner's precision ({hits} of {rows} designs meet the target)"
+            )
+        self.say(f"  round {r}: {note}")
+        self.state.history.append(Round(r, rows, failed, hits, (), note))
+        return bool(hits)  # nothing to refine around: more rounds would sample the same
+
+    def verify(self, r: int, records: list) -> bool:
+        """Fresh designs inside the rules worth it, best first; True when the loop stops."""
+        s, st, say = self.settings, self.state, self.say
+        with self._timed("verify"):
+            checks = self._checks(r, records)
+        ranked = [
+            VerifiedRule.of(rec, r, None if v is None else v.counts, self.sc.columns)
+            for rec, v in zip(records, checks, strict=True)
+        ]
+        for e in ranked:
+            say(
+                f"  round {r} rule {e.rank}: {e.text}  (estimate {_fmt(e.estimate)}, held-out "
+                f"{_fmt(e.test_precision)}, verified {_fmt(e.precision)})"
+            )
+        for i, v in enumerate(checks, start=1):
+            if v is not None:
+                rows = v.designs.drop(columns="meets_target").assign(origin=f"verify-{r}-{i}")
+                st.table = pd.concat([st.table, rows], ignore_index=True)
+        mined = st.miners[r]
+        st.history.append(Round(r, int(len(mined.table)), int(mined.n_failed),
+                                int(mined.meets.sum()), tuple(ranked)))  # fmt: skip
+        st.boxes = records
+        done = [e for e in ranked if e.verified is not None and rule_verified(e.verified)]
+        if s.until_verified and done and self.more(r):
+            say(f"  round {r}: rule {done[0].rank} is verified; no more rounds")
+            return True
+        if not done and not self.more(r) and (s.rounds is None or r < s.rounds):
+            say(f"  round {r}: the budget of {s.budget:,} simulations leaves no room for a round")
+        return False
+
+    def _checks(self, r: int, records: list) -> list:
+        """Each rule's verification (None: not verified), within the budget."""
+        s, st = self.settings, self.state
+        worth = _worth_verifying(records, last=not self.more(r))
+        self.say(f"[verify] round {r}: {len(worth)} of {len(records)} rule(s) (estimate >= "
+                 f"{VERIFY_FROM}), {s.verify} fresh designs each")  # fmt: skip
+        checks: list = [None] * len(records)
+        for i in worth:  # best lower estimate first; the first verified rule ends the round
+            spent = len(st.table) - st.free + sum(len(v.designs) for v in checks if v)
+            if spent + s.verify > s.budget:
+                self.say(f"  round {r}: the budget of simulations leaves no room to verify more")
+                break
+            vdir = self._round_dir(r) / "verify" / f"rule{i + 1}-{rule_key(records[i])}"
+            checks[i] = verify_rule(self.sc, records[i], st.mine_target, s.verify,
+                                    seed=s.seed + 100 * r + i + 1, folder=vdir,
+                                    **self.execution.runner())  # fmt: skip
+            st.used.update(p.parent.resolve() for p in vdir.rglob("designs.parquet"))
+            if s.until_verified and rule_verified(checks[i].counts):
+                break
+        return checks
+
+    # ------------------------------------------------------------------ 5. choose
+    def choose(self) -> tuple[Answer, pd.DataFrame]:
+        """From everything simulated in the folder (earlier runs too): the answer and the
+        table it indexes."""
+        p, st, say = self.problem, self.state, self.say
+        with self._timed("choose"):
+            earlier = _earlier_rows(self.sc, [self.dbf, self.out / "rounds"], st.used)
+            everything = st.table
+            if earlier is not None:
+                everything = pd.concat([st.table, earlier], ignore_index=True)
+                say(f"[choose] {len(earlier)} designs simulated by earlier runs in {self.out} "
+                    "join the candidates")  # fmt: skip
+            buildable = ", thick panels not overlapping" if p.buildable else ""
+            say(f"[choose] {p.objective.words}{buildable}")
+            rules = [r for h in st.history for r in h.rules]
+            answer = choose(everything, p.target, p.objective, rules,
+                            allow_overlap=p.allow_overlap)  # fmt: skip
+            everything = everything.reset_index(drop=True)
+        say(f"  {answer.headline}")
+        return answer, everything
+
+    # ------------------------------------------------------------------ 6. files
+    def write(self, answer: Answer, everything: pd.DataFrame, ledger: _Ledger) -> DesignOutcome:
+        """``design.json``, ``designs.parquet``, the chosen design's files and the report."""
+        p, st, sc, out = self.problem, self.state, self.sc, self.out
+        pick = partial(_pick, sc, everything, tgt=p.target)
+        summary = DesignSummary(
+            scenario=_scenario_summary(sc),
+            target=str(p.target),
+            mined_target=str(st.mine_target),
+            objective=str(p.objective),
+            allow_overlap=p.allow_overlap,
+            answer=answer.kind,
+            headline=_headline(answer, st.pilot),
+            chosen=pick(answer.chosen),
+            alternatives=tuple(pick(c) for c in answer.alternatives),
+            rounds=tuple(st.history),
+            database=_counts(everything, self.dbf, out),
+            pilot=st.pilot,
+            distributions=tuple(distributions(everything, _target_columns(sc, p.target,
+                                                                          p.objective))),
+        )  # fmt: skip
+        write_table(everything, out / "designs.parquet")
+        if self.output.files and answer.chosen is not None:
+            with self._timed("files"):
+                summary = self._files(summary, answer, everything)
+        summary = _replace(summary, timings=ledger.timings(st.times))
+        write_json(out / "design.json", summary.to_json())
+        ledger.append(st.times)
+        if self.output.files:
+            from holofold.design.report_page import write_report_page
+
+            write_report_page(out, summary)
+        _check_own_summary(out, summary.to_json())
+        _say_chosen(self.say, summary, p.target, out, sc.columns)
+        if summary.fabrication is not None:
+            self.say(f"part: {summary.fabrication.line()}")
+        return DesignOutcome(summary, everything, out)
+
+    def _files(self, summary: DesignSummary, answer: Answer, everything) -> DesignSummary:
+        sc, f = self.sc, self.output
         what = (
             "fabrication files, "
             if sc.write_files is not None
             else f"(no fabrication files for scenario {sc.name!r}) "
         )
-        say(f"[files] {what}pictures, 3D view and report.html")
+        self.say(f"[files] {what}pictures, 3D view and report.html")
         row = everything.loc[answer.chosen.label]
-        rule = answer.chosen.rule
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            extra = _write_files(
-                sc, row, out, rule, miners, everything, tgt, mesh_units, bed, answer.chosen, cutter
-            )
+            extra = _write_files(sc, row, self.out, answer.chosen.rule, self.state.miners,
+                                 everything, self.problem.target, f.mesh_units, self.problem.bed,
+                                 answer.chosen, f.cutter)  # fmt: skip
         notes = list(dict.fromkeys(str(w.message) for w in caught))
         for w in notes:
-            say(f"  note: {w}")
-        summary = _replace(summary, warnings=tuple(notes), **extra)
-        times["files"] = time.perf_counter() - t0
-    summary = _replace(summary, timings=ledger.timings(times))
-    write_json(out / "design.json", summary.to_json())
-    ledger.append(times)
-    if files:
-        from holofold.design.report_page import write_report_page
+            self.say(f"  note: {w}")
+        return _replace(summary, warnings=tuple(notes), **extra)
 
-        write_report_page(out, summary)
-    _check_own_summary(out, summary.to_json())
-    _say_chosen(say, summary, tgt, out, sc.columns)
-    if summary.fabrication is not None:
-        say(f"part: {summary.fabrication.line()}")
-    return DesignOutcome(summary, everything, out)
+
+def _pilot_info(table: pd.DataFrame, tgt, say) -> dict:
+    """The pilot's verdict for the summary (and the line saying why it stops the run)."""
+    hits, unmet, stop = _pilot_verdict(table, tgt)
+    if stop is not None:
+        say(f"  pilot: {stop} ({len(table)} designs); stopping before the rest")
+    return {
+        "rows": int(len(table)),
+        "meeting": hits,
+        "stopped": stop is not None,
+        "reason": stop or "",
+        "unmet": unmet,
+    }
 
 
 def _headline(answer: Answer, pilot: Mapping | None) -> str:
@@ -733,195 +842,6 @@ def _pick(sc: Scenario, table: pd.DataFrame, c: Candidate | None, tgt) -> Pick |
         objective=_clean(c.score),
         rule=c.rule,
     )
-
-
-def _rounds(
-    sc,
-    tgt,
-    roles,
-    table,
-    out,
-    dbf,
-    simulate,
-    *,
-    rounds,
-    budget,
-    free,
-    refine,
-    verify,
-    top,
-    strategy,
-    until_verified,
-    seed,
-    workers,
-    progress,
-    times,
-    used,
-    say,
-):
-    """Stages 2-4: mine, verify and refine until a rule is verified, ``rounds`` refinement
-    rounds are done or ``budget`` simulations would be passed (the first ``free`` rows of
-    ``table``, a given database's, cost nothing); returns the grown table, the rounds and each
-    round's mined rules (round -> MinedRules)."""
-    history: list[Round] = []
-    miners: dict = {}
-    boxes: list = []
-    around = -1  # the last round whose few hits could not be mined: the next samples around
-
-    def more(r: int) -> bool:
-        """Another refinement round after round ``r`` is allowed and fits the budget."""
-        capped = rounds is not None and r >= rounds
-        return not capped and len(table) - free + refine + verify <= budget
-
-    r = -1
-    while r < 0 or more(r):
-        r += 1
-        of = f"{r}/{rounds}" if rounds is not None else f"{r}"
-        rdir = out / "rounds" / f"round-{r}"
-        if r:
-            t0 = time.perf_counter()
-            s = seed + 7919 * r
-            if r - 1 not in miners and around == r - 1:  # too few hits to mine: around them
-                say(f"[refine] round {of}: {refine} new designs around the designs "
-                    "that meet the target")  # fmt: skip
-                key = _key("around-hits", [rule_key(b) for b in boxes], refine, s)
-                new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
-            elif r - 1 not in miners:  # no design met the target yet: more at random
-                say(f"[refine] round {of}: {refine} new designs at random (none met "
-                    "the target yet)")  # fmt: skip
-                key = _key("random", refine, s)
-                new = sample_designs(sc, refine, seed=s, start=10**6 * r)
-            elif strategy == "mixed":
-                say(f"[refine] round {of}: {refine} new designs, half where the forest votes "
-                    "for the target, half inside the best rule")  # fmt: skip
-                key = _key("mixed", [rule_key(b) for b in boxes], len(table), refine, s)
-                half = refine // 2
-                vote = likely_designs(sc, miners[r - 1].miner, refine - half, seed=s,
-                                      start=10**6 * r)  # fmt: skip
-                inside = refine_designs(sc, boxes[:1], half, seed=s, widen=0.0,
-                                        start=10**6 * r + refine - half)  # fmt: skip
-                new = pd.concat([vote, inside], ignore_index=True)
-            elif strategy == "likely":
-                say(f"[refine] round {of}: {refine} new designs where the forest votes "
-                    "for the target")  # fmt: skip
-                key = _key("likely", [rule_key(b) for b in boxes], len(table), refine, s)
-                new = likely_designs(sc, miners[r - 1].miner, refine, seed=s, start=10**6 * r)
-            else:
-                say(f"[refine] round {of}: {refine} new designs inside and around the "
-                    "rules")  # fmt: skip
-                key = _key([rule_key(b) for b in boxes], refine, s)
-                new = refine_designs(sc, boxes, refine, seed=s, start=10**6 * r)
-            res = simulate(new, dbf / f"refine-{r}-{key}")
-            table = pd.concat([table, res.assign(origin=f"refine-{r}")], ignore_index=True)
-            times["refine"] += time.perf_counter() - t0
-        t0 = time.perf_counter()
-        ok = table.loc[~failed_rows(table)]
-        hits = int(tgt.evaluate(ok).sum()) if len(ok) else 0
-        if hits in (0, len(ok)):  # nothing to tell apart: no rule to mine
-            note = (
-                f"no rule to mine: {hits} of {len(ok)} simulated designs meet "
-                f"{'the target' if hits == 0 else 'the target, all of them'}"
-            )
-            look = hits == 0 and more(r) and 0 < len(ok) and len(table) < RANDOM_UP_TO
-            if look:  # a rare target: keep looking
-                note += "; the next round samples more at random"
-            elif hits == 0 and len(table) >= RANDOM_UP_TO:
-                note += (
-                    f" (fewer than 3 in {len(table):,} at 95 % confidence): no more rounds; "
-                    "loosen the target or widen the feature ranges"
-                )
-            say(f"[mine] round {r}: {note}")
-            history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
-            times["mine"] += time.perf_counter() - t0
-            if look:
-                continue
-            break
-        say(f"[mine] round {r}: rules for {tgt} from {len(table)} designs")
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", FewRulesWarning)
-                mined = mine_rules(
-                    table, tgt, roles=roles, seed=seed, n_rules=top, max_overlap=0.5,
-                    source=str(dbf),
-                )  # fmt: skip
-        except OneClassSplit:  # a few hits, all held out: look around them, as with no rule
-            note = f"no rule yet ({hits} of {len(ok)} designs meet the target, too few to mine)"
-            times["mine"] += time.perf_counter() - t0
-            history.append(Round(r, len(ok), len(table) - len(ok), hits, (), note))
-            if not more(r):
-                say(f"  round {r}: {note}")
-                break
-            boxes, around = [_box_of(ok.loc[tgt.evaluate(ok)], roles)], r
-            say(f"  round {r}: {note}; the next round samples around them")
-            continue
-        records = mined_rules(mined.miner, mined.test_scores)[:top]
-        miners[r] = mined
-        if records:
-            rdir.mkdir(parents=True, exist_ok=True)
-            write_rules(rdir / "rules.json", records, sc.columns)
-        times["mine"] += time.perf_counter() - t0
-        rows, failed = int(len(mined.table)), int(mined.n_failed)
-        hits = int(mined.meets.sum())
-        if not records:
-            if hits and more(r):  # a rare target: refine around the designs that meet it
-                boxes = [_box_of(mined.table.loc[mined.meets], roles)]
-                note = (
-                    f"no rule yet ({hits} of {rows} designs meet the target); the next "
-                    "round samples around them"
-                )
-            else:
-                note = (
-                    f"no rule reaches the miner's precision ({hits} of {rows} designs meet "
-                    "the target)"
-                )
-            say(f"  round {r}: {note}")
-            history.append(Round(r, rows, failed, hits, (), note))
-            if not hits:
-                break  # nothing to refine around: more rounds would sample the same
-            continue
-        t0 = time.perf_counter()
-        worth = _worth_verifying(records, last=not more(r))
-        say(f"[verify] round {r}: {len(worth)} of {len(records)} rule(s) (estimate >= "
-            f"{VERIFY_FROM}), {verify} fresh designs each")  # fmt: skip
-        checks: list = [None] * len(records)
-        for i in worth:  # best lower estimate first; the first verified rule ends the round
-            spent = len(table) - free + sum(len(v.designs) for v in checks if v)
-            if spent + verify > budget:
-                say(f"  round {r}: the budget of simulations leaves no room to verify more")
-                break
-            rec = records[i]
-            vdir = rdir / "verify" / f"rule{i + 1}-{rule_key(rec)}"
-            checks[i] = verify_rule(sc, rec, tgt, verify, seed=seed + 100 * r + i + 1,
-                                    folder=vdir, workers=workers, progress=progress)  # fmt: skip
-            used.update(p.parent.resolve() for p in vdir.rglob("designs.parquet"))
-            if until_verified and rule_verified(checks[i].counts):
-                break
-        times["verify"] += time.perf_counter() - t0
-        ranked = [
-            VerifiedRule.of(rec, r, None if v is None else v.counts, sc.columns)
-            for rec, v in zip(records, checks, strict=True)
-        ]
-        for e in ranked:
-            say(
-                f"  round {r} rule {e.rank}: {e.text}  (estimate {_fmt(e.estimate)}, held-out "
-                f"{_fmt(e.test_precision)}, verified {_fmt(e.precision)})"
-            )
-        for i, v in enumerate(checks, start=1):
-            if v is None:
-                continue
-            table = pd.concat(
-                [table, v.designs.drop(columns="meets_target").assign(origin=f"verify-{r}-{i}")],
-                ignore_index=True,
-            )
-        history.append(Round(r, rows, failed, hits, tuple(ranked)))
-        boxes = records
-        done = [e for e in ranked if e.verified is not None and rule_verified(e.verified)]
-        if until_verified and done and more(r):
-            say(f"  round {r}: rule {done[0].rank} is verified; no more rounds")
-            break
-        if not done and not more(r) and (rounds is None or r < rounds):
-            say(f"  round {r}: the budget of {budget:,} simulations leaves no room for a round")
-    return table, history, miners
 
 
 def rule_verified(counts) -> bool:

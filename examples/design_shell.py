@@ -52,9 +52,10 @@ def main(out: Path, samples: int) -> dict:
     fit, check = fit_dome(out)
     # centred thick panels of most designs meet where the folds close (the overlap column): the
     # designer accepts that here (offset panels, docs/fabrication.md, would avoid it)
-    outcome = run_design(HERE / "my_shell.toml", TARGET, out / "design", samples=samples,
-                         verify=10, top=2, rounds=0, workers=2, progress=False, say=print,
-                         allow_overlap=True)  # fmt: skip
+    problem = hf.design.DesignProblem(HERE / "my_shell.toml", TARGET, allow_overlap=True)
+    settings = hf.design.LoopSettings(samples=samples, verify=10, top=2, rounds=0)
+    execution = hf.design.Execution(workers=2, progress=False, say=print)
+    outcome = run_design(problem, folder=out / "design", settings=settings, execution=execution)
     # the chosen design, simulated again from its features alone
     sc = hf.design.read_scenario(HERE / "my_shell.toml")
     again = sc.evaluate(outcome.features)

@@ -30,7 +30,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "write_fabrication_set",
             "export_pattern_files",
         ],
-        "cutter": ["CutterProfile", "CutterOptions", "PROFILES", "DEFAULT_PROFILE", "get_profile"],
+        "cutter": [
+            "CutterProfile",
+            "CutterOptions",
+            "PROFILES",
+            "DEFAULT_PROFILE",
+            "get_profile",
+            "register_profile",
+        ],
         "dxf": ["DXF_LAYERS", "export_dxf"],
         "thick": [
             "TECHNIQUES",
@@ -50,7 +57,9 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "family_names",
             "get_family",
             "register_family",
+            "FAMILIES",
         ],
+        "registry": ["Registry"],
         "fold_io": ["export_fold", "fold_dict", "load_fold", "read_fold", "FoldWarning"],
         "fold_frames": ["fold_path_dict", "export_fold_path"],
         "gripper": [

@@ -35,6 +35,7 @@ import numpy as np
 
 from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.registry import Registry
 
 __all__ = [
     "Stroke",
@@ -46,6 +47,7 @@ __all__ = [
     "cutter_drawing",
     "dashes",
     "get_profile",
+    "register_profile",
     "CutterOptions",
 ]
 
@@ -96,7 +98,15 @@ class CutterProfile:
         object.__setattr__(self, "layers", tuple(order))
 
 
-PROFILES: dict[str, CutterProfile] = {
+def _check_profile(name, profile) -> CutterProfile:
+    if not isinstance(profile, CutterProfile):
+        raise TypeError(f"expected a CutterProfile, got {type(profile).__name__}")
+    if profile.name != name:
+        raise ValueError(f"cutter profile {profile.name!r} registered as {name!r}")
+    return profile
+
+
+_BUILTIN_PROFILES = {
     "origami-simulator": CutterProfile(
         "origami-simulator",
         {
@@ -145,6 +155,15 @@ PROFILES: dict[str, CutterProfile] = {
         "ScanNCut; other drag-knife plotters",
     ),
 }
+#: name -> profile (a :class:`~holofold.geometry.registry.Registry`; plug-ins from the
+#: entry-point group ``holofold.cutter_profiles``)
+PROFILES: Registry[CutterProfile] = Registry(
+    "cutter profile",
+    _BUILTIN_PROFILES,
+    group="holofold.cutter_profiles",
+    check=_check_profile,
+    error=ParameterError,
+)
 DEFAULT_PROFILE = "origami-simulator"
 
 
@@ -152,9 +171,13 @@ def get_profile(name: str | CutterProfile) -> CutterProfile:
     """The profile of that name (one of :data:`PROFILES`), or the profile given."""
     if isinstance(name, CutterProfile):
         return name
-    if name not in PROFILES:
-        raise ParameterError(f"unknown cutter profile {name!r}; known: {', '.join(PROFILES)}")
     return PROFILES[name]
+
+
+def register_profile(profile: CutterProfile, *, replace: bool = False) -> CutterProfile:
+    """Add a cutter profile under its name (a built-in name never, a registered one only with
+    ``replace=True``); ``--profile`` and scenario files name it from then on."""
+    return PROFILES.register(profile, replace=replace)
 
 
 def dashes(p0: np.ndarray, p1: np.ndarray, dash: float, gap: float, end_gap: tuple) -> np.ndarray:

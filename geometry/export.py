@@ -23,6 +23,7 @@ from holofold.geometry.errors import ParameterError
 from holofold.geometry.mesh import MESH_UNITS
 from holofold.geometry.outputs import atomic_write
 from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.registry import Registry
 
 __all__ = ["Format", "FORMATS", "register_format", "export", "EXPORT_TYPES"]
 
@@ -54,18 +55,25 @@ class Format:
     description: str
 
 
-#: suffix -> Format
-FORMATS: dict[str, Format] = {}
-
-
-def register_format(fmt: Format) -> Format:
-    """Add ``fmt`` to :data:`FORMATS` (a suffix is registered once)."""
+def _check_format(suffix, fmt) -> Format:
+    if not isinstance(fmt, Format):
+        raise TypeError(f"format {suffix!r}: expected a Format, got {type(fmt).__name__}")
     if fmt.takes not in ("pattern", "mesh"):
         raise ValueError(f"format {fmt.suffix!r}: takes must be 'pattern' or 'mesh'")
-    if fmt.suffix in FORMATS:
-        raise ValueError(f"format {fmt.suffix!r} is already registered")
-    FORMATS[fmt.suffix] = fmt
     return fmt
+
+
+#: suffix -> Format (a :class:`~holofold.geometry.registry.Registry`; plug-ins from the
+#: entry-point group ``holofold.formats``)
+FORMATS: Registry[Format] = Registry(
+    "format", group="holofold.formats", check=_check_format, key=str.lower, error=ValueError
+)
+
+
+def register_format(fmt: Format, *, replace: bool = False) -> Format:
+    """Add ``fmt`` to :data:`FORMATS` (a taken suffix only with ``replace=True``; a built-in
+    one never)."""
+    return FORMATS.register(fmt, fmt.suffix, replace=replace)
 
 
 def _fold(obj, unit, **kw):
@@ -114,10 +122,10 @@ for _fmt in (
     Format("ply", "mesh", None, _mesh_writer("ply"), "binary PLY surface"),
     Format("glb", "mesh", "m", _glb, "binary glTF 2.0 (metres, as glTF requires)"),
 ):
-    register_format(_fmt)
+    FORMATS.register(_fmt, _fmt.suffix, builtin=True)
 
 #: the built-in suffixes (:data:`FORMATS` holds any registered later too)
-EXPORT_TYPES = tuple(FORMATS)
+EXPORT_TYPES = FORMATS.builtin_names()
 
 
 def export(

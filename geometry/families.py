@@ -23,11 +23,13 @@ from dataclasses import dataclass, field
 
 from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.pattern import MAX_PANELS, CreasePattern
+from holofold.geometry.registry import Registry
 
 __all__ = [
     "Parameter",
     "PatternFamily",
     "ENTRY_POINT_GROUP",
+    "FAMILIES",
     "pattern_families",
     "family_names",
     "get_family",
@@ -273,57 +275,43 @@ _BUILTIN = (
         describe=lambda v: f"file {v['path']}",
     ),
 )  # fmt: skip
-_REGISTERED: dict[str, PatternFamily] = {f.name: f for f in _BUILTIN}
 
 
-def _entry_points() -> dict:
-    from importlib.metadata import entry_points
+def _check_family(name, fam) -> PatternFamily:
+    if not isinstance(fam, PatternFamily):
+        raise TypeError(f"expected a PatternFamily, got {type(fam).__name__}")
+    return fam
 
-    return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+#: name -> family (a :class:`~holofold.geometry.registry.Registry`; plug-ins from the
+#: entry-point group :data:`ENTRY_POINT_GROUP`)
+FAMILIES: Registry[PatternFamily] = Registry(
+    "pattern family",
+    {f.name: f for f in _BUILTIN},
+    group=ENTRY_POINT_GROUP,
+    check=_check_family,
+    error=ParameterError,
+)
 
 
 def family_names() -> tuple[str, ...]:
     """Every family: built-in and registered, then from entry points."""
-    names = list(_REGISTERED)
-    names += [n for n in _entry_points() if n not in names]
-    return tuple(names)
+    return FAMILIES.names()
 
 
 def get_family(name: str) -> PatternFamily:
     """The family called ``name`` (one ParameterError line naming the known ones)."""
-    if name in _REGISTERED:
-        return _REGISTERED[name]
-    eps = _entry_points()
-    if name in eps:
-        try:
-            fam = eps[name].load()
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in: say which
-            raise ParameterError(
-                f"pattern family {name!r} (entry point {eps[name].value}) cannot be loaded: "
-                f"{type(exc).__name__}: {exc}"
-            ) from None
-        if not isinstance(fam, PatternFamily):
-            raise ParameterError(f"entry point {eps[name].value} is not a PatternFamily")
-        return fam
-    raise ParameterError(f"unknown pattern family {name!r}; known: {', '.join(family_names())}")
+    return FAMILIES[name]
 
 
 def pattern_families() -> dict[str, PatternFamily]:
     """name -> family of every family that loads."""
-    out = {}
-    for n in family_names():
-        try:
-            out[n] = get_family(n)
-        except ParameterError:
-            continue
-    return out
+    return FAMILIES.loaded()
 
 
-def register_family(family: PatternFamily) -> PatternFamily:
-    """Add a family at run time; a built-in name cannot be taken."""
+def register_family(family: PatternFamily, *, replace: bool = False) -> PatternFamily:
+    """Add a family at run time; a built-in name cannot be taken, a registered one only with
+    ``replace=True``."""
     if not isinstance(family, PatternFamily):
         raise TypeError(f"expected a PatternFamily, got {type(family).__name__}")
-    if family.name in {f.name for f in _BUILTIN}:
-        raise ValueError(f"pattern family {family.name!r} is built in; choose another name")
-    _REGISTERED[family.name] = family
-    return family
+    return FAMILIES.register(family, replace=replace)

@@ -29,6 +29,7 @@ import numpy as np
 
 from holofold.geometry.errors import FormatError, ParameterError
 from holofold.geometry.pattern import MAX_PANELS, CreasePattern
+from holofold.geometry.registry import Registry
 
 __all__ = [
     "PatternWarning",
@@ -97,26 +98,40 @@ def _cp(path, **kw):
     return read_cp_pattern(path, **kw)
 
 
-#: suffix -> reader
-READERS: dict[str, PatternReader] = {
-    ".fold": PatternReader(".fold", "FOLD 1.2", _fold, ("frame", "unit", "split")),
-    ".svg": PatternReader(
-        ".svg", "SVG (Origami Simulator colours)", _svg, ("tol", "unit", "split", "curves")
-    ),
-    ".dxf": PatternReader(
-        ".dxf", "DXF (layers or colours)", _dxf, ("tol", "unit", "split", "curves")
-    ),
-    ".opx": PatternReader(".opx", "ORIPA", _opx, ("tol", "unit", "split")),
-    ".cp": PatternReader(".cp", "ORIPA/Oriedita lines", _cp, ("tol", "unit", "split")),
-}
-
-
-def register_reader(reader: PatternReader) -> PatternReader:
-    """Add (or replace) the reader of ``reader.suffix``."""
-    if not reader.suffix.startswith(".") or len(reader.suffix) < 2:
-        raise ValueError(f"suffix {reader.suffix!r} must look like '.ext'")
-    READERS[reader.suffix.lower()] = reader
+def _check_reader(suffix, reader) -> PatternReader:
+    if not isinstance(reader, PatternReader):
+        raise TypeError(f"reader {suffix!r}: expected a PatternReader, got {type(reader).__name__}")
+    if not str(suffix).startswith(".") or len(suffix) < 2:
+        raise ValueError(f"suffix {suffix!r} must look like '.ext'")
     return reader
+
+
+#: suffix -> reader (a :class:`~holofold.geometry.registry.Registry`; plug-ins from the
+#: entry-point group ``holofold.readers``)
+READERS: Registry[PatternReader] = Registry(
+    "crease-pattern reader",
+    {
+        ".fold": PatternReader(".fold", "FOLD 1.2", _fold, ("frame", "unit", "split")),
+        ".svg": PatternReader(
+            ".svg", "SVG (Origami Simulator colours)", _svg, ("tol", "unit", "split", "curves")
+        ),
+        ".dxf": PatternReader(
+            ".dxf", "DXF (layers or colours)", _dxf, ("tol", "unit", "split", "curves")
+        ),
+        ".opx": PatternReader(".opx", "ORIPA", _opx, ("tol", "unit", "split")),
+        ".cp": PatternReader(".cp", "ORIPA/Oriedita lines", _cp, ("tol", "unit", "split")),
+    },
+    group="holofold.readers",
+    check=_check_reader,
+    key=str.lower,
+    error=FormatError,
+)
+
+
+def register_reader(reader: PatternReader, *, replace: bool = False) -> PatternReader:
+    """Add the reader of ``reader.suffix`` (a taken suffix only with ``replace=True``; a
+    built-in one never)."""
+    return READERS.register(reader, reader.suffix, replace=replace)
 
 
 def reader_for(path) -> PatternReader:

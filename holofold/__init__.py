@@ -28,17 +28,42 @@ database and mine a rule from it.
 >>> sheet = hf.miura_sheet(4, 4, a=0.02, b=0.02, gamma=1.0, ext=0.6)  # m, rad
 >>> sheet.n_vertices, sheet.n_faces
 (25, 16)
+
+The design loop is asked with three records, each checked when made: what you want
+(:class:`DesignProblem`), how it searches (:class:`LoopSettings`) and how it runs
+(:class:`Execution`); ``hf.run_design(problem, folder=..., settings=..., execution=...)`` then
+writes the chosen design, its files and ``report.html`` (docs/scenarios.md §9).
+
+>>> problem = hf.DesignProblem("arch", "Zstiff > 100 & error < 0.1", objective="min tpanel")
+>>> problem.target.columns, problem.objective.column
+(('Zstiff', 'error'), 'tpanel')
+>>> hf.LoopSettings(samples=200, budget=1000, strategy="mixed").budget
+1000
+>>> hf.LoopSettings(samples=10)
+Traceback (most recent call last):
+ValueError: samples = 10 must be an integer >= 20
+
+Everything else is on the layer faces (``hf.geometry``, ``hf.fitting``, ``hf.mechanics``,
+``hf.design``); extending holofold (a reader, a format, a pattern family, a scenario kind, a
+cutter profile, a refinement strategy) is described in CONTRIBUTING.md.
 """
 
 import lazy_loader
 
 #: the four layers, and the names a user needs first by the layer whose face offers them
-#: (each imported on first use)
+#: (each imported on first use; at most about 40: the layer faces keep the rest)
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submodules=["geometry", "fitting", "mechanics", "design"],
     submod_attrs={
-        "geometry": ["CreasePattern", "miura_sheet", "tmp_sheet", "export"],
+        "geometry": [
+            "CreasePattern",
+            "miura_sheet",
+            "tmp_sheet",
+            "read_pattern",
+            "export",
+            "CutterOptions",
+        ],
         "fitting": [
             "builtin_curve",
             "load_curve",
@@ -58,7 +83,12 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "mine_rules",
             "verify_rules",
             "run_design",
+            "DesignProblem",
+            "LoopSettings",
+            "Execution",
             "load_scenario",
+            "read_scenario",
+            "parse_target",
         ],
     },
 )

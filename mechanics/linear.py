@@ -19,6 +19,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg.lapack import dgetrf, dgetrs, dpbtrf, dpbtrs
 
 from holofold.mechanics.sparsity import ReducedPattern
+from holofold.mechanics.status import SingularSystemError
 
 __all__ = [
     "SingularSystemError",
@@ -60,10 +61,6 @@ SOLVER_PATHS = {
 
 NON_FINITE = "non-finite solution of the linear system (singular stiffness)"
 SINGULAR = "singular stiffness matrix (Singular matrix)"
-
-
-class SingularSystemError(RuntimeError):
-    """The reduced tangent stiffness could not be factorised or solved."""
 
 
 def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:

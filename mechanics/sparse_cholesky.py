@@ -37,7 +37,7 @@ import weakref
 import numpy as np
 
 from holofold.geometry.errors import EnvironmentFault
-from holofold.mechanics.linear import SingularSystemError
+from holofold.mechanics.status import SingularSystemError
 
 __all__ = ["SparseCholesky", "CholeskyFactor", "available", "INSTALL_HINT", "METIS_MIN_DOF"]
 

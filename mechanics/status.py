@@ -21,7 +21,19 @@ from enum import Enum
 
 import numpy as np
 
-__all__ = ["Outcome", "Status", "CONVERGED", "failed_mask", "converged_mask"]
+__all__ = [
+    "Outcome",
+    "Status",
+    "CONVERGED",
+    "failed_mask",
+    "converged_mask",
+    "SingularSystemError",
+]
+
+
+class SingularSystemError(RuntimeError):
+    """The reduced tangent stiffness could not be factorised or solved (a failed solve; here,
+    below the linear algebra, so every solver path raises the one class)."""
 
 
 class Outcome(Enum):

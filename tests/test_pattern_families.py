@@ -15,9 +15,9 @@ from holofold.geometry import ParameterError, families
 
 
 @pytest.fixture
-def clean(monkeypatch):
-    monkeypatch.setattr(families, "_REGISTERED", dict(families._REGISTERED))
-    return families
+def clean():
+    with families.FAMILIES.saved():  # families registered by a test are gone after it
+        yield families
 
 
 def test_builtin_families_make_the_generators_patterns():

@@ -29,9 +29,9 @@ def _toy_from_config(doc, name, description):
 
 
 @pytest.fixture
-def clean_registry(monkeypatch):
-    monkeypatch.setattr(registry, "_REGISTERED", {})
-    return registry
+def clean_registry():
+    with registry.KINDS.saved():  # kinds registered by a test are gone after it
+        yield registry
 
 
 def _write(tmp_path, text):

@@ -17,6 +17,7 @@ from holofold.design.scenarios.files import (
     shipped_text,
 )
 from holofold.design.scenarios.kinds import (
+    KINDS,
     ScenarioKind,
     get_kind,
     kind_names,
@@ -40,6 +41,7 @@ __all__ = [
     "get_kind",
     "kind_names",
     "register_kind",
+    "KINDS",
     "scenario_kinds",
 ]
 

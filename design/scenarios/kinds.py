@@ -30,9 +30,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
 
+from holofold.geometry import Registry
+
 __all__ = [
     "ScenarioKind",
     "ENTRY_POINT_GROUP",
+    "KINDS",
     "BUILTIN_KINDS",
     "scenario_kinds",
     "get_kind",
@@ -81,7 +84,6 @@ BUILTIN_KINDS = {
         "a generalised Miura-ori fitted to a target surface, folded, then loaded",
     ),
 }
-_REGISTERED: dict[str, ScenarioKind] = {}
 
 
 def _from_module(name: str, module: ModuleType, description: str | None = None) -> ScenarioKind:
@@ -104,64 +106,50 @@ def _as_kind(name: str, obj) -> ScenarioKind:
     )
 
 
-def _entry_points() -> dict[str, object]:
-    """name -> entry point of the group (not loaded)."""
-    from importlib.metadata import entry_points
+def _check_kind(name, obj) -> ScenarioKind:
+    if not name or not str(name).replace("-", "_").isidentifier():
+        raise ValueError(f"scenario kind name {name!r} must be a word such as 'surface'")
+    return _as_kind(name, obj)
 
-    return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+def _builtin(name: str, module: str, text: str):
+    return lambda: _from_module(name, importlib.import_module(module), text)
+
+
+#: name -> kind (a :class:`~holofold.geometry.Registry`: built-in kinds imported when used,
+#: registered ones, then plug-ins of :data:`ENTRY_POINT_GROUP`)
+KINDS: Registry[ScenarioKind] = Registry(
+    "scenario kind", group=ENTRY_POINT_GROUP, check=_check_kind, error=KeyError
+)
+for _name, (_module, _text) in BUILTIN_KINDS.items():
+    KINDS.register_lazy(_name, _builtin(_name, _module, _text))
 
 
 def kind_names() -> tuple[str, ...]:
     """Every kind a file may name: built-in, registered, then from entry points."""
-    names = list(BUILTIN_KINDS)
-    names += [n for n in _REGISTERED if n not in names]
-    names += [n for n in _entry_points() if n not in names]
-    return tuple(names)
+    return KINDS.names()
 
 
 def get_kind(name: str) -> ScenarioKind:
     """The kind called ``name`` (raises ``KeyError`` naming the known kinds)."""
-    if name in BUILTIN_KINDS:
-        module, text = BUILTIN_KINDS[name]
-        return _from_module(name, importlib.import_module(module), text)
-    if name in _REGISTERED:
-        return _REGISTERED[name]
-    eps = _entry_points()
-    if name in eps:
-        try:
-            obj = eps[name].load()
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in: say which, do not crash
-            raise KeyError(
-                f"scenario kind {name!r} (entry point {eps[name].value}) cannot be loaded: "
-                f"{type(exc).__name__}: {exc}"
-            ) from None
-        return _as_kind(name, obj)
-    raise KeyError(f"unknown scenario kind {name!r}; known: {', '.join(kind_names())}")
+    return KINDS[name]
 
 
 def scenario_kinds() -> dict[str, ScenarioKind]:
     """name -> kind of every kind that loads (a plug-in that fails to load is left out)."""
-    out = {}
-    for n in kind_names():
-        try:
-            out[n] = get_kind(n)
-        except (KeyError, TypeError, ImportError):
-            continue
-    return out
+    return KINDS.loaded()
 
 
-def register_kind(kind: ScenarioKind | ModuleType, name: str | None = None) -> ScenarioKind:
+def register_kind(
+    kind: ScenarioKind | ModuleType, name: str | None = None, *, replace: bool = False
+) -> ScenarioKind:
     """Add a kind at run time (a :class:`ScenarioKind`, or a module with ``from_config``
-    registered under ``name``); returns it. A built-in name cannot be replaced."""
+    registered under ``name``); returns it. A built-in name cannot be replaced, a registered
+    one only with ``replace=True``."""
     if isinstance(kind, ModuleType):
         if not name:
             raise ValueError("register_kind(module, name): give the kind's name")
         kind = _from_module(name, kind)
     elif not isinstance(kind, ScenarioKind):
         raise TypeError(f"expected a ScenarioKind or a module, got {type(kind).__name__}")
-    if not kind.name or not kind.name.replace("-", "_").isidentifier():
-        raise ValueError(f"scenario kind name {kind.name!r} must be a word such as 'surface'")
-    if kind.name in BUILTIN_KINDS:
-        raise ValueError(f"scenario kind {kind.name!r} is built in; choose another name")
-    _REGISTERED[kind.name] = kind
-    return kind
+    return KINDS.register(kind, replace=replace)

@@ -47,7 +47,7 @@ gamma = 70 deg, extensions 0.3, 0.6, 0.9 and the loads ``bend`` (3 N in -z) and 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 
@@ -113,8 +113,30 @@ __all__ = [
 ]
 
 MIURA, TMP = MIURA_SHEET.code, TMP_SHEET.code
-#: pattern names of scenario files -> the feature's codes (the sheet families)
-PATTERNS = {f.name: code for code, f in SHEET_FAMILIES.items()}
+
+
+class _PatternCodes(Mapping):
+    """Pattern names of scenario files -> the feature's codes, read from
+    :data:`SHEET_FAMILIES` on every call (a family registered later is named too)."""
+
+    def _now(self) -> dict[str, int]:
+        return {f.name: code for code, f in SHEET_FAMILIES.items()}
+
+    def __getitem__(self, name: str) -> int:
+        return self._now()[name]
+
+    def __iter__(self):
+        return iter(self._now())
+
+    def __len__(self) -> int:
+        return len(self._now())
+
+    def __repr__(self) -> str:
+        return repr(self._now())
+
+
+#: pattern names of scenario files -> the feature's codes (the sheet families, live)
+PATTERNS: Mapping[str, int] = _PatternCodes()
 GAMMA_70 = 70.0 / 180.0 * math.pi  #: the canopy's Miura sector angle, rad
 
 #: every feature a sheet can have, with the paper's ranges (canopy; ``gama`` from data0).

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from holofold.geometry import Registry
 from holofold.geometry.families import get_family
 
 __all__ = [
@@ -220,23 +221,27 @@ TMP_SHEET = SheetFamily(
     check_setting=_tmp_setting, check_levels=_tmp_levels, shape=_tmp_shape,
 )  # fmt: skip
 
-#: code of the ``pattern`` feature -> family
-SHEET_FAMILIES: dict[int, SheetFamily] = {f.code: f for f in (MIURA_SHEET, TMP_SHEET)}
+
+def _check_sheet(code, family) -> SheetFamily:
+    if not isinstance(family, SheetFamily):
+        raise TypeError(f"expected a SheetFamily, got {type(family).__name__}")
+    if isinstance(code, bool) or not isinstance(code, int) or code != family.code:
+        raise ValueError(f"sheet family {family.name!r}: its code must be an integer, got {code!r}")
+    return family
+
+
+#: code of the ``pattern`` feature -> family (a :class:`~holofold.geometry.Registry`)
+SHEET_FAMILIES: Registry[SheetFamily] = Registry(
+    "sheet family", {f.code: f for f in (MIURA_SHEET, TMP_SHEET)}, check=_check_sheet
+)
 
 
 def sheet_family(code) -> SheetFamily | None:
-    """The family of a ``pattern`` code (None if there is none)."""
-    try:
-        return SHEET_FAMILIES.get(code)  # 1.0 finds 1; 1.5 finds nothing
-    except TypeError:  # unhashable
-        return None
+    """The family of a ``pattern`` code (None if there is none; 1.0 finds 1, 1.5 nothing)."""
+    return SHEET_FAMILIES.get(code)
 
 
-def register_sheet_family(family: SheetFamily) -> SheetFamily:
-    """Add a sheet pattern (its ``name`` must be a geometry family with ``faces``)."""
-    if family.code in SHEET_FAMILIES:
-        raise ValueError(
-            f"pattern code {family.code} is taken by {SHEET_FAMILIES[family.code].name}"
-        )
-    SHEET_FAMILIES[family.code] = family
-    return family
+def register_sheet_family(family: SheetFamily, *, replace: bool = False) -> SheetFamily:
+    """Add a sheet pattern (its ``name`` must be a geometry family with ``faces``); a built-in
+    code cannot be taken, a registered one only with ``replace=True``."""
+    return SHEET_FAMILIES.register(family, family.code, replace=replace)

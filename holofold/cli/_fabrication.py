@@ -13,14 +13,16 @@ __all__ = [
     "say_part",
 ]
 
-_PROFILES = ("origami-simulator", "laser", "cricut")
-
 
 def add_cutter_arguments(p) -> None:
-    """``--profile``, ``--dash``, ``--gap``, ``--vertex-gap`` and ``--two-sided``."""
+    """``--profile``, ``--dash``, ``--gap``, ``--vertex-gap`` and ``--two-sided`` (the
+    profiles are the registry's, :data:`holofold.geometry.PROFILES`, asked when the parser is
+    built)."""
+    from holofold.geometry import DEFAULT_PROFILE, PROFILES
+
     g = p.add_argument_group("cutter files (SVG and DXF of the flat pattern; docs/fabrication.md)")
     g.add_argument(
-        "--profile", choices=_PROFILES, default="origami-simulator",
+        "--profile", choices=tuple(PROFILES), default=DEFAULT_PROFILE,
         help="colours, strokes and layers of the SVG and DXF: origami-simulator (default: "
         "Origami Simulator's import convention), laser (red hairline cuts, blue mountain and "
         "green valley scores, dashed) or cricut (cut and score layers)",

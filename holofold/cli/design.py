@@ -91,11 +91,12 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--strategy",
-        choices=("mixed", "likely", "around"),
         default="mixed",
+        metavar="NAME",
         help="where a refinement round samples: half where the forest votes for the target and "
-        "half inside the best rule (mixed, default), all where the forest votes (likely), or "
-        "inside and around the rules (around)",
+        "half inside the best rule (mixed, default), all where the forest votes (likely), "
+        "inside and around the rules (around), or a registered strategy "
+        "(holofold.design.STRATEGIES)",
     )
     p.add_argument(
         "--all-rounds",
@@ -118,31 +119,30 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from holofold.design import PILOT, run_design
-
-    cutter = cutter_options(args)
-    out = run_design(
-        args.scenario,
-        args.target,
-        args.output,
-        samples=args.samples,
-        rounds=args.rounds,
-        budget=args.budget,
-        refine=args.refine,
-        verify=args.verify,
-        top=args.top,
-        strategy=args.strategy,
-        until_verified=not args.all_rounds,
-        db=args.db,
-        seed=args.seed,
-        workers=args.workers,
-        progress=False if args.no_progress else None,
-        mesh_units=args.units,
-        cutter=cutter,
-        objective=args.objective,
-        allow_overlap=args.allow_overlap,
-        bed=args.bed,
-        pilot=PILOT if args.pilot is None else args.pilot,
-        say=lambda text: print(text, flush=True),
+    from holofold.design import (
+        PILOT,
+        DesignFiles,
+        DesignProblem,
+        Execution,
+        LoopSettings,
+        run_design,
     )
+
+    problem = DesignProblem(
+        args.scenario, args.target, objective=args.objective, bed=args.bed,
+        allow_overlap=args.allow_overlap,
+    )  # fmt: skip
+    settings = LoopSettings(
+        samples=args.samples, rounds=args.rounds, budget=args.budget, refine=args.refine,
+        verify=args.verify, top=args.top, strategy=args.strategy,
+        until_verified=not args.all_rounds, seed=args.seed,
+        pilot=PILOT if args.pilot is None else args.pilot,
+    )  # fmt: skip
+    execution = Execution(
+        workers=args.workers, progress=False if args.no_progress else None,
+        say=lambda text: print(text, flush=True),
+    )  # fmt: skip
+    output = DesignFiles(db=args.db, mesh_units=args.units, cutter=cutter_options(args))
+    out = run_design(problem, folder=args.output, settings=settings, execution=execution,
+                     output=output)  # fmt: skip
     return 0 if out.met else 1
