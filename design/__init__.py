@@ -39,7 +39,17 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "describe_source",
             "PILOT",
         ],
-        "buildability": ["Bed", "DEFAULT_BED", "PartFit", "PrintablePart", "parse_bed", "part_fit"],
+        "buildability": [
+            "Bed",
+            "DEFAULT_BED",
+            "PartFit",
+            "PrintablePart",
+            "parse_bed",
+            "part_fit",
+            "ThicknessChoice",
+            "choose_thickness",
+            "THICK_CHOICES",
+        ],
         "batches": ["batch_spans"],
         "evaluation": [
             "holdout",

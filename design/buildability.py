@@ -18,10 +18,104 @@ from pathlib import Path
 
 from holofold.geometry import DEFAULT_BED, Bed
 
-__all__ = ["Bed", "DEFAULT_BED", "PrintablePart", "PartFit", "parse_bed", "part_fit", "FILM"]
+__all__ = [
+    "Bed",
+    "DEFAULT_BED",
+    "PrintablePart",
+    "PartFit",
+    "parse_bed",
+    "part_fit",
+    "FILM",
+    "THICK_CHOICES",
+    "THICK_CODES",
+    "ThicknessChoice",
+    "choose_thickness",
+    "thick_name",
+]
 
 #: a part thinner than this is a film to cut, not a part to print (half a 0.2 mm layer), m
 FILM = 0.1e-3
+
+#: the thickness techniques in the order ``thick = "auto"`` tries them, by column code
+THICK_CODES = {"centred": 0, "offset": 1, "tapered": 2}
+#: what a scenario's ``thick`` key takes: a technique, or "auto" (the first that folds clear)
+THICK_CHOICES = (*THICK_CODES, "auto")
+#: summed overlap of thick panels that counts as none, m^3 (0.001 mm^3; as the loop's
+#: :data:`holofold.design.choice.OVERLAP_TOLERANCE`)
+_CLEAR = 1e-12
+
+
+def thick_name(code: float) -> str:
+    """The technique of a ``thick`` column code (0 centred, 1 offset, 2 tapered)."""
+    for name, c in THICK_CODES.items():
+        if c == int(round(float(code))):
+            return name
+    raise ValueError(f"thick = {code!r} is no technique code (0 centred, 1 offset, 2 tapered)")
+
+
+@dataclass(frozen=True)
+class ThicknessChoice:
+    """How a design's panels are thickened: the technique kept, its overlap and clearance.
+
+    ``overlap`` (m^3): centred panels in the folded state (:func:`holofold.geometry.printability`);
+    offset and tapered panels the largest over the fold path
+    (:func:`holofold.geometry.thick.path_overlap`, exact intersections). ``clearance`` (m): the
+    smallest gap between panels sharing no vertex in the folded state, from the centred panels'
+    mid-surface distance less their half thicknesses; a lower bound for tapered panels (inside
+    the centred slabs: the same number) and offset ones (inside slabs twice as thick: one
+    thickness less). ``tried`` the techniques tried, in order."""
+
+    technique: str
+    overlap: float
+    clearance: float
+    tried: tuple[str, ...] = ()
+
+    @property
+    def code(self) -> int:
+        return THICK_CODES[self.technique]
+
+
+def choose_thickness(
+    state,
+    thickness: float,
+    crease_width: float,
+    *,
+    path=(),
+    thick: str = "auto",
+    no_neighbour: float = 1e3,
+) -> ThicknessChoice:
+    """The thick panels of a design folded to ``state`` (a CreasePattern with its flat layout;
+    ``path`` other states on the way from flat): with ``thick = "auto"`` centred, offset, then
+    tapered panels, the first whose panels do not overlap (by more than 0.001 mm^3; centred
+    ones also with no negative clearance: panels sharing no vertex apart), else the
+    centred ones (the measure the loop's overlap rule was calibrated on); a technique name:
+    that one. ``no_neighbour`` caps the clearance where every pair of panels shares a vertex."""
+    from holofold.geometry import printability
+    from holofold.geometry.thick import path_overlap, thick_panels
+
+    if thick not in THICK_CHOICES:
+        raise ValueError(f"thick = {thick!r}; known: {', '.join(THICK_CHOICES)}")
+    order = tuple(THICK_CODES) if thick == "auto" else (thick,)
+    p = printability(state, thickness, crease_width)
+    gap = float(min(p.clearance, no_neighbour))
+    centred = ThicknessChoice("centred", float(p.overlap), gap, ("centred",))
+    tried = []
+    for name in order:
+        tried.append(name)
+        if name == "centred":
+            got = centred
+        else:
+            try:
+                panels = thick_panels(state, thickness, crease_width, name, path=path)
+                over = path_overlap([*path, state], panels)
+            except ValueError:  # panels too small for their bevels: not this technique
+                continue
+            low = gap - (thickness if name == "offset" else 0.0) if gap < no_neighbour else gap
+            got = ThicknessChoice(name, float(over.volume.max()), low)
+        clear = got.overlap <= _CLEAR and (name != "centred" or not got.clearance < 0)
+        if clear or len(order) == 1:
+            return ThicknessChoice(got.technique, got.overlap, got.clearance, tuple(tried))
+    return ThicknessChoice("centred", centred.overlap, centred.clearance, tuple(tried))
 
 
 def _mm(v: float) -> str:
@@ -47,12 +141,29 @@ def parse_bed(text: str | Bed | tuple) -> Bed:
 @dataclass(frozen=True)
 class PrintablePart:
     """The part a design prints: its crease pattern with the flat layout, and the panel
-    thickness, hinge (crease) thickness and hinge width it is printed with, m."""
+    thickness, hinge (crease) thickness and hinge width it is printed with, m; ``thick`` the
+    thickness technique of its panels (:data:`holofold.geometry.TECHNIQUES`) and ``path`` the
+    fold states their bevels are cut for."""
 
     pattern: object
     panel_thickness: float
     crease_thickness: float
     crease_width: float
+    thick: str = "centred"
+    path: tuple = ()
+
+    def panels(self):
+        """The :class:`~holofold.geometry.ThickPanels` of ``thick`` (None: centred), bevelled
+        for the fold ``path`` (states of the pattern; a Miura sheet's own path by default)."""
+        if self.thick == "centred":
+            return None
+        from holofold.geometry.thick import miura_path, thick_panels
+
+        path = self.path
+        if not path and self.pattern.meta.get("kind") == "miura":
+            path = tuple(miura_path(self.pattern, 10))
+        return thick_panels(self.pattern, self.panel_thickness, self.crease_width, self.thick,
+                            path=path)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -147,6 +258,26 @@ class PartFit:
             f"(its length and width features). {scale}"
         )
 
+    def line(self) -> str:
+        """One line for the command line: file, extent, bed fit, pieces, print time."""
+        from holofold.geometry.bed import print_time_text
+
+        if self.film:
+            return f"{self.file}: {self.extent_text()}, a film: cut it, do not print it"
+        if self.fits:
+            verdict = f"fits the {self.bed_text} bed whole (1 piece)"
+        elif self.pieces:
+            verdict = (
+                f"does not fit the {self.bed_text} bed whole: cut into {self.pieces} pieces "
+                f"that each fit ({self.segments}/, assembly.svg)"
+            )
+        else:
+            verdict = f"does not fit the {self.bed_text} bed and is not cut ({self.problem})"
+        return (
+            f"{self.file}: {self.extent_text()}, {verdict}; print time "
+            f"{print_time_text(self.hours)}"
+        )
+
     def to_json(self) -> dict:
         return {
             "file": self.file,
@@ -158,12 +289,18 @@ class PartFit:
             "fits": self.fits,
             "turn_deg": self.turn,
             "print_hours": self.hours,
+            "print_time": "not printed: a film" if self.film else self._time_text(),
             "print_class": "not printed: a film" if self.film else self.time_class,
             "pieces": self.pieces,
             "segments": self.segments,
             "problem": self.problem,
             "advice": self.advice,
         }
+
+    def _time_text(self) -> str:
+        from holofold.geometry.bed import print_time_text
+
+        return print_time_text(self.hours)
 
     @classmethod
     def from_json(cls, d) -> PartFit:
@@ -214,7 +351,7 @@ def part_fit(
 
         try:
             seg = segment_part(part.pattern, part.panel_thickness, part.crease_thickness,
-                               part.crease_width, bed)  # fmt: skip
+                               part.crease_width, bed, panels=part.panels())  # fmt: skip
         except DegenerateGeometryError as exc:  # a cut the geometry could not make
             seg = None
             problem = f"cutting it into bed-sized pieces failed: {exc}"
@@ -226,7 +363,7 @@ def part_fit(
         elif seg is not None:
             problem = seg.problem
     elif not fit.fits:
-        problem = "the part cannot be cut into pieces here"
+        problem = "this kind of part has no flat layout to cut into pieces"
     return PartFit(rel.replace(os.sep, "/"), tuple(float(v) for v in fit.extent),
                    float(fit.volume), (bed.width, bed.depth), turn, float(fit.print_hours),
                    fit.time_class, pieces, folder.replace(os.sep, "/"), problem)  # fmt: skip

@@ -722,6 +722,8 @@ class DesignLoop:
             write_report_page(out, summary)
         _check_own_summary(out, summary.to_json())
         _say_chosen(self.say, summary, p.target, out, sc.columns)
+        if summary.fabrication is not None:
+            self.say(f"part: {summary.fabrication.line()}")
         return DesignOutcome(summary, everything, out)
 
     def _files(self, summary: DesignSummary, answer: Answer, everything) -> DesignSummary:

@@ -22,6 +22,7 @@ import base64
 import html
 import math
 import numbers
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from urllib.parse import quote
@@ -277,6 +278,23 @@ _KIND_TITLE = {
 }
 
 
+_NUMBER = re.compile(r"(?<![\w.])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
+
+
+def _condition_text(cond: str, names, cols: Mapping) -> str:
+    """A condition on one column with its numbers in the column's display unit
+    (``rms_error < 5e-05`` on a length in m: ``rms_error < 0.05 mm``), escaped; as written
+    otherwise."""
+    col = cols.get(names[0]) if len(names) == 1 else None
+    if col is None or not getattr(col, "unit", "") or col.unit == "-":
+        return _esc(cond)
+    out, last = [], 0
+    for m in _NUMBER.finditer(cond):
+        out += [_esc(cond[last : m.start()]), _shown(float(m.group(0)), col)]
+        last = m.end()
+    return "".join(out) + _esc(cond[last:])
+
+
 def _condition_rows(pick: Pick, target: str, cols: Mapping) -> list:
     """Per target condition: the chosen design's value, its margin and met / missed."""
     rows = []
@@ -301,7 +319,7 @@ def _condition_rows(pick: Pick, target: str, cols: Mapping) -> list:
             )
         rows.append(
             [
-                f"<code>{_esc(cond)}</code>",
+                f"<code>{_condition_text(cond, names, cols)}</code>",
                 (value, "num"),
                 (margin, "num"),
                 _margin_bar(m) if math.isfinite(m) else "",
@@ -337,13 +355,13 @@ def _fabrication(summary: DesignSummary) -> str:
             f"<code>{_esc(f.segments)}/segment_01.stl</code> ... "
             f"<code>segment_{f.pieces:02d}.stl</code>, each placed on the bed.</p>"
         )
-    from holofold.geometry.bed import INFILL, PRINT_RATE, SOLID_SKIN
+    from holofold.geometry.bed import INFILL, PRINT_RATE, SOLID_SKIN, print_time_text
 
     return (
         '<div class="card" id="part"><h3>The part to print</h3>'
         f'<p><a href="{href}">{_esc(f.file)}</a>: <b>{_esc(f.extent_text())}</b>; {verdict}.</p>'
         f"<p>{_esc(f.advice)}</p>{pieces}"
-        f"<p>Print time: <b>{_esc(f.time_class)}</b> (about {f.hours:.2g}&nbsp;h: the volume "
+        f"<p>Print time: <b>{_esc(print_time_text(f.hours))}</b> ({_esc(f.time_class)}: the volume "
         f"a slicer deposits, solid to {SOLID_SKIN * 1e3:g}&nbsp;mm and {INFILL:.0%} infill "
         f"above, at {PRINT_RATE * 1e9:g}&nbsp;mm<sup>3</sup>/s, calibrated with PrusaSlicer; "
         "the slicer gives the real time)."

@@ -113,6 +113,11 @@ class PatternSetting:
         Largest rest-angle change per fold step, degrees.
     collisions : bool
         Check the folded thick panels for collisions.
+    thick : str
+        The thickness technique of the panels checked (``"centred"``, ``"offset"``,
+        ``"tapered"``) or ``"auto"`` (default): the first of them that folds without overlap
+        (:func:`holofold.design.buildability.choose_thickness`, over up to four states of the
+        fold path).
     """
 
     material: Material = field(default_factory=lambda: get_material("pp"))
@@ -128,6 +133,7 @@ class PatternSetting:
     max_iter: int = 30
     max_step_deg: float = 3.0
     collisions: bool = True
+    thick: str = "auto"
 
     def __post_init__(self):
         if isinstance(self.material, str):
@@ -181,6 +187,7 @@ class PatternSimulation:
     clearance: float | None
     closest: tuple[int, int] | None
     seconds: float
+    thick: str = "centred"
 
     @property
     def folded(self) -> CreasePattern:
@@ -189,8 +196,21 @@ class PatternSimulation:
 
     @property
     def collision(self) -> bool:
-        """Thick panels that share no vertex run into each other in the folded state."""
+        """Thick panels that share no vertex run into each other in the folded state (centred
+        panels: a negative clearance; offset and tapered ones: any overlap along the path)."""
+        if self.thick != "centred":
+            return bool(self.overlap is not None and self.overlap > 1e-12)
         return bool(self.clearance is not None and self.clearance < 0)
+
+    @property
+    def panel_bending(self) -> float:
+        """The largest bend of a panel in the last state, degrees: |fold angle| over the
+        panels' own lines (F and J edges inside the sheet: a facet or a triangulation line)."""
+        p = self.fold.pattern
+        inside = np.isin(p.assignment, ("F", "J")) & p.interior
+        if not inside.any():
+            return 0.0
+        return float(np.abs(np.asarray(self.fold.fold_angles[-1], float)[inside]).max())
 
     @property
     def status(self) -> Status:
@@ -203,7 +223,19 @@ class PatternSimulation:
         f = self.fold
         text = f"{f.verdict}: reached {100 * f.reached:.0f} % of {100 * f.requested:.0f} % "
         text += f"(fold progress {100 * f.progress:.0f} %); {f.note}"
-        if self.clearance is not None and self.clearance < 0:
+        bend = self.panel_bending
+        if bend > 5.0:
+            text += (
+                f"; panels bend by up to {bend:.0f} deg across their facet lines (the pattern "
+                "does not fold with flat panels)"
+            )
+        if self.thick != "centred":
+            text += (
+                f"; {self.thick} panels fold without collision"
+                if not self.collision
+                else f"; {self.thick} panels overlap by {1e9 * self.overlap:.3g} mm^3"
+            )
+        elif self.clearance is not None and self.clearance < 0:
             a, b = self.closest or (-1, -1)
             text += (
                 f"; collision: thick panels {a} and {b} run into each other (clearance "
@@ -293,6 +325,7 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
                     LoadOutcome(ld.name, math.nan, math.nan, Status.from_exception(exc))
                 )
     overlap = clearance = closest = None
+    thick = "centred"
     if s.collisions:
         from holofold.geometry import printability
 
@@ -301,10 +334,23 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
             overlap, clearance, closest = pr.overlap, pr.clearance, pr.closest
         except ValueError:  # panels too small for the crease width: no thick panels
             pass
+        clash = overlap is not None and (overlap > 1e-12 or (clearance or 0.0) < 0)
+        if overlap is not None and (s.thick not in ("auto", "centred")
+                                    or (s.thick == "auto" and clash)):  # fmt: skip
+            from holofold.design.buildability import choose_thickness
+
+            k = len(fold.coords)
+            way = [fold.folded(int(i)) for i in np.unique(np.linspace(0, k - 1, 5).round())[1:-1]]
+            try:
+                got = choose_thickness(fold.folded(), s.panel_thickness, s.crease_width,
+                                       path=way, thick=s.thick, no_neighbour=math.inf)  # fmt: skip
+                overlap, clearance, thick = got.overlap, got.clearance, got.technique
+            except ValueError:
+                pass
     return PatternSimulation(
         pattern=pattern, setting=s, fold=fold, loads=tuple(outcomes),
         mass=pattern_mass(pattern, s), overlap=overlap, clearance=clearance, closest=closest,
-        seconds=time.perf_counter() - t0,
+        seconds=time.perf_counter() - t0, thick=thick,
     )  # fmt: skip
 
 
@@ -393,6 +439,8 @@ def _summary(sim: PatternSimulation) -> dict:
         ],  # fmt: skip
         "mass_kg": sim.mass,
         "overlap_m3": sim.overlap,
+        "thick": sim.thick,
+        "panel_bending_deg": sim.panel_bending,
         "clearance_m": _num(sim.clearance) if sim.clearance is not None else None,
         "seconds": sim.seconds,
     }

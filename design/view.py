@@ -16,6 +16,7 @@ drawn (for tests in a headless browser).
 
 from __future__ import annotations
 
+import html
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -52,7 +53,9 @@ class DesignView:
     supports : (ns,) int
     loads : tuple of Load
     curve : (P, 3) float or None
-        The target curve, drawn over every frame.
+        The target curve (or a surface's grid lines as one polyline), drawn over every frame.
+    curve_name : str
+        What the legend calls it ("target curve", "target surface").
     scalar : (K, nv) float or None
         A value per vertex and frame, coloured (``scalar_name`` in ``scalar_unit``).
     facts : tuple of (str, str)
@@ -67,6 +70,7 @@ class DesignView:
     supports: np.ndarray = field(default_factory=lambda: np.zeros(0, int))
     loads: tuple[Load, ...] = ()
     curve: np.ndarray | None = None
+    curve_name: str = "target curve"
     scalar: np.ndarray | None = None
     scalar_name: str = ""
     scalar_unit: str = ""
@@ -127,6 +131,7 @@ class DesignView:
                 for ld in self.loads
             ],
             "curve": None if self.curve is None else r(np.asarray(self.curve) * 1e3),
+            "curve_name": self.curve_name,
             "scalar": None
             if self.scalar is None
             else np.round(np.asarray(self.scalar, float), 4).tolist(),
@@ -181,7 +186,8 @@ def view_html(view: Mapping | DesignView, element_id: str = "design-view") -> st
         legend.append('<span><span class="sw" style="background:#e67e22"></span>load</span>')
     if data.get("curve"):
         legend.append(
-            '<span><span class="sw" style="background:#1e8c45"></span>target curve</span>'
+            '<span><span class="sw" style="background:#1e8c45"></span>'
+            f"{html.escape(str(data.get('curve_name') or 'target curve'))}</span>"
         )
     eid = json.dumps(element_id)
     return (

@@ -376,8 +376,11 @@ def read_surface(path, units: str = "m", *, check_size: bool = True) -> TargetSu
     """A target surface from an STL, OBJ, PLY or OFF file whose numbers are in ``units``.
 
     The mesh is charted by its best-fit plane (principal axes of its vertices) and must be a
-    height field over it: a mesh with triangles facing away from that plane (a closed body, a
-    surface folding over itself) is refused. Closest points come from trimesh.
+    height field over it: a mesh with triangles facing away from that plane (a surface folding
+    over itself) is refused. A closed solid (what CAD exports by default) gives its upper skin:
+    the faces facing up over its best-fit plane (the plane's normal turned to +z), said in one
+    warning; one without such a skin is refused with what to export. Closest points come from
+    trimesh.
     """
     import trimesh
 
@@ -424,8 +427,36 @@ def read_surface(path, units: str = "m", *, check_size: bool = True) -> TargetSu
                 SurfaceUnitWarning,
                 stacklevel=2,
             )
-    return mesh_surface(mesh, name=path.stem, params={"file": str(path), "units": units},
-                        units=units)  # fmt: skip
+    params = {"file": str(path), "units": units}
+    if mesh.is_watertight:  # a closed solid (CAD's default export): its upper skin
+        mesh, said = _upper_skin(mesh, path.name)
+        warnings.warn(said, UserWarning, stacklevel=2)
+        params["faces"] = "upward faces of a closed solid"
+    return mesh_surface(mesh, name=path.stem, params=params, units=units)
+
+
+def _upper_skin(mesh, name: str):
+    """The faces of a closed solid ``mesh`` that face up over its best-fit plane (the plane's
+    normal turned to the file's +z), as a mesh, and one line saying so; refused (with what to
+    export) when none or too few do."""
+    V = np.asarray(mesh.vertices, float)
+    _, _, vt = np.linalg.svd(V - V.mean(axis=0), full_matrices=False)
+    nz = vt[2] if vt[2][2] >= 0 else -vt[2]
+    up = np.asarray(mesh.face_normals, float) @ nz > 0.2
+    area = np.asarray(mesh.area_faces, float)
+    share = float(area[up].sum() / area.sum()) if area.sum() > 0 else 0.0
+    if up.sum() < 2 or share < 0.1:
+        raise SurfaceError(
+            f"{name!r} is a closed solid with no upper skin over its best-fit plane to fit: "
+            "export the surface alone (an open STL/OBJ of the faces to fit)"
+        )
+    skin = mesh.submesh([np.flatnonzero(up)], append=True)
+    said = (
+        f"{name!r} is a closed solid: its {int(up.sum())} upward faces over the best-fit plane "
+        f"({100 * share:.0f} % of its area) are taken as the surface; export the surface alone "
+        "to fit another"
+    )
+    return skin, said
 
 
 def mesh_surface(mesh, *, name: str = "mesh", params: dict | None = None,

@@ -71,7 +71,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "DEFAULT_RANGE",
             "GRIPPER_NAMES",
         ],
-        "bed": ["Bed", "DEFAULT_BED", "BedFit", "bed_fit", "place_on_bed"],
+        "bed": ["Bed", "DEFAULT_BED", "BedFit", "bed_fit", "place_on_bed", "print_time_text"],
         "segments": ["Segment", "Segmentation", "segment_part", "assembly_sheet", "write_segments"],
         "clearance": ["Printability", "printability", "panel_overlap", "panel_clearance"],
         "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],

@@ -37,6 +37,7 @@ __all__ = [
     "deposited_volume",
     "PRINT_RATE",
     "TIME_CLASSES",
+    "print_time_text",
 ]
 
 #: deposition rate of a desktop FDM printer, m^3/s (1.8 mm^3/s; see the module docstring)
@@ -53,6 +54,20 @@ TIME_CLASSES = (
     (48.0, "12-48 h"),
     (math.inf, "over 2 days"),
 )
+
+
+def print_time_text(hours: float) -> str:
+    """A print time in hours and days: ``"about 510 h (21 days)"``, ``"about 40 min"``,
+    ``"about 7.5 h"``; the class alone (``"over 2 days"``) hides how many."""
+    if not math.isfinite(hours) or hours < 0:
+        return "unknown"
+    if hours < 1.0:
+        return f"about {max(1, round(60 * hours))} min"
+    text = f"about {hours:.2g} h" if hours < 10 else f"about {hours:.0f} h"
+    if hours >= 24.0:
+        days = hours / 24.0
+        text += f" ({days:.2g} days)" if days < 10 else f" ({days:.0f} days)"
+    return text
 
 
 @dataclass(frozen=True)
@@ -138,7 +153,10 @@ class BedFit:
             if self.fits
             else f"does not fit the {self.bed} bed"
         )
-        return f"{x:.4g} x {y:.4g} x {z:.3g} mm, {verdict}; print time {self.time_class}"
+        return (
+            f"{x:.4g} x {y:.4g} x {z:.3g} mm, {verdict}; print time "
+            f"{print_time_text(self.print_hours)} ({self.time_class})"
+        )
 
 
 def _hull(points: np.ndarray) -> np.ndarray:

@@ -1,7 +1,8 @@
 """DXF crease patterns with named layers, for CAD and laser software (written with ezdxf).
 
 The flat layout in millimetres (``$INSUNITS`` = 4, y up as the pattern has it), one ``LINE``
-per drawn segment on the layer of its role (:data:`DXF_LAYERS`): ``BOUNDARY``, ``CUT``,
+per drawn segment on the layer of its role (:data:`DXF_LAYERS`; the outline is cut, so it goes
+on ``CUT`` with the cuts, and ``BOUNDARY`` stays empty for other software's use): ``CUT``,
 ``SCORE_M`` (mountains), ``SCORE_V`` (valleys), ``SCORE_F`` (flat creases), ``SCORE_U``
 (unassigned), ``REGISTRATION``. Each layer has the profile's colour (as a true colour and the
 nearest AutoCAD colour index, which laser software maps by) and a lineweight of the profile's
@@ -102,7 +103,9 @@ def _dxf_text(ezdxf, prof: CutterProfile, draw) -> str:
     flip = np.array([1.0, -1.0])
     shift = np.array([0.0, draw.height])
     for role, segs in draw.lines.items():
-        name = DXF_LAYERS[role]
+        # the outline is cut: on CUT, which the laser and cutter software cut (a reader takes
+        # a cut on the outline for the border it is)
+        name = DXF_LAYERS["cut" if role == "boundary" else role]
         for a, b in segs * flip + shift:
             msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": name})
     for c in draw.holes:

@@ -248,7 +248,12 @@ def write_fabrication_set(
     elif panel_thickness is not None:
         t = check_range("panel_thickness", panel_thickness, 0.0, None, low_open=True)
         shrunk_panels(folded, W)  # a crease wider than a panel fails here
-        solid = thick_solid(folded, t, W)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            solid = thick_solid(folded, t, W)
+        for w in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        overlap_said = any("thick panels intersect" in str(w.message) for w in said)
         if crease_thickness is not None:
             part = printable_solid(layout, t, tc, W)
             with warnings.catch_warnings(record=True) as caught:
@@ -256,6 +261,8 @@ def write_fabrication_set(
                 bent = folded_printable(folded, t, tc, W)
             for w in caught:
                 notes.append(str(w.message))
+                if overlap_said and "thick panels intersect" in str(w.message):
+                    continue  # the same overlap, said once (thick_solid's words)
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     drawing = cutter.drawing()
     fill = {"pattern": names.pattern, "surface": names.surface, "thick": names.thick}

@@ -170,6 +170,23 @@ def _check_split(split: str) -> str:
     return split
 
 
+def _outline_cuts_as_border(faces, edges, assignment) -> np.ndarray:
+    """The assignments with every cut (C) on the outline (an edge of one face) a border (B):
+    a cutter file draws the outline as a cut, which is what a border is."""
+    asg = np.asarray(assignment).copy()
+    E = np.sort(np.asarray(edges, int).reshape(-1, 2), axis=1)
+    if not len(E) or not (asg == "C").any():
+        return asg
+    sides = np.sort(
+        np.array([(f[k], f[(k + 1) % len(f)]) for f in faces for k in range(len(f))], int), axis=1
+    )
+    pairs, count = np.unique(sides, axis=0, return_counts=True)
+    key = {tuple(p): c for p, c in zip(pairs.tolist(), count.tolist(), strict=True)}
+    one = np.array([key.get(tuple(e), 0) == 1 for e in E.tolist()])
+    asg[(asg == "C") & one] = "B"
+    return asg
+
+
 def finish_pattern(
     xy, faces, edges, assignment, fold_angle, *, name: str, notes=(), split: str = "as-needed",
     meta: dict | None = None, coords3=None,
@@ -182,6 +199,7 @@ def finish_pattern(
     split = _check_split(split)
     notes = list(notes)
     xy = np.asarray(xy, float)
+    assignment = _outline_cuts_as_border(faces, edges, assignment)
     xy, faces, edges, asg, ang, origin, more = separate_cuts(
         xy, faces, edges, assignment, fold_angle
     )

@@ -26,7 +26,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.geometry.bed import DEFAULT_BED, Bed, BedFit, bed_fit, footprint_turns, place_on_bed
+from holofold.geometry.bed import (
+    DEFAULT_BED,
+    Bed,
+    BedFit,
+    bed_fit,
+    footprint_turns,
+    place_on_bed,
+    print_time_text,
+)
 from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError, check_range
 from holofold.geometry.pattern import CreasePattern
 
@@ -97,7 +105,7 @@ class Segmentation:
         hours = sum(s.fit.print_hours for s in self.segments)
         return (
             f"{len(self.segments)} pieces joined along {len(self.joints)} creases and cuts, "
-            f"each fits the {self.bed} bed; {hours:.3g} h of printing in all"
+            f"each fits the {self.bed} bed; {print_time_text(hours)} of printing in all"
         )
 
 
@@ -333,6 +341,7 @@ def segment_part(
     *,
     clearance: float = 0.2e-3,
     rim: float = 3e-3,
+    panels=None,
 ) -> Segmentation:
     """The printable part of ``pattern`` cut into pieces that fit ``bed`` (see the module).
 
@@ -347,6 +356,10 @@ def segment_part(
         Gap around each joint, m (>= 0).
     rim : float
         How far a joint at a crease runs into the later piece's panel beyond the hinge, m.
+    panels : ThickPanels, optional
+        Offset or tapered panels (:func:`~holofold.geometry.thick.thick_panels`): the part is
+        :func:`~holofold.geometry.thick.thick_printable`'s, each piece printed the way up it
+        prints (hinge face on the bed); default the centred part of ``printable_solid``.
     """
     import manifold3d as m3d
     import trimesh
@@ -358,11 +371,22 @@ def segment_part(
     c = check_range("clearance", clearance, 0.0, 5e-3) * _MM
     rim_mm = check_range("rim", rim, 0.0, None, low_open=True) * _MM
     W = np.broadcast_to(np.asarray(crease_width, float), (pattern.n_edges,))
-    part_m = printable_solid(pattern, panel_thickness, crease_thickness, crease_width)
+    flip = False
+    if panels is None or panels.technique == "centred":
+        part_m = printable_solid(pattern, panel_thickness, crease_thickness, crease_width)
+    else:
+        from holofold.geometry.thick import thick_printable, turned_over
+
+        part_m = thick_printable(pattern, panels, crease_thickness, turn=False)
+        flip = turned_over(pattern, panels)
     whole = bed_fit(part_m, bed)
     none = np.zeros((0, 3), int)
     if whole.fits:
-        seg = Segment(1, np.arange(pattern.n_faces), (), place_on_bed(part_m, whole), whole)
+        lying = part_m.copy()
+        if flip:
+            lying.apply_transform(np.diag([1.0, -1.0, -1.0, 1.0]))
+            lying.apply_translation((0.0, 0.0, -lying.bounds[0][2]))
+        seg = Segment(1, np.arange(pattern.n_faces), (), place_on_bed(lying, whole), whole)
         return Segmentation(bed, whole, (seg,), none)
     flat = pattern.flat * _MM
     margin = float(W.max()) / 2 * _MM + rim_mm + 3.0 + c
@@ -421,6 +445,16 @@ def segment_part(
             faces=np.asarray(solid.tri_verts, np.int64),
             process=False,
         )
+        # as its STL (mm) reads back: vertices merged
+        closed = trimesh.Trimesh(np.asarray(mesh.vertices) * _MM, mesh.faces)
+        if not closed.is_watertight or closed.body_count != 1:
+            raise DegenerateGeometryError(
+                f"piece {k + 1} is not one closed body once its vertices are merged (parts of "
+                "it touch along an edge)"
+            )
+        if flip:  # hinge face down, as the whole part prints
+            mesh.apply_transform(np.diag([1.0, -1.0, -1.0, 1.0]))
+        mesh.apply_translation((0.0, 0.0, -mesh.bounds[0][2]))
         fit = bed_fit(mesh, bed)
         placed = place_on_bed(mesh, fit) if fit.fits else mesh
         outline = tuple(np.asarray(p) / _MM for p in region.to_polygons())

@@ -176,14 +176,15 @@ def test_dxf_reads_back_with_layers_and_dashes(which, request, tmp_path):
         lines.setdefault(e.dxf.layer, []).append([[e.dxf.start.x, e.dxf.start.y],
                                                   [e.dxf.end.x, e.dxf.end.y]])  # fmt: skip
     draw = cutter_drawing(pattern, "laser")
-    for role, layer in (("boundary", "BOUNDARY"), ("mountain", "SCORE_M"), ("valley", "SCORE_V")):
+    assert "BOUNDARY" not in lines  # the outline is cut: on CUT (the patterns have no cuts)
+    for role, layer in (("boundary", "CUT"), ("mountain", "SCORE_M"), ("valley", "SCORE_V")):
         got = np.array(lines[layer])
         want = draw.lines[role].copy()
         want[..., 1] = draw.height - want[..., 1]  # DXF's y points up
         assert got.shape == want.shape
         np.testing.assert_allclose(got, want, atol=1e-9)
     # the outline closes: every boundary end point is shared by two boundary lines (in mm)
-    ends = np.round(np.array(lines["BOUNDARY"]).reshape(-1, 2), 6)
+    ends = np.round(np.array(lines["CUT"]).reshape(-1, 2), 6)
     _, counts = np.unique(ends, axis=0, return_counts=True)
     assert (counts == 2).all()
     assert not list(doc.modelspace().query("TEXT MTEXT"))
@@ -197,7 +198,7 @@ def test_dxf_simulator_profile_has_whole_creases(miura):
     for e in doc.modelspace().query("LINE"):
         by_layer[e.dxf.layer] = by_layer.get(e.dxf.layer, 0) + 1
     count = {c: int((miura.assignment == c).sum()) for c in "MVB"}
-    assert by_layer == {"SCORE_M": count["M"], "SCORE_V": count["V"], "BOUNDARY": count["B"]}
+    assert by_layer == {"SCORE_M": count["M"], "SCORE_V": count["V"], "CUT": count["B"]}
 
 
 def _render(svg_path, png_path, dpi: int) -> np.ndarray:

@@ -137,3 +137,34 @@ def test_the_gripper_is_shown_closed_with_its_temperatures(tmp_path):
 def _options(sc):
     """The GripperOptions behind a gripper scenario (its view's bound argument)."""
     return sc.view.args[0]
+
+
+@pytest.mark.slow
+def test_the_surface_kinds_view_draws_in_a_real_browser(tmp_path):
+    """The surface kind's view (issue 34: the pattern and surface kinds had no canvas): the
+    shell's 36 quads drawn as 72 triangles in Chromium, the target surface's lines green."""
+    import matplotlib.image
+    from _browser import chromium
+
+    from holofold.design.scenarios.files import read_scenario
+
+    sc = read_scenario(ROOT / "examples" / "my_shell.toml")
+    row = sc.complete({"m": 6.0, "n": 6.0, "tpanel": 2e-3, "tcrease": 0.45e-3, "W": 2e-3,
+                       "ext": 0.7, "coverage": 0.825})  # fmt: skip
+    html = view_html(sc.view(row), "v")
+    assert "target surface" in html
+    page = tmp_path / "view.html"
+    page.write_text(
+        "<!DOCTYPE html><html><head><meta charset='utf-8'><style>" + view_css + "</style>"
+        "</head><body style='width:900px;margin:0'>" + html + "</body></html>"
+    )  # fmt: skip
+    dom = chromium(tmp_path, "--dump-dom", page.as_uri()).stdout
+    attrs = dict(re.findall(r'(data-[\w-]+)="([^"]*)"', re.search(r'<div class="viewer"[^>]*>',
+                                                                  dom).group(0)))  # fmt: skip
+    assert attrs["data-viewer-ready"] == "1" and attrs["data-viewer-triangles"] == "72"
+    shot = tmp_path / "view.png"
+    chromium(tmp_path, f"--screenshot={shot}", "--window-size=900,520", page.as_uri())
+    px = matplotlib.image.imread(shot)[:440, :, :3]
+    green = (px[..., 1] > 0.45) & (px[..., 0] < 0.25) & (px[..., 2] < 0.4)
+    orange = (px[..., 0] > 0.8) & (px[..., 1] > 0.35) & (px[..., 1] < 0.6) & (px[..., 2] < 0.3)
+    assert green.sum() > 100 and orange.sum() > 20

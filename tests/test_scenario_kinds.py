@@ -55,7 +55,13 @@ def test_shipped_canopy_is_the_python_canopy(reference_data):
     toml, py = _shipped("canopy"), get_scenario("canopy")
     assert toml.kind == "sheet" and toml.features == py.features
     assert toml.categorical == py.categorical
-    assert toml.performance_names == [*py.performance_names, "mass", "overlap", "clearance"]
+    assert toml.performance_names == [
+        *py.performance_names,
+        "mass",
+        "overlap",
+        "clearance",
+        "thick",
+    ]
     rows = _rows(reference_data, py, "data1_MiuraSheet_sample", [0])
     rows += _rows(reference_data, py, "data1_TMPSheet_sample", [0])
     rows += _rows(reference_data, py, "data4_TMPSheetMat_sample", [0])  # creaseE, panelE
@@ -139,7 +145,9 @@ def _user_sheet(tmp_path, E=2e9, force=3.0, name="mine.toml"):
 
 def test_user_sheet_columns_and_linear_scaling(tmp_path):
     sc = _user_sheet(tmp_path)
-    assert sc.performance_names == ["liftstiff50", "liftstiff80", "mass", "overlap", "clearance"]
+    assert sc.performance_names == [
+        "liftstiff50", "liftstiff80", "mass", "overlap", "clearance", "thick",
+    ]  # fmt: skip
     assert sc.feature_names == ["m", "n", "tcrease", "tpanel", "W"]  # pattern fixed, no moduli
     assert sc.categorical == ("m", "n")
     assert sc.setting["footprint (m)"] == "0.3 x 0.15"
@@ -167,16 +175,47 @@ def test_sheet_overlap_and_clearance_at_the_most_folded_state(tmp_path):
     from holofold.design.scenarios.sheet import sheet_shape
     from holofold.geometry import printability
 
-    sc = _user_sheet(tmp_path)
+    text = USER_SHEET.format(E=2e9, force=3.0).replace('name = "awning"', _CENTRED)
+    sc = read_scenario(_file(tmp_path, text, "centred.toml"))
     assert sc.performance[3].display_unit == "mm^3" and sc.performance[4].display_unit == "mm"
     rows = [sc.complete({**SHEET_ROW, "tpanel": 1e-3, "W": w}) for w in (1e-3, 2e-3, 6e-3)]
     out = [sc.evaluate(r) for r in rows]
     ov = [o["overlap"] for o in out]
     assert ov[0] > ov[1] > 0 and ov[2] == 0.0
+    assert [o["thick"] for o in out] == [0, 0, 0]
     assert out[2]["clearance"] > 0 and out[0]["clearance"] < out[2]["clearance"]
     # at the sheet's smallest extension (0.5), where it is most folded: the 0.8 state overlaps less
     flatter = printability(sheet_shape(_setting(sc), rows[1], 0.8), 1e-3, 2e-3).overlap
     assert flatter < ov[1]
+
+
+_CENTRED = 'name = "awning"\nthick = "centred"'
+
+
+def test_sheet_thick_auto_keeps_the_first_technique_that_folds_clear(tmp_path):
+    """thick = "auto" (the default): where centred panels overlap folded to Ext 0.5 (W = t),
+    offset panels fold from flat to 0.5 without any overlap at five states, and the row says
+    so (thick 1, overlap 0, clearance a lower bound one thickness below the centred one);
+    where centred panels are clear (W = 6 t) they are kept (thick 0, the same numbers)."""
+    from holofold.design.scenarios.sheet import sheet_fold_path
+    from holofold.geometry.thick import path_overlap, thick_panels
+
+    auto = _user_sheet(tmp_path)
+    text = USER_SHEET.format(E=2e9, force=3.0).replace('name = "awning"', _CENTRED)
+    centred = read_scenario(_file(tmp_path, text, "centred.toml"))
+    rows = [auto.complete({**SHEET_ROW, "tpanel": 1e-3, "W": w}) for w in (1e-3, 6e-3)]
+    a = [auto.evaluate(r) for r in rows]
+    c = [centred.evaluate(r) for r in rows]
+    assert c[0]["overlap"] > 1e-12 and a[0]["thick"] == 1 and a[0]["overlap"] == 0.0
+    assert a[0]["clearance"] == pytest.approx(c[0]["clearance"] - 1e-3, abs=1e-12)
+    assert a[1]["thick"] == 0 and a[1]["overlap"] == c[1]["overlap"] == 0.0
+    assert a[1]["clearance"] == c[1]["clearance"] > 0
+    for k in ("liftstiff50", "liftstiff80", "mass"):  # the mechanics do not change
+        assert a[0][k] == c[0][k]
+    state, way = sheet_fold_path(_setting(auto), rows[0])
+    panels = thick_panels(state, 1e-3, 1e-3, "offset", path=way)
+    assert path_overlap([*way, state], panels).volume.max() == 0.0
+    assert path_overlap([*way, state], thick_panels(state, 1e-3, 1e-3)).volume.max() > 0
 
 
 def _setting(sc):
@@ -223,7 +262,8 @@ def test_user_sheet_shape_and_files(tmp_path):
     assert all(f.path.is_file() and f.path.stat().st_size > 0 for f in files)
     # 6 mm panels folded to 0.3 overlap: every file but the thick solid, and a warning
     text = USER_SHEET.format(E=2e9, force=3.0).replace("[0.5, 0.8]", "[0.3]")
-    folded = read_scenario(_file(tmp_path, text, "folded.toml"))
+    folded = read_scenario(_file(tmp_path, text.replace('name = "awning"', _CENTRED),
+                                 "folded.toml"))  # fmt: skip
     with pytest.warns(UserWarning, match="no thick.stl: the thick panels"):
         files = folded.write_files(folded.complete({**SHEET_ROW, "tpanel": 6e-3}), tmp_path / "f")
     assert [f.key for f in files] == ["fold", "svg", "dxf", "surface_stl", "surface_obj"]

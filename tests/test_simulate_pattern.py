@@ -227,7 +227,9 @@ def test_pattern_scenario_file(tmp_path):
     sc = read_scenario(tmp_path / "wb.toml")
     assert sc.kind == "pattern"
     assert sc.feature_names == ["tpanel", "tcrease", "W", "fold", "scale"]
-    assert sc.performance_names == ["tipstiff", "energy", "mass", "overlap", "clearance", "reached"]
+    assert sc.performance_names == [
+        "tipstiff", "energy", "mass", "overlap", "clearance", "thick", "reached",
+    ]  # fmt: skip
     row = {"tpanel": 1e-3, "tcrease": 0.3e-3, "W": 1e-3, "fold": 0.5, "scale": 1.0}
     out = sc.evaluate(row)
     assert out["status"].converged and out["reached"] == 0.5 and out["tipstiff"] > 0

@@ -25,6 +25,7 @@ def test_example_shell_row_fits_folds_and_carries_its_load():
     assert sc.kind == "surface"
     assert [c.name for c in sc.performance] == [
         "rms_error", "max_error", "fold_error", "Zstiff", "mass", "overlap", "clearance",
+        "thick",
     ]  # fmt: skip
     assert set(sc.categorical) == {"m", "n"}
     out = sc.evaluate(ROW)

@@ -115,8 +115,14 @@ def test_mesh_units_warning_and_refusals(tmp_path):
         read_surface(path)  # metres: 800 m across
     closed = tmp_path / "ball.stl"
     trimesh.creation.icosphere(2).export(closed)
+    with pytest.warns(UserWarning, match="closed solid: its .* upward faces"):
+        cap = read_surface(closed, units="m")  # a closed solid: its upper skin
+    assert cap.params["faces"] == "upward faces of a closed solid"
+    ball = trimesh.creation.icosphere(2)
+    opened = tmp_path / "opened.stl"  # open (one face off) and folding back over its plane
+    trimesh.Trimesh(ball.vertices, ball.faces[1:]).export(opened)
     with pytest.raises(SurfaceError, match="not a height field"):
-        read_surface(closed, units="m")
+        read_surface(opened, units="m")
     bad = tmp_path / "bad.stl"
     bad.write_bytes(b"solid x\nnonsense\n")
     with pytest.raises((FormatError, SurfaceError)):

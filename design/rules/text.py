@@ -29,13 +29,18 @@ def fmt_level(v) -> str:
 
 def condition_text(name: str, gt=None, le=None, levels=None, column=None, digits: int = 3) -> str:
     """One condition as text: ``name <= 0.779 mm``, ``0.5 < W <= 2 mm`` (the unit once, after
-    the upper end), ``name > 65.8 deg``, ``m = 16`` or ``m in {16, 24}``.
+    the upper end), ``name > 65.8 deg``, ``m = 16`` or ``m in {16, 24}``; a category whose
+    column names its levels with the name: ``pattern = 2 (TMP)``.
 
     ``gt``/``le`` are SI (None for an open side), ``levels`` the allowed categorical values,
     ``column`` the feature's :class:`~holofold.design.scenarios.Column` (its display unit).
     """
     if levels is not None:
-        lv = [fmt_level(v) for v in levels]
+        named = column is not None and getattr(column, "names", ())
+        lv = [
+            fmt_level(v) + (f" ({column.level_name(v)})" if named and column.level_name(v) else "")
+            for v in levels
+        ]
         return f"{name} = {lv[0]}" if len(lv) == 1 else f"{name} in {{{', '.join(lv)}}}"
     if gt is not None and le is not None:
         f = 1.0 if column is None else column.display_factor
@@ -57,7 +62,7 @@ def box_text(bounds, names, *, categorical=(), columns=None, digits: int = 3) ->
         if b is None:
             continue
         if name in categorical:
-            parts.append(condition_text(name, levels=b))
+            parts.append(condition_text(name, levels=b, column=cols.get(name)))
             continue
         gt, le = (None if not np.isfinite(v) else float(v) for v in b)
         if gt is not None or le is not None:

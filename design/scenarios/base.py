@@ -129,8 +129,20 @@ class Column:
     required: bool = True
     default: float | None = None
     display: str = ""
+    names: tuple[str, ...] = ()
+
+    def level_name(self, value) -> str:
+        """The name of a categorical level (``names`` aligned with ``choices``), or ""."""
+        for c, n in zip(self.choices, self.names, strict=False):
+            if float(c) == float(value):
+                return n
+        return ""
 
     def __post_init__(self):
+        if self.names and len(self.names) != len(self.choices):
+            raise ValueError(
+                f"column {self.name!r}: {len(self.names)} names for {len(self.choices)} choices"
+            )
         if self.display and self.display != self.unit:
             allowed = DISPLAY_UNITS.get(self.unit, {self.unit: 1.0})
             if self.display not in allowed:
@@ -158,8 +170,14 @@ class Column:
         return value / self.display_factor
 
     def format(self, value: float, digits: int = 3) -> str:
-        """:func:`format_value` of ``value`` (SI) in this column's display unit."""
-        return format_value(value, self, digits=digits)
+        """:func:`format_value` of ``value`` (SI) in this column's display unit; a named
+        categorical level with its name (``1 (offset)``)."""
+        text = format_value(value, self, digits=digits)
+        try:
+            name = self.level_name(value) if self.names else ""
+        except (TypeError, ValueError):
+            name = ""
+        return f"{text} ({name})" if name else text
 
     def out_of_range(self, value: float) -> str | None:
         """A warning text if ``value`` is outside the paper's sampling range, else None."""
@@ -230,6 +248,9 @@ class Scenario:
         The runner's default time limit per row, seconds (a row past it is recorded as
         ``failed: timeout ...``; see :mod:`~holofold.design.row_limits`); None: the default of
         the scenario's ``kind`` (:data:`ROW_TIMEOUTS`).
+    bed : str
+        The printer's bed of the scenario file's ``bed`` key ("250x210", mm; ``--bed`` wins),
+        or ``""`` (the default bed).
     """
 
     name: str
@@ -249,6 +270,7 @@ class Scenario:
     evaluate_batch: Callable[[list], list] | None = None
     batch_key: Callable[[Mapping[str, float]], object] | None = None
     row_timeout: float | None = None
+    bed: str = ""
 
     def __post_init__(self):
         if self.row_timeout is None:

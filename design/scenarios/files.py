@@ -61,6 +61,14 @@ def read_scenario(path: str | os.PathLike) -> Scenario:
     if not name.strip():
         raise doc.error("name must not be empty")
     description = doc.string("description", "")
+    bed = doc.string("bed", "")
+    if bed:
+        from holofold.geometry import Bed
+
+        try:
+            Bed.parse(bed)
+        except ValueError as exc:
+            raise doc.error(str(exc)) from None
     doc.where = f"{path.name}"
     try:
         reader = get_kind(kind)
@@ -69,7 +77,18 @@ def read_scenario(path: str | os.PathLike) -> Scenario:
     scenario = reader.from_config(doc, name, description)
     doc.where = f"{path.name}: top level"
     doc.done()
-    return replace(scenario, source=str(path))
+    return replace(scenario, source=_display_path(path), bed=bed)
+
+
+def _display_path(path: Path) -> str:
+    """How a scenario file is named in reports: a shipped one relative to the package
+    (``holofold/design/scenarios/shipped/arch.toml``, the same on every machine), another as
+    given."""
+    try:
+        rel = path.resolve().relative_to(_SHIPPED.resolve())
+    except ValueError:
+        return str(path)
+    return f"holofold/design/scenarios/shipped/{rel.as_posix()}"
 
 
 def shipped_scenarios() -> dict[str, Path]:

@@ -35,10 +35,15 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
+    THICK_COLUMN,
+    crease_view,
     describe_material_and_loads,
+    fold_way,
     loaded_columns,
     read_supports_and_loads,
+    row_part,
     row_status,
+    row_thickness,
     write_row_files,
 )
 from holofold.design.simulate import (
@@ -121,6 +126,7 @@ def pattern_columns(setting: PatternScenarioSetting) -> tuple[Column, ...]:
         Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
         Column("overlap", "m^3", "intersection volume of the folded thick panels"),
         Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
+        THICK_COLUMN,
         Column("reached", "-", "fold fraction reached"),
     ]
     return tuple(cols)
@@ -156,17 +162,49 @@ def evaluate_pattern(setting: PatternScenarioSetting, columns: Sequence[str], ro
     return {**{c: out[c] for c in columns}, "status": row_status(sim.status)}
 
 
-def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
-    """The design's pattern folded as far as its fold got (flat layout kept), m."""
+def _fold(setting: PatternScenarioSetting, row):
     from holofold.mechanics.folding import fold_pattern
 
     s = _setting_for(setting, row)
-    fold = fold_pattern(
+    return fold_pattern(
         _pattern(setting, row), s.fold, panel_thickness=s.panel_thickness,
         crease_thickness=s.crease_thickness, crease_width=s.crease_width, E=s.material.E,
         nu=s.material.nu, model=s.model,
     )  # fmt: skip
-    return fold.folded()
+
+
+def pattern_shape(setting: PatternScenarioSetting, row) -> CreasePattern:
+    """The design's pattern folded as far as its fold got (flat layout kept), m."""
+    return _fold(setting, row).folded()
+
+
+def pattern_part(setting: PatternScenarioSetting, row):
+    """The printable part: the pattern's flat layout at the row's scale, with the row's
+    thicknesses and hinge width (:func:`~holofold.design.scenarios.pattern_loads.row_part`)."""
+    from dataclasses import replace
+
+    part = row_part(_pattern(setting, row), row)
+    if part is None:
+        return None
+    fold = _fold(setting, row)
+    shape, way = fold.folded(), fold_way(fold)
+    got = row_thickness(shape, row, way)
+    if got is None or got.technique == "centred" or shape.flat is None:
+        return part
+    return replace(part, pattern=shape, thick=got.technique, path=tuple(way))
+
+
+def pattern_view(setting: PatternScenarioSetting, row):
+    """The 3D view: flat, up to four states of the fold path, the vertex sets held and the
+    loads (:func:`~holofold.design.scenarios.pattern_loads.crease_view`)."""
+    fold = _fold(setting, row)
+    k = len(fold.coords)
+    pick = np.unique(np.linspace(0, k - 1, min(k, 4)).round().astype(int))
+    pick = pick[fold.fractions[pick] > 0] if k > 1 else pick
+    labels = tuple(f"fold {fold.fractions[i]:.0%}" for i in pick)
+    bending = f"{fold.verdict}: {fold.note}" if fold.note else fold.verdict
+    return crease_view(fold.pattern, fold.coords[pick], labels, setting.supports, setting.loads,
+                       facts=(("fold", bending),))  # fmt: skip
 
 
 def write_pattern_files(
@@ -176,7 +214,12 @@ def write_pattern_files(
     pattern folded as far as its fold got: printable part, FOLD, SVG and DXF for ``cutter``,
     STL/OBJ and the thick solid; without the solids (a note says why) where the panels do not
     allow them."""
-    return write_row_files(pattern_shape(setting, row), folder, row, units=units, cutter=cutter)
+    fold = _fold(setting, row)
+    shape, way = fold.folded(), fold_way(fold)
+    got = row_thickness(shape, row, way)
+    thick = None if got is None else got.technique
+    return write_row_files(shape, folder, row, units=units, cutter=cutter, thick=thick,
+                           path=None if got is None else [*way, shape])  # fmt: skip
 
 
 def pattern_scenario(
@@ -212,6 +255,8 @@ def pattern_scenario(
         source=source,
         shape=partial(pattern_shape, setting),
         write_files=partial(write_pattern_files, setting),
+        view=partial(pattern_view, setting),
+        part=partial(pattern_part, setting),
         row_timeout=PATTERN_ROW_TIMEOUT,
     )
 

@@ -13,6 +13,10 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
+
+from holofold.design.buildability import THICK_CODES
+from holofold.design.scenarios.base import Column
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -32,6 +36,12 @@ __all__ = [
     "loaded_columns",
     "row_status",
     "write_row_files",
+    "row_part",
+    "crease_view",
+    "surface_lines",
+    "THICK_COLUMN",
+    "row_thickness",
+    "fold_way",
 ]
 
 _LOAD_KEYS = ("name", "at", "direction", "force", "increments")
@@ -113,12 +123,39 @@ def describe_material_and_loads(
 
 def loaded_columns(sim: PatternSimulation) -> dict[str, float]:
     """``{name}stiff`` (N/m) of every load, ``mass`` (kg), ``overlap`` (m^3, NaN where not
-    computed) and ``clearance`` (m, at most 1000) of one simulated design."""
+    computed), ``clearance`` (m, at most 1000) and ``thick`` (the technique's code) of one
+    simulated design."""
     out = {f"{o.name}stiff": o.stiffness for o in sim.loads}
     out["mass"] = sim.mass
     out["overlap"] = math.nan if sim.overlap is None else sim.overlap
     out["clearance"] = math.nan if sim.clearance is None else min(sim.clearance, 1e3)
+    out["thick"] = float(THICK_CODES[sim.thick])
     return out
+
+
+#: the ``thick`` column of the crease-pattern kinds
+THICK_COLUMN = Column(
+    "thick", "-", "thickness technique of the folded panels: 0 centred, 1 offset, 2 tapered "
+    "(the first that folds without collision)", choices=(0.0, 1.0, 2.0),
+    names=("centred", "offset", "tapered"),
+)  # fmt: skip
+
+
+def row_thickness(state: CreasePattern, row, path=()):
+    """The row's thick panels in ``state`` (:func:`~holofold.design.buildability.
+    choose_thickness` with ``thick = "auto"``, over ``path``)."""
+    from holofold.design.buildability import choose_thickness
+
+    try:
+        return choose_thickness(state, float(row["tpanel"]), float(row["W"]), path=tuple(path))
+    except ValueError:
+        return None
+
+
+def fold_way(fold, states: int = 3) -> list:
+    """Up to ``states`` states of a fold path between its start and end."""
+    k = len(fold.coords)
+    return [fold.folded(int(i)) for i in np.unique(np.linspace(0, k - 1, states + 2).round())[1:-1]]
 
 
 def row_status(status: Status) -> Status:
@@ -130,7 +167,8 @@ def row_status(status: Status) -> Status:
 
 
 def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cutter=None,
-                    thick=None, fallback=ValueError, what: str = "no solids"):  # fmt: skip
+                    thick=None, fallback=ValueError, what: str = "no solids",
+                    path=None):  # fmt: skip
     """The fabrication set (:func:`~holofold.geometry.write_fabrication_set`) of a design's
     folded ``shape`` with the row's ``tpanel``, ``tcrease`` and ``W`` (m); where the solids
     cannot be made (``fallback``, raised by the writer), every file but the solids with a note
@@ -139,6 +177,8 @@ def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cut
 
     W = float(row["W"])
     extra = {} if thick is None else {"thick": thick}
+    if path is not None:
+        extra["path"] = path
     try:
         return write_fabrication_set(
             shape, folder, panel_thickness=float(row["tpanel"]), crease_width=W,
@@ -148,3 +188,81 @@ def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cut
         warnings.warn(f"{what}: {exc}", stacklevel=3)
         got = write_fabrication_set(shape, folder, crease_width=W, units=units, cutter=cutter)
         return FabricationSet(got.files, (*got.notes, f"no solids: {exc}"))
+
+
+def row_part(pattern: CreasePattern, row):
+    """The printable part of a design whose crease pattern is ``pattern`` (its flat layout;
+    a pattern read flat is its own layout), printed with the row's ``tpanel``, ``tcrease`` and
+    ``W`` (:class:`~holofold.design.buildability.PrintablePart`); None without a flat layout."""
+    from dataclasses import replace
+
+    from holofold.design.buildability import PrintablePart
+
+    if pattern.flat is None:
+        z = pattern.coords[:, 2]
+        if float(np.ptp(z)) > 1e-9 * max(float(np.ptp(pattern.coords, axis=0).max()), 1e-12):
+            return None
+        pattern = replace(pattern, flat=pattern.coords[:, :2].copy())
+    return PrintablePart(pattern, float(row["tpanel"]), float(row["tcrease"]), float(row["W"]))
+
+
+def _flat_frame(pattern: CreasePattern) -> np.ndarray:
+    if pattern.flat is not None:
+        return np.column_stack([pattern.flat, np.zeros(pattern.n_vertices)])
+    return np.asarray(pattern.coords, float)
+
+
+def crease_view(
+    pattern: CreasePattern,
+    states: np.ndarray,
+    labels: tuple[str, ...],
+    supports: tuple[str, ...],
+    loads: tuple[PatternLoad, ...],
+    *,
+    curve: np.ndarray | None = None,
+    curve_name: str = "target curve",
+    facts: tuple[tuple[str, str], ...] = (),
+):
+    """The 3D view (:class:`~holofold.design.view.DesignView`) of a crease-pattern design:
+    the flat layout, then ``states`` (k, nv, 3) m with their ``labels``; the vertex sets held
+    and the loads (one arrow per loaded vertex) selected on ``pattern``; ``curve`` (P, 3) m the
+    target drawn over every state."""
+    from holofold.design.view import DesignView, Load
+
+    frames = np.concatenate([_flat_frame(pattern)[None], np.asarray(states, float)])
+    held = (
+        np.unique(np.concatenate([parse_vertex_set(a).select(pattern) for a in supports]))
+        if supports
+        else np.zeros(0, int)
+    )
+    arrows = tuple(
+        Load(int(v), tuple(float(x) for x in ld.direction), f"{ld.name}: {ld.force:g} N shared")
+        for ld in loads
+        for v in ld.at.select(pattern)
+    )
+    return DesignView(
+        frames=frames, labels=("flat", *labels), faces=[list(f) for f in pattern.faces],
+        edges=pattern.edges, kinds="".join(str(a)[0] for a in pattern.assignment),
+        supports=held, loads=arrows, curve=curve, curve_name=curve_name, facts=facts,
+    )  # fmt: skip
+
+
+def surface_lines(chart, domain, lines: int = 9, samples: int = 25) -> np.ndarray:
+    """One polyline (P, 3) m over a charted surface: ``lines`` u-lines then ``lines`` v-lines
+    of the ``domain`` (u0, u1, v0, v1), run back and forth so that the pen never lifts
+    (the viewer draws a target as one line). ``chart(u, v)`` -> (points, normals)."""
+    u0, u1, v0, v1 = domain
+    us, vs = np.linspace(u0, u1, lines), np.linspace(v0, v1, lines)
+    ts_u, ts_v = np.linspace(v0, v1, samples), np.linspace(u0, u1, samples)
+    uu, vv = [], []
+    for k, u in enumerate(us):
+        t = ts_u if k % 2 == 0 else ts_u[::-1]
+        uu.append(np.full(samples, u))
+        vv.append(t)
+    for k, v in enumerate(vs[::-1] if lines % 2 else vs):
+        t = ts_v[::-1] if lines % 2 else ts_v
+        t = t if k % 2 == 0 else t[::-1]
+        uu.append(t)
+        vv.append(np.full(samples, v))
+    pts, _ = chart(np.concatenate(uu), np.concatenate(vv))
+    return np.asarray(pts, float)

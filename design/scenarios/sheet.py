@@ -30,7 +30,13 @@ Columns, SI units:
     volume where the thick panels (tpanel, pulled back W/2 from the creases) intersect, m^3,
     and the smallest gap between panels sharing no vertex, m, folded to the smallest modelled
     extension (the most folded state the sheet is used in): 0 overlap means the part can be
-    folded there as designed (:func:`holofold.geometry.printability`).
+    folded there as designed (:func:`holofold.geometry.printability`);
+``thick``
+    the thickness technique of those panels, 0 centred, 1 offset, 2 tapered: the setting's
+    ``thick``, or with ``thick = "auto"`` (the default) the first whose panels fold from flat
+    to that extension without collision (:func:`~holofold.design.buildability.choose_thickness`;
+    offset and tapered panels are checked at four states on the way and report ``overlap``
+    over the path and ``clearance`` nan). The files and the printable part use it.
 
 The paper's canopy (:mod:`~holofold.design.scenarios.canopy`) is this kind with a 0.2 m square,
 gamma = 70 deg, extensions 0.3, 0.6, 0.9 and the loads ``bend`` (3 N in -z) and ``axial``
@@ -47,6 +53,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
+from holofold.design.buildability import THICK_CHOICES
 from holofold.design.scenarios.base import Column, Scenario, integer, positive
 from holofold.design.scenarios.config import (
     Section,
@@ -68,7 +75,6 @@ from holofold.design.scenarios.sheet_families import (
     sheet_family,
 )
 from holofold.geometry import MAX_PANELS
-from holofold.geometry import TECHNIQUES as THICK_TECHNIQUES
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
@@ -137,7 +143,9 @@ GAMMA_70 = 70.0 / 180.0 * math.pi  #: the canopy's Miura sector angle, rad
 #: ``pattern``, ``m``, ``n`` are features unless the setting fixes them, ``gama`` only when the
 #: setting has no sector angle; ``creaseE``/``panelE`` are optional (default: the setting's E).
 SHEET_FEATURES = (
-    Column("pattern", "-", "1 = Miura-ori, 2 = TMP", choices=(1.0, 2.0)),
+    Column(
+        "pattern", "-", "1 = Miura-ori, 2 = TMP", choices=(1.0, 2.0), names=("Miura-ori", "TMP")
+    ),
     Column("m", "-", "panels along x (TMP: even)", choices=(24.0, 30.0, 36.0)),
     Column("n", "-", "panels along y (TMP: multiple of 3)", choices=(6.0, 9.0, 12.0)),
     Column("tcrease", "m", "crease thickness", 0.5e-3, 1.0e-3, display="mm"),
@@ -236,7 +244,7 @@ class SheetSetting:
     support_dofs: str = "xyz"
     tol: float = 1e-7
     max_iter: int = 30
-    thick: str = "centred"
+    thick: str = "auto"
 
 
 def extension_tag(ext: float) -> int:
@@ -296,8 +304,15 @@ def sheet_columns(setting: SheetSetting, extras: bool = True) -> tuple[Column, .
                 display="mm^3",
             )
         )
-        cols.append(Column("clearance", "m", "smallest gap between panels sharing no vertex, "
-                           f"folded to Ext = {most:g}", display="mm"))  # fmt: skip
+        cols.append(Column("clearance", "m", "smallest gap between centred panels sharing no "
+                           f"vertex, folded to Ext = {most:g} (nan for offset and tapered "
+                           "panels: their overlap is checked along the fold path)",
+                           display="mm"))  # fmt: skip
+        cols.append(Column("thick", "-", "thickness technique of the panels: 0 centred, "
+                           "1 offset, 2 tapered (with thick = 'auto' the first that folds "
+                           f"from flat to Ext = {most:g} without collision)",
+                           choices=(0.0, 1.0, 2.0),
+                           names=("centred", "offset", "tapered")))  # fmt: skip
     return tuple(cols)
 
 
@@ -487,7 +502,8 @@ def evaluate_sheet_batch(setting: SheetSetting, columns: Sequence[str], rows) ->
         if "mass" in columns:
             out["mass"] = sheet_mass(setting, row)
         if "overlap" in columns:
-            out["overlap"], out["clearance"] = _printability(setting, row)
+            got = sheet_thickness(setting, row)
+            out["overlap"], out["clearance"], out["thick"] = got.overlap, got.clearance, got.code
         out = {c: out[c] for c in columns}
         out["status"] = Status.gather(case, worst=Outcome.NOT_CONVERGED)
         result.append(out)
@@ -498,16 +514,24 @@ def evaluate_sheet_batch(setting: SheetSetting, columns: Sequence[str], rows) ->
 _NO_NEIGHBOUR = 1e3
 
 
-def _printability(setting: SheetSetting, row) -> tuple[float, float]:
-    """(overlap m^3, clearance m) of the design's thick panels (tpanel, pulled back W/2 from
-    the creases) folded to the smallest modelled extension, where they come closest
-    (:func:`holofold.geometry.printability`, imported on first use: trimesh and
-    scipy.spatial are a second of start-up for a worker that never needs them)."""
-    from holofold.geometry import printability
+def sheet_fold_path(setting: SheetSetting, row) -> tuple[CreasePattern, list[CreasePattern]]:
+    """The design folded to the smallest modelled extension (where its panels come closest)
+    and four states on the way from flat, m."""
+    most = min(setting.extensions)
+    way = [sheet_shape(setting, row, float(e)) for e in np.linspace(1.0, most, 6)[1:-1]]
+    return sheet_shape(setting, row, most), way
 
-    shape = sheet_shape(setting, row, min(setting.extensions))
-    p = printability(shape, float(row["tpanel"]), float(row["W"]))
-    return float(p.overlap), float(min(p.clearance, _NO_NEIGHBOUR))
+
+def sheet_thickness(setting: SheetSetting, row):
+    """The design's thick panels (:func:`~holofold.design.buildability.choose_thickness`):
+    the setting's technique, or with ``thick = "auto"`` the first of centred, offset and
+    tapered whose panels fold from flat to the smallest modelled extension without collision
+    (trimesh, scipy.spatial and manifold3d load on first use)."""
+    from holofold.design.buildability import choose_thickness
+
+    state, way = sheet_fold_path(setting, row)
+    return choose_thickness(state, float(row["tpanel"]), float(row["W"]), path=way,
+                            thick=setting.thick, no_neighbour=_NO_NEIGHBOUR)  # fmt: skip
 
 
 def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreasePattern:
@@ -548,9 +572,10 @@ def sheet_part(setting: SheetSetting, row):
     (:class:`~holofold.design.buildability.PrintablePart`)."""
     from holofold.design.buildability import PrintablePart
 
-    return PrintablePart(
-        sheet_shape(setting, row), float(row["tpanel"]), float(row["tcrease"]), float(row["W"])
-    )
+    got = sheet_thickness(setting, row)
+    state, way = sheet_fold_path(setting, row)
+    return PrintablePart(state, float(row["tpanel"]), float(row["tcrease"]), float(row["W"]),
+                         thick=got.technique, path=tuple(way))  # fmt: skip
 
 
 def write_sheet_files(
@@ -561,9 +586,11 @@ def write_sheet_files(
     STL/OBJ and the thick solid (meshes in ``units``); if the thick panels overlap too much in
     that state, every file but the solids, with a note saying why.
     """
+    got = sheet_thickness(setting, row)
+    state, way = sheet_fold_path(setting, row)
     return write_row_files(sheet_shape(setting, row, ext), folder, row, units=units,
-                           cutter=cutter, thick=setting.thick, fallback=DegenerateGeometryError,
-                           what="no thick.stl")  # fmt: skip
+                           cutter=cutter, thick=got.technique, fallback=DegenerateGeometryError,
+                           what="no thick.stl", path=[*way, state])  # fmt: skip
 
 
 def sheet_scenario(
@@ -775,7 +802,7 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
         support_dofs=dofs,
         tol=tol,
         max_iter=max_iter,
-        thick=doc.choice("thick", THICK_TECHNIQUES, "centred"),
+        thick=doc.choice("thick", THICK_CHOICES, "auto"),
     )
     # the optional moduli are features when the file names them (else E holds everywhere)
     moduli = any(fsec.has(k) for k in _OPTIONAL_E)

@@ -40,10 +40,15 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
+    THICK_COLUMN,
+    crease_view,
     describe_material_and_loads,
     loaded_columns,
     read_supports_and_loads,
+    row_part,
     row_status,
+    row_thickness,
+    surface_lines,
     write_row_files,
 )
 from holofold.design.simulate import PatternLoad, PatternSetting, simulate_pattern
@@ -132,6 +137,7 @@ def surface_columns(setting: SurfaceScenarioSetting) -> tuple[Column, ...]:
         Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
         Column("overlap", "m^3", "intersection volume of the folded thick panels"),
         Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
+        THICK_COLUMN,
     ]
     return tuple(cols)
 
@@ -228,12 +234,55 @@ def surface_shape(setting: SurfaceScenarioSetting, row) -> CreasePattern:
     return fit.pattern
 
 
+def surface_part(setting: SurfaceScenarioSetting, row):
+    """The printable part: the fitted pattern's flat layout with the row's thicknesses and
+    hinge width (:func:`~holofold.design.scenarios.pattern_loads.row_part`)."""
+    from dataclasses import replace
+
+    shape = surface_shape(setting, row)
+    part = row_part(shape, row)
+    got = row_thickness(shape, row)
+    if part is None or got is None:
+        return part
+    return replace(part, thick=got.technique)
+
+
+def surface_view(setting: SurfaceScenarioSetting, row):
+    """The 3D view: flat, the fitted shell (the folded state, in the target's frame), the
+    supports and loads, and the target surface's grid lines over the fitted region."""
+    fit = surface_fit_of(setting, row)
+    if not fit.ok:
+        raise ValueError(f"the fit failed: {fit.message}")
+    pat = fit.pattern
+    # the chart's rectangle of the fitted footprint (surface_fit_of's placement)
+    u0, u1, v0, v1 = setting.target.domain
+    c = setting.centre or ((u0 + u1) / 2, (v0 + v1) / 2)
+    cov = float(row["coverage"])
+    hu, hv = cov * min(c[0] - u0, u1 - c[0]), cov * min(c[1] - v0, v1 - c[1])
+    dom = (c[0] - hu, c[0] + hu, c[1] - hv, c[1] + hv)
+    lines = surface_lines(setting.target.chart, dom)
+    rms = 1e3 * fit.rms
+    return crease_view(
+        pat,
+        fit.coords[None],
+        (f"fitted, ext {float(row['ext']):.3g}",),
+        setting.supports,
+        setting.loads,
+        curve=lines,
+        curve_name="target surface",
+        facts=(("fit", f"rms distance to the target {rms:.3g} mm, {pat.n_faces} panels"),),
+    )
+
+
 def write_surface_files(setting: SurfaceScenarioSetting, row, folder, units: str = "mm",
                         cutter=None):  # fmt: skip
     """The design's fabrication set (:func:`~holofold.geometry.write_fabrication_set`): FOLD,
     SVG, DXF, the folded shell as STL/OBJ, the thick panels and the printable part; without the
     solids (a note says why) where the panels do not allow them."""
-    return write_row_files(surface_shape(setting, row), folder, row, units=units, cutter=cutter)
+    shape = surface_shape(setting, row)
+    got = row_thickness(shape, row)
+    return write_row_files(shape, folder, row, units=units, cutter=cutter,
+                           thick=None if got is None else got.technique)  # fmt: skip
 
 
 def surface_scenario(
@@ -268,6 +317,8 @@ def surface_scenario(
         source=source,
         shape=partial(surface_shape, setting),
         write_files=partial(write_surface_files, setting),
+        view=partial(surface_view, setting),
+        part=partial(surface_part, setting),
         row_timeout=SURFACE_ROW_TIMEOUT,
     )
 

@@ -1,9 +1,17 @@
 """Options shared by the commands that write fabrication files (pattern, fit, design, demo):
-the cutter profile of the flat pattern's SVG and DXF."""
+the cutter profile of the flat pattern's SVG and DXF, the printer's bed the printable part is
+fitted on (and cut into pieces for when larger)."""
 
 from __future__ import annotations
 
-__all__ = ["add_cutter_arguments", "cutter_options", "add_thick_argument"]
+__all__ = [
+    "add_cutter_arguments",
+    "cutter_options",
+    "add_thick_argument",
+    "add_bed_argument",
+    "bed_of",
+    "say_part",
+]
 
 
 def add_cutter_arguments(p) -> None:
@@ -48,3 +56,35 @@ def add_thick_argument(p) -> None:
         "bevelled on both faces); the hinges stay on the simulated surface "
         "(docs/fabrication.md)",
     )  # fmt: skip
+
+
+def add_bed_argument(p) -> None:
+    """``--bed WxD``: the printer's bed the printable part is fitted on."""
+    p.add_argument(
+        "--bed", default=None, metavar="WxD",
+        help="printer bed WIDTHxDEPTH in mm (default 250x210): the printable part is fitted on "
+        "it and, when larger, cut at panel boundaries into pieces that each fit "
+        "(segments/segment_NN.stl and assembly.svg beside printable.stl)",
+    )  # fmt: skip
+
+
+def bed_of(args):
+    """The :class:`~holofold.geometry.Bed` of ``--bed`` (checked before any work)."""
+    from holofold.design import DEFAULT_BED, parse_bed
+
+    text = getattr(args, "bed", None)
+    return DEFAULT_BED if text is None else parse_bed(text)
+
+
+def say_part(files, bed, part, units: str, root) -> dict | None:
+    """If ``files`` (a fabrication set) holds ``printable``: its fit on ``bed``, cut into pieces
+    when larger (``part``: a :class:`~holofold.design.buildability.PrintablePart`), said in one
+    line; its JSON record (None without a printable part)."""
+    from holofold.design import part_fit
+
+    path = next((f.path for f in files.files if f.key == "printable"), None)
+    if path is None:
+        return None
+    fit = part_fit(path, bed, units=units, root=root, part=part)
+    print(fit.line())
+    return fit.to_json()

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import sys
 
-from holofold.cli._fabrication import cutter_options
+from holofold.cli._fabrication import bed_of, cutter_options, say_part
 from holofold.geometry import MAX_PANELS, ParameterError, check_range
 
 __all__ = ["SURFACE_ONLY", "add_surface_arguments", "run_surface"]
@@ -97,6 +97,7 @@ def run_surface(args) -> int:
 
     cells = _cells(args.cells)
     cutter = cutter_options(args)
+    bed = bed_of(args)
     gamma = check_range("--gamma", args.gamma, 0.0, 90.0, low_open=True, high_open=True)
     check_range("--ext", args.ext, 0.0, 1.0, low_open=True, high_open=True)
     angle = math.radians(check_range("--angle", args.angle, -360.0, 360.0))
@@ -151,7 +152,16 @@ def run_surface(args) -> int:
     elif check is not None:
         print(f"folded by simulation to within {check['fold_deviation_max']:.3g} m of the fit "
               f"({check['fold_seconds']:.1f} s)")  # fmt: skip
+    part = None
+    if getattr(args, "printable", False) and fit.ok:
+        from holofold.design import PrintablePart
+
+        part = PrintablePart(fit.pattern, args.panel_thickness, args.crease_thickness,
+                             args.crease_width, thick=args.thick)  # fmt: skip
+    fabrication = say_part(files, bed, part, units, None)
     summary = {**fit.summary, **(check or {}), "files": [str(p) for p in files.paths]}
+    if fabrication:
+        summary["fabrication"] = fabrication
     print(json.dumps(summary))
     if failed:
         print(f"holofold fit: {failed}", file=sys.stderr)

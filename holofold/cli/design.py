@@ -59,8 +59,10 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--bed",
-        default="250x210",
-        help="printer bed WIDTHxDEPTH in mm the part is fitted on (default 250x210)",
+        default=None,
+        metavar="WxD",
+        help="printer bed WIDTHxDEPTH in mm the part is fitted on and, when larger, cut into "
+        "pieces for (default: the scenario's bed key, else 250x210)",
     )
     p.add_argument(
         "--pilot",

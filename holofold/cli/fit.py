@@ -33,7 +33,14 @@ import argparse
 import math
 from pathlib import Path
 
-from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
+from holofold.cli._fabrication import (
+    add_bed_argument,
+    add_cutter_arguments,
+    add_thick_argument,
+    bed_of,
+    cutter_options,
+    say_part,
+)
 from holofold.cli._surface_fit import SURFACE_ONLY, add_surface_arguments, run_surface
 from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
@@ -141,6 +148,7 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
     add_thick_argument(p)
+    add_bed_argument(p)
     add_cutter_arguments(p)
     return p
 
@@ -255,6 +263,7 @@ def run(args) -> int:
 
     opts = _validate(args)
     cutter = cutter_options(args)
+    bed = bed_of(args)
     scaled = args.curve_scale != 1.0
     curve = load_curve(args.curve, units=args.curve_units, check_size=not scaled)
     if scaled:
@@ -294,6 +303,13 @@ def run(args) -> int:
         cutter=cutter,
         thick=args.thick,
     )
+    part = None
+    if args.printable and fit.flat is not None:
+        from holofold.design import PrintablePart
+
+        part = PrintablePart(fit.flat_pattern, args.panel_thickness, args.crease_thickness,
+                             args.crease_width, thick=args.thick)  # fmt: skip
+    fabrication = say_part(written, bed, part, args.units, None)
     units = {"lengths": "m", "errors": "m", "warp": "relative (1 = 100 %)",
              "mesh files": args.units, "strip.fold": "m", "strip.svg": "mm",
              "strip.dxf": "mm"}  # fmt: skip
@@ -303,6 +319,7 @@ def run(args) -> int:
         "units": units,
         "files": [str(f.path) for f in written],
         "notes": list(written.notes),
+        **({"fabrication": fabrication} if fabrication else {}),
     }
     warp = fit.errors["warp_max"]
     limit = f" (limit {100 * args.max_warp:.3g} %)" if args.auto else ""

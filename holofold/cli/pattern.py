@@ -29,7 +29,14 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.cli._fabrication import add_cutter_arguments, add_thick_argument, cutter_options
+from holofold.cli._fabrication import (
+    add_bed_argument,
+    add_cutter_arguments,
+    add_thick_argument,
+    bed_of,
+    cutter_options,
+    say_part,
+)
 
 
 def _option(name: str) -> str:
@@ -56,6 +63,7 @@ def _fabrication_arguments(p) -> None:
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
     add_thick_argument(p)
+    add_bed_argument(p)
     add_cutter_arguments(p)
 
 
@@ -100,6 +108,7 @@ def run(args) -> int:
     from holofold.geometry import ParameterError, check_range, write_fabrication_set
 
     cutter = cutter_options(args)
+    bed = bed_of(args)
     fam, values, pattern = _build(args)
     check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:
@@ -135,4 +144,10 @@ def run(args) -> int:
     )
     for note in written.notes:
         print(f"  note: {note}")
+    if args.printable and pattern.flat is not None:
+        from holofold.design import PrintablePart
+
+        part = PrintablePart(pattern, args.thickness, args.crease_thickness, args.crease_width,
+                             thick=args.thick)  # fmt: skip
+        say_part(written, bed, part, args.units, None)
     return 0

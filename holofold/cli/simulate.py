@@ -136,7 +136,7 @@ def run(args) -> int:
         model=args.model, supports=tuple(args.support), support_dofs=args.support_dofs,
         loads=loads, collisions=not args.no_collisions,
     )  # fmt: skip
-    pattern = read_pattern(args.pattern, **given)
+    pattern = _read_sized(read_pattern, args, given)
     if args.size is not None:
         check_range("--size", args.size, 0.0, None, low_open=True)
         span = float(
@@ -156,3 +156,26 @@ def run(args) -> int:
     )
     print(sim.status_line())
     return 0 if sim.fold.complete else 1  # 1: the fold stopped short (the status says where)
+
+
+def _read_sized(read_pattern, args, given):
+    """The pattern read, its readers' unit notes said with this command's options: none when
+    ``--size`` or ``--scale`` sets the size anyway, else naming ``--unit`` and ``--size``."""
+    import warnings
+
+    from holofold.geometry import PatternWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        pattern = read_pattern(args.pattern, **given)
+    sized = args.size is not None or args.scale is not None
+    for w in caught:
+        text = str(w.message)
+        if text.endswith("give unit") and issubclass(w.category, PatternWarning):
+            if sized:
+                continue  # --size / --scale sets the lengths: the file's unit does not matter
+            text = text[: -len("give unit")] + (
+                "give --unit (metres per drawing unit) or --size (the larger side, m)"
+            )
+        warnings.warn_explicit(text, w.category, w.filename, w.lineno)
+    return pattern
