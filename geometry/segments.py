@@ -286,15 +286,29 @@ def _teeth(L: float, room: float, far: float) -> tuple:
     return neck * k, head * k, deep * k, max(1, int(L // 30.0))
 
 
-def _piece_solid(part, region, name: str):
+#: a separate fragment of a piece smaller than this is left out, mm^3 (and a region's island
+#: under this many mm^2 is not drawn): a sliver the region arithmetic leaves at a joint's
+#: corner, below a printer's nozzle width in two directions
+_CRUMB = 1.0
+
+
+def _piece_bodies(part, region) -> list:
+    """The part inside ``region``'s prism as its separate bodies (fragments under ``_CRUMB``
+    left out), largest first. A planned piece whose panels the joints next to it leave joined
+    only through a neighbour's hinge comes out as more than one body: each is printed as a
+    piece of its own."""
     import manifold3d as m3d
 
     prism = m3d.Manifold.extrude(region, 1e6).translate((0.0, 0.0, -5e5))
-    solid = part ^ prism
-    bodies = len(solid.decompose())
-    if bodies != 1:
-        raise DegenerateGeometryError(f"{name} falls apart into {bodies} bodies")
-    return solid
+    bodies = [b for b in (part ^ prism).decompose() if b.volume() >= _CRUMB]
+    return sorted(bodies, key=lambda b: -b.volume())
+
+
+def _xy_distance(box, point) -> float:
+    """Distance (mm) in the layout's plane from a point to a body's bounding box
+    (min x, min y, min z, max x, max y, max z)."""
+    lo, hi = np.asarray(box[:2]), np.asarray(box[3:5])
+    return float(np.hypot(*np.maximum(np.maximum(lo - point, point - hi), 0.0)))
 
 
 def _joints(pattern, cells, chords, piece_of, W, rim_mm):
@@ -430,36 +444,56 @@ def segment_part(
         take = _band(p0, p1, gc - p0, far, teeth, c / 2, ext) ^ cell
         regions[a] = regions[a] + give
         regions[b] = regions[b] - take
-        joints.append((a + 1, b + 1, e))
+        joints.append((a, b, e, (p0 + p1) / 2))
     part = m3d.Manifold(
         m3d.Mesh64(
             vert_properties=np.ascontiguousarray(np.asarray(part_m.vertices) * _MM),
             tri_verts=np.asarray(part_m.faces, np.uint64),
         )
     )
-    segments = []
+    segments, body_of = [], []  # body_of[k]: (segment index, xy box) of planned piece k
     for k, (members, region) in enumerate(zip(plan, regions, strict=True)):
-        solid = _piece_solid(part, region, f"piece {k + 1}").to_mesh64()
-        mesh = trimesh.Trimesh(
-            vertices=np.asarray(solid.vert_properties)[:, :3] / _MM,
-            faces=np.asarray(solid.tri_verts, np.int64),
-            process=False,
-        )
-        # as its STL (mm) reads back: vertices merged
-        closed = trimesh.Trimesh(np.asarray(mesh.vertices) * _MM, mesh.faces)
-        if not closed.is_watertight or closed.body_count != 1:
-            raise DegenerateGeometryError(
-                f"piece {k + 1} is not one closed body once its vertices are merged (parts of "
-                "it touch along an edge)"
+        bodies = _piece_bodies(part, region)
+        if not bodies:
+            raise DegenerateGeometryError(f"piece {k + 1} is empty")
+        body_of.append([])
+        for body in bodies:
+            index = len(segments) + 1
+            box = body.bounding_box()
+            body_of[k].append((index, box))
+            solid = body.to_mesh64()
+            mesh = trimesh.Trimesh(
+                vertices=np.asarray(solid.vert_properties)[:, :3] / _MM,
+                faces=np.asarray(solid.tri_verts, np.int64),
+                process=False,
             )
-        if flip:  # hinge face down, as the whole part prints
-            mesh.apply_transform(np.diag([1.0, -1.0, -1.0, 1.0]))
-        mesh.apply_translation((0.0, 0.0, -mesh.bounds[0][2]))
-        fit = bed_fit(mesh, bed)
-        placed = place_on_bed(mesh, fit) if fit.fits else mesh
-        outline = tuple(np.asarray(p) / _MM for p in region.to_polygons())
-        faces = np.unique([cells[m].face for m in members])
-        segments.append(Segment(k + 1, faces, outline, placed, fit))
+            # as its STL (mm) reads back: vertices merged
+            closed = trimesh.Trimesh(np.asarray(mesh.vertices) * _MM, mesh.faces)
+            if not closed.is_watertight or closed.body_count != 1:
+                raise DegenerateGeometryError(
+                    f"piece {index} is not one closed body once its vertices are merged (parts "
+                    "of it touch along an edge)"
+                )
+            if flip:  # hinge face down, as the whole part prints
+                mesh.apply_transform(np.diag([1.0, -1.0, -1.0, 1.0]))
+            mesh.apply_translation((0.0, 0.0, -mesh.bounds[0][2]))
+            fit = bed_fit(mesh, bed)
+            placed = place_on_bed(mesh, fit) if fit.fits else mesh
+            polys = [
+                np.asarray(q) for q in region.to_polygons() if abs(_area(np.asarray(q))) >= _CRUMB
+            ]
+            mine = [
+                q for q in polys if len(bodies) == 1 or _xy_distance(box, q.mean(axis=0)) < 1e-6
+            ]
+            outline = tuple(q / _MM for q in mine)
+            near = [m for m in members if _xy_distance(box, cells[m].poly.mean(axis=0)) < 1e-6]
+            faces = np.unique([cells[m].face for m in (members if len(bodies) == 1 else near)])
+            segments.append(Segment(index, faces, outline, placed, fit))
+
+    def which(k, point):  # the segment of planned piece k nearest a joint's middle
+        return min(body_of[k], key=lambda ib: _xy_distance(ib[1], point))[0]
+
+    joints = [(which(a, mid), which(b, mid), e) for a, b, e, mid in joints]
     out = Segmentation(bed, whole, tuple(segments), np.array(joints, int).reshape(-1, 3))
     if not out.fits:
         bad = next(s for s in segments if not s.fit.fits)

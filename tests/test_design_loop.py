@@ -264,7 +264,9 @@ def test_demo_is_the_design_loop_on_the_arch(tmp_path):
     assert parse_target("Zstiff > 100 & error < 0.1").evaluate(
         pd.DataFrame([summary["performance"]])
     )[0]
-    assert said[0].startswith("[database]") and said[-1].startswith("chosen:")
+    # the chosen design, then its printable part: cut into pieces that fit the default bed
+    assert said[0].startswith("[database]") and said[-2].startswith("chosen:")
+    assert said[-1].startswith("part: files/printable.stl") and "cut into" in said[-1], said[-1]
 
 
 @pytest.mark.slow
@@ -502,6 +504,7 @@ def test_hf_design_and_the_other_layers_are_reachable():
 SHEET = """
 kind = "sheet"
 name = "awning"
+thick = "centred"
 [sheet]
 size_x = 0.3
 size_y = 0.15
@@ -536,7 +539,7 @@ def test_overlapping_panels_are_chosen_only_when_allowed_and_then_not_printed_fo
     assert not (tmp_path / "a" / "files" / "thick.stl").exists()
     assert any("thick.stl not written" in w for w in s["warnings"])
     assert (tmp_path / "a" / s["files"]["printable"]["path"]).is_file()  # the flat part prints
-    # by default the same designs give a buildable one, or say that none is
+    # without --allow-overlap the same designs give a buildable one, or say that none is
     strict = run_design(tmp_path / "awning.toml", "mass > 0", tmp_path / "a", **kw)
     t = strict.summary
     assert t["buildable"] is True and t["performance"]["overlap"] == 0.0
