@@ -4,7 +4,8 @@
 
 1. **database**: sample designs of the scenario and simulate them (resumable Parquet batches),
    a small **pilot** batch first: when no pilot design meets the target and one of its
-   conditions is met by none of them, the run stops there and says what the designs reach;
+   conditions is out of reach (the pilot's tail, extrapolated, expects less than one design
+   meeting it within the budget), the run stops there and says what the designs reach;
 2. **mine**: rules for the target (random forest), keeping distinct alternatives;
 3. **verify**: simulate fresh designs inside each top rule (95 % Wilson interval);
 4. **refine** (until a rule is verified or the ``budget`` of simulations is spent): sample new
@@ -227,21 +228,34 @@ def _clean(v):
     return v
 
 
-def _pilot_verdict(rows: pd.DataFrame, tgt) -> tuple[int, list[str], str | None]:
-    """(designs meeting the target, conditions met by none, why to stop or None)."""
+def _pilot_verdict(rows: pd.DataFrame, tgt, budget: int) -> tuple[int, list[str], str | None]:
+    """(designs meeting the target, conditions out of reach, why to stop or None).
+
+    A condition no pilot design meets is out of reach when the pilot's top tail,
+    extrapolated (:meth:`Target.reach`), expects fewer than one design meeting it in the
+    run's ``budget`` of simulations; a condition that is merely rare (or met by some designs)
+    never stops the run. With ``|``, the run stops only when every condition is out of reach.
+    """
     ok = rows.loc[~failed_rows(rows)]
     if not len(ok):
         return 0, [], f"every one of the {len(rows)} pilot simulations failed"
     hits = int(tgt.evaluate(ok).sum())
     if hits:
         return hits, [], None
-    margins = tgt.margins(ok)
-    unmet = [c for c, m in margins.items() if not (np.nan_to_num(m, nan=-np.inf) >= 0).any()]
-    if unmet:
-        return 0, unmet, (f"no pilot design meets {' nor '.join(unmet)}")
-    if not tgt.conjunctive:
-        return 0, [], f"no pilot design meets the target {str(tgt)!r}"
-    return 0, [], None  # each condition met by some, jointly by none: a rare target, go on
+    reach = tgt.reach(ok)
+    far = [r for r in reach if r.meeting == 0 and r.rarity * budget < 1.0]
+    if not far or (not tgt.conjunctive and len(far) < len(tgt.conditions)):
+        return 0, [], None  # rare, not out of reach: go on
+    why = []
+    for r in far:
+        q5, q50, q95 = np.nanquantile(ok[r.column].to_numpy(float), [0.05, 0.5, 0.95])
+        odds = f"1 in {1 / r.rarity:.2g}" if r.rarity > 0 else "none"
+        why.append(
+            f"{r.condition} (the pilot's 5 / 50 / 95 % are {q5:.4g} / {q50:.4g} / {q95:.4g}, its "
+            f"best {r.best:.4g}; its top quarter extrapolates to {odds} designs, fewer than one "
+            f"in the budget of {budget})"
+        )
+    return 0, [r.condition for r in far], "no pilot design meets " + " nor ".join(why)
 
 
 def _buildable_target(sc: Scenario, tgt, table: pd.DataFrame, say=lambda text: None):
@@ -498,7 +512,7 @@ class DesignLoop:
             parts.append(rows.assign(origin="database"))
             st.table = pd.concat([p for p in parts if len(p)], ignore_index=True)
             if s.pilot:
-                st.pilot = _pilot_info(st.table, self.problem.target, say)
+                st.pilot = _pilot_info(st.table, self.problem.target, s.budget, say)
         if st.pilot and st.pilot["stopped"]:
             return False
         with self._timed("database"):
@@ -746,11 +760,15 @@ class DesignLoop:
         return _replace(summary, warnings=tuple(notes), **extra)
 
 
-def _pilot_info(table: pd.DataFrame, tgt, say) -> dict:
-    """The pilot's verdict for the summary (and the line saying why it stops the run)."""
-    hits, unmet, stop = _pilot_verdict(table, tgt)
+def _pilot_info(table: pd.DataFrame, tgt, budget: int, say) -> dict:
+    """The pilot's verdict for the summary (and the line saying why it stops the run, or that
+    a target none of its designs meets is rare, not out of reach)."""
+    hits, unmet, stop = _pilot_verdict(table, tgt, budget)
     if stop is not None:
         say(f"  pilot: {stop} ({len(table)} designs); stopping before the rest")
+    elif not hits and len(table):
+        say(f"  pilot: none of {len(table)} designs meets the target, but it is not out of reach "
+            "(rare: the run goes on)")  # fmt: skip
     return {
         "rows": int(len(table)),
         "meeting": hits,

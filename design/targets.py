@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["TargetError", "Target", "parse_target"]
+__all__ = ["TargetError", "Target", "Reach", "parse_target"]
 
 
 class TargetError(ValueError):
@@ -247,6 +247,24 @@ def _pairs(node):
     return [(node.operands[k], op, node.operands[k + 1]) for k, op in enumerate(node.ops)]
 
 
+def _tail_rarity(x: np.ndarray, t: float, up: bool) -> float:
+    """Fraction of designs beyond ``t`` (above when ``up``) extrapolated from the top of ``x``
+    (finite values, none beyond ``t``) with an exponential tail; see :meth:`Target.reach`."""
+    n = len(x)
+    if n < 5:
+        return float("nan")
+    if (x > 0).all() and t > 0:
+        x, t = np.log(x), float(np.log(t))
+    if not up:
+        x, t = -x, -t
+    k = max(2, n // 4)
+    top = np.sort(x)[::-1][:k]
+    beta = (top[0] - top[-1]) / float(np.sum(1.0 / np.arange(1, k)))
+    if beta <= 0:
+        return 0.0
+    return float(k / n * np.exp(-(t - top[-1]) / beta))
+
+
 def _pair_margin(a, op, b, frame) -> np.ndarray:
     """Signed margin of ``a op b`` per row of ``frame``, normalised by the threshold (>= 0
     where it holds); (len(frame),) even for a pair of two numbers (``1 < 2 < Zstiff``)."""
@@ -300,6 +318,37 @@ def _render(node) -> str:
         else:
             parts.append(f"{o.value:g}")
     return " ".join(parts)
+
+
+@dataclass(frozen=True)
+class Reach:
+    """How far a sample of designs is from one condition of a target.
+
+    Attributes
+    ----------
+    condition : str
+        The comparison, as text (``"axialstiff30 > 33000"``).
+    column : str
+        Its column.
+    threshold : float
+        The number it is compared with, in the column's unit.
+    best : float
+        The sample's value nearest to meeting it (largest for ``>``), in the column's unit.
+    meeting : int
+        Designs of the sample that meet it.
+    rarity : float
+        The fraction of designs estimated to meet it: the observed fraction when some do;
+        otherwise an extrapolation of the sample's top tail (see :meth:`Target.reach`);
+        NaN when it cannot be estimated (fewer than 5 finite values, or a condition between two
+        columns).
+    """
+
+    condition: str
+    column: str
+    threshold: float
+    best: float
+    meeting: int
+    rarity: float
 
 
 @dataclass(frozen=True)
@@ -367,6 +416,38 @@ class Target:
         out: list = []
         _conditions(self._tree, out)
         return {f"{_text(a)} {op} {_text(b)}": _pair_margin(a, op, b, frame) for a, op, b in out}
+
+    def reach(self, frame) -> tuple[Reach, ...]:
+        """Per condition between a column and a number, how far ``frame``'s designs are from it.
+
+        Where no design meets a condition, its rarity is extrapolated from the top of the
+        sample, with an exponential tail beyond the k-th best value (k = a quarter of the finite
+        values, at least 2): the spacing of the k best values gives the tail's scale
+        ``beta = (best - x_k) / H_(k-1)`` (the mean spacing of exponential order statistics,
+        H the harmonic number), and ``rarity = (k / n) exp(-(t - x_k) / beta)``. Values and
+        threshold are taken on a log scale when all are positive (stiffnesses, masses: a
+        multiplicative spread). A target out of a uniform range's reach gets a tiny rarity (its
+        top values bunch below the bound); a rare one in a long tail gets about its true
+        frequency.
+        """
+        self.evaluate(frame)
+        out: list = []
+        _conditions(self._tree, out)
+        reach = []
+        for a, op, b in out:
+            if op in ("==", "!=") or isinstance(a, _Column) == isinstance(b, _Column):
+                continue
+            col, num, up = (a, b, op in (">", ">=")) if isinstance(a, _Column) else (
+                b, a, op in ("<", "<="))  # fmt: skip
+            x = np.asarray(frame[col.name], dtype=float)
+            x = x[np.isfinite(x)]
+            t = float(num.value)
+            holds = np.asarray(_OPS[op](x, t) if col is a else _OPS[op](t, x), bool)
+            best = float((x.max() if up else x.min()) if len(x) else np.nan)
+            rarity = float(holds.mean()) if holds.any() else _tail_rarity(x, t, up)
+            reach.append(Reach(f"{_text(a)} {op} {_text(b)}", col.name, t, best,
+                               int(holds.sum()), rarity))  # fmt: skip
+        return tuple(reach)
 
     def margin(self, frame) -> np.ndarray:
         """(n_rows,) worst-case margin: the minimum over ``&``, the maximum over ``|``."""

@@ -419,13 +419,17 @@ def test_without_a_qualifying_rule_or_a_meeting_design_the_answer_is_still_there
 
 
 def test_an_unreachable_target_stops_after_the_pilot_with_an_answer(tmp_path):
+    """double = 2a, a uniform on [0, 1]: a threshold twice the bound is out of reach (the
+    pilot's top values bunch below 2, extrapolating to far less than one design in the
+    budget); the line says the pilot's quantiles."""
     sc = _cheap_scenario()
     said = []
-    res = run_design(sc, "double > 3", tmp_path / "o", samples=200, pilot=30, verify=5, rounds=0,
+    res = run_design(sc, "double > 4", tmp_path / "o", samples=200, pilot=30, verify=5, rounds=0,
                      workers=1, progress=False, say=said.append)  # fmt: skip
     s = json.loads((tmp_path / "o" / "design.json").read_text())
     assert s["pilot"]["stopped"] and s["pilot"]["rows"] == 30 and s["rounds"] == []
-    assert "no pilot design meets double > 3" in s["pilot"]["reason"]
+    assert "no pilot design meets double > 4 (the pilot's 5 / 50 / 95 % are" in s["pilot"]["reason"]
+    assert "fewer than one in the budget of 6000" in s["pilot"]["reason"]
     assert s["answer"] == "nearest" and not s["meets_target"] and len(res.table) == 30
     d = {x["name"]: x for x in s["distributions"]}["double"]
     assert d["rows"] == 30 and d["quantiles"]["100%"] < 2.0  # what the designs reach
@@ -435,6 +439,13 @@ def test_an_unreachable_target_stops_after_the_pilot_with_an_answer(tmp_path):
     rare = run_design(sc, "double > 1.9 & mass < 1.0", tmp_path / "r", samples=60, pilot=30,
                       verify=5, rounds=0, workers=1, progress=False, files=False)  # fmt: skip
     assert not rare.record.pilot["stopped"] and len(rare.table) >= 60
+    # one condition that no pilot design meets but the sample's tail reaches: rare, goes on
+    said = []
+    one = run_design(sc, "double > 1.995", tmp_path / "one", samples=60, pilot=30, verify=5,
+                     rounds=0, workers=1, progress=False, files=False, say=said.append)  # fmt: skip
+    assert not (one.table["double"].iloc[:30] > 1.995).any()  # the pilot has no hit
+    assert not one.record.pilot["stopped"] and len(one.table) >= 60
+    assert any("not out of reach" in line for line in said)
 
 
 def test_growing_samples_rounds_and_verify_extends_the_folder(tmp_path):

@@ -135,3 +135,26 @@ def test_a_chain_with_two_numbers_side_by_side_has_a_margin_per_row():
     never = parse_target("1 < 1 < Zstiff", ["Zstiff"])
     assert never.evaluate(frame).tolist() == [False, False, False]
     assert never.margin(frame).shape == (3,)
+
+
+def test_reach_extrapolates_a_rare_condition_and_not_a_bounded_one():
+    """A 1 %-rare stiffness (lognormal sample) that none of 50 designs meets is estimated at
+    about its frequency; a threshold 50 % beyond a uniform column's bound at far less; met
+    conditions give their observed fraction."""
+    rng = np.random.default_rng(3)
+    rare, bounded = [], []
+    for _ in range(200):
+        x = np.exp(rng.normal(0.0, 1.0, 50))
+        if (x > np.exp(2.326)).any():  # 1 % of the distribution lies beyond
+            continue
+        (r,) = parse_target(f"k > {np.exp(2.326)}").reach(pd.DataFrame({"k": x}))
+        assert r.meeting == 0 and r.best == pytest.approx(x.max())
+        rare.append(r.rarity)
+        (u,) = parse_target("d > 3").reach(pd.DataFrame({"d": 2 * rng.uniform(0, 1, 50)}))
+        bounded.append(u.rarity)
+    assert 2e-3 < np.median(rare) < 2e-2 and np.quantile(rare, 0.05) > 1.7e-4
+    assert np.median(bounded) < 1e-4
+    (m,) = parse_target("30 < k").reach(pd.DataFrame({"k": [10.0, 20.0, 40.0, 50.0]}))
+    assert m.meeting == 2 and m.rarity == 0.5 and m.best == 50.0 and m.column == "k"
+    (low,) = parse_target("k < 0.5").reach(pd.DataFrame({"k": np.linspace(1.0, 2.0, 40)}))
+    assert low.best == 1.0 and 0.0 <= low.rarity < 1e-3

@@ -16,7 +16,10 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="design end to end: database, rules, verification, the best design and its files",
         description=(
             "Build (or reuse and extend) a database of the scenario, a pilot batch first (the "
-            "run stops after it, saying what the designs reach, when none meets the target), "
+            "run stops after it, saying what the designs reach, only when no pilot design "
+            "meets the target and a condition is out of reach: the pilot's top tail, "
+            "extrapolated, expects less than one design meeting it within --budget; a rare "
+            "target goes on), "
             "mine design rules for the target, verify the best rules with fresh simulations, "
             "refine where the forest expects the target and mine again until a rule is verified "
             "or --budget simulations are spent, and choose from every simulated "
@@ -68,7 +71,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "--pilot",
         type=int,
         default=None,
-        help="designs simulated first to check the target is reachable (default 50; 0: none)",
+        help="designs simulated first to check the target is within reach (default 50; 0: none)",
     )
     p.add_argument("--db", type=Path, help="database folder (default OUT/database)")
     p.add_argument(
