@@ -581,7 +581,7 @@ class DesignLoop:
                                        n_rules=s.top, max_overlap=0.5,
                                        source=str(self.dbf))  # fmt: skip
             except OneClassSplit:  # a few hits, all held out: look around them, as with no rule
-                note = f"no rule yet ({hits} of {len(ok)} designs meet the target, too few to mine)"
+                note = f"no rule yet ({self._met(ok, hits)}: too few to mine)"
                 st.history.append(Round(r, len(ok), len(st.table) - len(ok), hits, (), note))
                 if not self.more(r):
                     say(f"  round {r}: {note}")
@@ -596,11 +596,23 @@ class DesignLoop:
                 write_rules(self._round_dir(r) / "rules.json", records, self.sc.columns)
         return records or self._no_rule(r, mined)
 
+    def _met(self, ok: pd.DataFrame, hits: int, what: str = "designs") -> str:
+        """'k of n designs meet the target', and when rules are mined for the target with
+        buildable panels, how many meet the target itself: the two counts, never one for
+        the other."""
+        st, target = self.state, self.problem.target
+        if str(st.mine_target) == str(target) or not len(ok):
+            return f"{hits} of {len(ok)} {what} meet the target"
+        raw = int(target.evaluate(ok).sum())
+        return (
+            f"{raw} of {len(ok)} {what} meet the target, {hits} of them with thick panels "
+            "that do not overlap"
+        )
+
     def _nothing_to_mine(self, r: int, ok: pd.DataFrame, hits: int) -> bool:
         st, n = self.state, len(self.state.table)
-        note = (
-            f"no rule to mine: {hits} of {len(ok)} simulated designs meet "
-            f"{'the target' if hits == 0 else 'the target, all of them'}"
+        note = f"no rule to mine: {self._met(ok, hits, 'simulated designs')}" + (
+            ", all of them" if hits else ""
         )
         look = hits == 0 and self.more(r) and 0 < len(ok) and n < RANDOM_UP_TO
         if look:  # a rare target: keep looking
@@ -616,16 +628,12 @@ class DesignLoop:
 
     def _no_rule(self, r: int, mined) -> bool:
         rows, failed, hits = int(len(mined.table)), int(mined.n_failed), int(mined.meets.sum())
+        ok = mined.table  # the rows mined: failed ones already left out
         if hits and self.more(r):  # a rare target: refine around the designs that meet it
             self.state.boxes = [_box_of(mined.table.loc[mined.meets], self.roles)]
-            note = (
-                f"no rule yet ({hits} of {rows} designs meet the target); the next "
-                "round samples around them"
-            )
+            note = f"no rule yet ({self._met(ok, hits)}); the next round samples around them"
         else:
-            note = (
-                f"no rule reaches the miner's precision ({hits} of {rows} designs meet the target)"
-            )
+            note = f"no rule reaches the miner's precision ({self._met(ok, hits)})"
         self.say(f"  round {r}: {note}")
         self.state.history.append(Round(r, rows, failed, hits, (), note))
         return bool(hits)  # nothing to refine around: more rounds would sample the same
