@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from holofold.design.objective import Objective
-from holofold.design.rounds import RULE_QUALIFIES, VerifiedRule
+from holofold.design.rounds import RULE_BAR, RULE_QUALIFIES, VerifiedRule
 from holofold.design.row_status import converged_rows, failed_rows
 
 __all__ = ["Candidate", "Answer", "choose", "OVERLAP_TOLERANCE", "ANSWER_KINDS"]
@@ -267,9 +267,16 @@ def _headline(
     if kind == "rule":
         r = chosen.rule
         lo, hi = r.interval
+        bar = (
+            "verified rule of all rounds"
+            if r.meets_bar
+            else f"rule of all rounds, verified BELOW the loop's bar of {_pct(RULE_BAR[0])} "
+            f"(interval from {_pct(RULE_BAR[1])}): about {_pct(1 - r.precision)} of designs "
+            "inside it miss the target"
+        )
         return (
             f"The design with {by} among the simulated designs inside {r.label}, the best "
-            f"verified rule of all rounds (verified precision {_pct(r.precision)}, 95 % "
+            f"{bar} (verified precision {_pct(r.precision)}, 95 % "
             f"interval {_pct(lo)} to {_pct(hi)}, n = {r.verified.simulated}); "
             f"{n_good} of {n_ok} simulated designs {meeting[5:]}.{overlap}"
         )

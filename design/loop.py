@@ -51,7 +51,7 @@ from holofold.design.describe import distributions
 from holofold.design.folder_lock import folder_lock
 from holofold.design.mining import OneClassSplit, mine_rules
 from holofold.design.objective import Objective, parse_objective
-from holofold.design.rounds import Round, VerifiedRule
+from holofold.design.rounds import RULE_BAR, Round, VerifiedRule
 from holofold.design.row_status import converged_rows, failed_rows
 from holofold.design.rulefile import mined_rules, write_rules
 from holofold.design.rules import Condition, FewRulesWarning, Rule
@@ -823,12 +823,13 @@ def _say_chosen(say, summary: DesignSummary, tgt, out: Path, columns: Mapping) -
         say(f"no design: every simulation failed; see {out}/report.html")
         return
     vp = None if c.rule is None else c.rule.precision
+    below = "" if c.rule is None or c.rule.meets_bar else f" (below the {RULE_BAR[0]:g} bar)"
     feats = ", ".join(f"{k} = {_shown(columns, k, v)}" for k, v in c.features.items())
     perf = ", ".join(f"{k} = {_shown(columns, k, c.performance.get(k))}" for k in tgt.columns)
     state = "meets the target" if c.meets else "does NOT meet the target (nearest)"
     say(
         f"chosen: {feats}\n  {perf}; {state}; worst margin {c.worst_margin:.3g}; answer "
-        f"{summary.answer!r}; rule verified precision {_fmt(vp)}; files in {out}/"
+        f"{summary.answer!r}; rule verified precision {_fmt(vp)}{below}; files in {out}/"
     )
 
 
@@ -874,7 +875,7 @@ def rule_verified(counts) -> bool:
     """A rule is verified: at least 90 % of its fresh designs met the target and the lower end
     of their 95 % Wilson interval is at least 0.8 (``counts``: a verification's ``Counts``)."""
     p, ci = counts.precision, counts.interval
-    return p is not None and p >= 0.9 and ci[0] >= 0.8
+    return p is not None and p >= RULE_BAR[0] and ci[0] >= RULE_BAR[1]
 
 
 def _worth_verifying(rules: Sequence[Rule], last: bool) -> list[int]:

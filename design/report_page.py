@@ -469,7 +469,12 @@ def _alternatives(summary: DesignSummary, cols: Mapping) -> str:
     ]
     rows = [
         ["rule verified precision"]
-        + [_precision(p.rule.precision) if p.rule is not None else _MISSING for p in unique]
+        + [
+            _MISSING
+            if p.rule is None
+            else _precision(p.rule.precision) + ("" if p.rule.meets_bar else " (below the bar)")
+            for p in unique
+        ]
     ]
     rows.append(["meets the target"] + ["yes" if p.meets else "no" for p in unique])
     rows.append(

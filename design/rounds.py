@@ -16,10 +16,13 @@ from dataclasses import dataclass, field
 
 from holofold.design.rules.record import Rule
 
-__all__ = ["Counts", "VerifiedRule", "Round", "RULE_QUALIFIES", "wilson"]
+__all__ = ["Counts", "VerifiedRule", "Round", "RULE_QUALIFIES", "RULE_BAR", "wilson"]
 
 #: a rule is an answer when at least this share of its fresh designs met the target
 RULE_QUALIFIES = 0.5
+#: the loop's bar for a verified rule: this share of its fresh designs met the target, and the
+#: lower end of their 95 % Wilson interval at least the second number
+RULE_BAR = (0.9, 0.8)
 
 
 def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
@@ -148,6 +151,12 @@ class VerifiedRule:
         """Verified at :data:`RULE_QUALIFIES` or more."""
         p = self.precision
         return p is not None and p >= RULE_QUALIFIES
+
+    @property
+    def meets_bar(self) -> bool:
+        """Verified at the loop's bar (:data:`RULE_BAR`): the rule the loop stops on."""
+        p, ci = self.precision, self.interval
+        return p is not None and p >= RULE_BAR[0] and ci[0] >= RULE_BAR[1]
 
     def sort_key(self) -> tuple:
         """Best first when sorted descending: verified precision, its lower bound, held-out."""

@@ -299,6 +299,8 @@ class DesignSummary:
             "buildable": None if c is None else c.buildable,
             "rule": None if c is None or c.rule is None else c.rule.to_json(),
             "verified_precision": None if c is None or c.rule is None else c.rule.precision,
+            # the chosen rule verified at the loop's bar (90 %, interval from 80 %), or below it
+            "rule_meets_bar": None if c is None or c.rule is None else c.rule.meets_bar,
             "chosen": None if c is None else c.to_json(),
             "alternatives": [a.to_json() for a in self.alternatives],
             "rounds": [r.to_json() for r in self.rounds],

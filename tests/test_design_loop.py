@@ -401,6 +401,23 @@ def test_choose_takes_the_best_verified_rule_of_all_rounds_and_the_objective():
     assert any("overlapping panels were allowed" in c.source for c in strict.alternatives)
 
 
+def test_a_rule_verified_below_the_bar_is_labelled_so():
+    """9 of 10 fresh designs (interval from 60 %) is an answer but below the loop's bar (90 %,
+    interval from 80 %): the headline says so; 48 of 50 meets it."""
+    from holofold.design import choose, parse_objective
+
+    t = parse_target("double > 1")
+    df = pd.DataFrame([{**r, **_two(r)} for r in [{"a": 0.7, "b": 0.1}, {"a": 0.2, "b": 0.1}]])
+    box = {"a": {"gt": 0.5, "le": None}}
+    weak, strong = _rule(0, 1, box, 9), _rule(0, 1, box, 48, n=50)
+    assert not weak.meets_bar and strong.meets_bar
+    below = choose(df, t, parse_objective(None, df.columns), [weak])
+    assert below.kind == "rule" and "verified BELOW the loop's bar of 90 %" in below.headline
+    assert "about 10 % of designs inside it miss the target" in below.headline
+    at = choose(df, t, parse_objective(None, df.columns), [strong])
+    assert "the best verified rule of all rounds (verified precision 96 %" in at.headline
+
+
 def test_without_a_qualifying_rule_or_a_meeting_design_the_answer_is_still_there():
     from holofold.design import choose, parse_objective
 
