@@ -83,6 +83,9 @@ class Segmentation:
         Joined pieces (earlier, later, 1-based) and the crease edge id of each joint.
     problem : str
         Why no segmentation fits the bed ("" when it does), with what to do.
+    crumbs : float
+        Volume of the slivers left out, m^3: separate fragments under 10 mm across that the
+        joints' cuts leave at a panel's corner (see :func:`segment_part`).
     """
 
     bed: Bed
@@ -90,6 +93,7 @@ class Segmentation:
     segments: tuple[Segment, ...]
     joints: np.ndarray
     problem: str = ""
+    crumbs: float = 0.0
 
     @property
     def fits(self) -> bool:
@@ -103,9 +107,14 @@ class Segmentation:
         if len(self.segments) == 1:
             return f"one piece: {self.whole.summary()}"
         hours = sum(s.fit.print_hours for s in self.segments)
+        crumbs = (
+            f"; {self.crumbs * 1e9:.3g} mm^3 of slivers at joint corners left out"
+            if self.crumbs > 0
+            else ""
+        )
         return (
             f"{len(self.segments)} pieces joined along {len(self.joints)} creases and cuts, "
-            f"each fits the {self.bed} bed; {print_time_text(hours)} of printing in all"
+            f"each fits the {self.bed} bed; {print_time_text(hours)} of printing in all{crumbs}"
         )
 
 
@@ -286,22 +295,32 @@ def _teeth(L: float, room: float, far: float) -> tuple:
     return neck * k, head * k, deep * k, max(1, int(L // 30.0))
 
 
-#: a separate fragment of a piece smaller than this is left out, mm^3 (and a region's island
-#: under this many mm^2 is not drawn): a sliver the region arithmetic leaves at a joint's
-#: corner, below a printer's nozzle width in two directions
-_CRUMB = 1.0
+#: a separate fragment of a piece under this size across (mm) is a sliver the region
+#: arithmetic leaves at a joint's corner: it is left out (and its volume counted), where a
+#: larger separate body becomes a piece of its own
+_CRUMB = 10.0
 
 
-def _piece_bodies(part, region) -> list:
-    """The part inside ``region``'s prism as its separate bodies (fragments under ``_CRUMB``
-    left out), largest first. A planned piece whose panels the joints next to it leave joined
-    only through a neighbour's hinge comes out as more than one body: each is printed as a
-    piece of its own."""
+def _piece_bodies(part, region) -> tuple[list, float]:
+    """The part inside ``region``'s prism as its separate bodies, largest first, and the
+    volume (mm^3) of the slivers left out (bodies under ``_CRUMB`` mm across, when a larger
+    one remains). A planned piece whose panels the joints next to it leave joined only through
+    a neighbour's hinge comes out as more than one body: each is printed as a piece of its
+    own."""
     import manifold3d as m3d
 
     prism = m3d.Manifold.extrude(region, 1e6).translate((0.0, 0.0, -5e5))
-    bodies = [b for b in (part ^ prism).decompose() if b.volume() >= _CRUMB]
-    return sorted(bodies, key=lambda b: -b.volume())
+    bodies = sorted((part ^ prism).decompose(), key=lambda b: -b.volume())
+    big = [b for b in bodies if max(np.ptp(np.reshape(b.bounding_box(), (2, 3)), axis=0)) >= _CRUMB]
+    keep = big or bodies[:1]
+    return keep, float(sum(b.volume() for b in bodies) - sum(b.volume() for b in keep))
+
+
+def _boxes_meet(box, poly: np.ndarray) -> bool:
+    """A body's bounding box (min x, y, z, max x, y, z; mm) and a polygon's (k, 2) overlap in
+    the layout's plane."""
+    return bool((poly.min(axis=0) <= np.asarray(box[3:5])).all()
+                and (poly.max(axis=0) >= np.asarray(box[:2])).all())  # fmt: skip
 
 
 def _xy_distance(box, point) -> float:
@@ -451,9 +470,10 @@ def segment_part(
             tri_verts=np.asarray(part_m.faces, np.uint64),
         )
     )
-    segments, body_of = [], []  # body_of[k]: (segment index, xy box) of planned piece k
+    segments, body_of, crumbs = [], [], 0.0  # body_of[k]: (segment, xy box) of planned piece k
     for k, (members, region) in enumerate(zip(plan, regions, strict=True)):
-        bodies = _piece_bodies(part, region)
+        bodies, lost = _piece_bodies(part, region)
+        crumbs += lost
         if not bodies:
             raise DegenerateGeometryError(f"piece {k + 1} is empty")
         body_of.append([])
@@ -479,14 +499,11 @@ def segment_part(
             mesh.apply_translation((0.0, 0.0, -mesh.bounds[0][2]))
             fit = bed_fit(mesh, bed)
             placed = place_on_bed(mesh, fit) if fit.fits else mesh
-            polys = [
-                np.asarray(q) for q in region.to_polygons() if abs(_area(np.asarray(q))) >= _CRUMB
-            ]
-            mine = [
-                q for q in polys if len(bodies) == 1 or _xy_distance(box, q.mean(axis=0)) < 1e-6
-            ]
-            outline = tuple(q / _MM for q in mine)
-            near = [m for m in members if _xy_distance(box, cells[m].poly.mean(axis=0)) < 1e-6]
+            polys = [np.asarray(q) for q in region.to_polygons()]
+            if len(bodies) > 1:  # the region's polygons that overlap this body's box
+                polys = [q for q in polys if _boxes_meet(box, q)] or polys
+            outline = tuple(q / _MM for q in polys)
+            near = [m for m in members if _boxes_meet(box, cells[m].poly)]
             faces = np.unique([cells[m].face for m in (members if len(bodies) == 1 else near)])
             segments.append(Segment(index, faces, outline, placed, fit))
 
@@ -494,13 +511,14 @@ def segment_part(
         return min(body_of[k], key=lambda ib: _xy_distance(ib[1], point))[0]
 
     joints = [(which(a, mid), which(b, mid), e) for a, b, e, mid in joints]
-    out = Segmentation(bed, whole, tuple(segments), np.array(joints, int).reshape(-1, 3))
+    out = Segmentation(bed, whole, tuple(segments), np.array(joints, int).reshape(-1, 3),
+                       crumbs=crumbs / _MM**3)  # fmt: skip
     if not out.fits:
         bad = next(s for s in segments if not s.fit.fits)
         return Segmentation(
             bed, whole, out.segments, out.joints,
             f"piece {bad.index} ({bad.fit.summary()}) does not fit with its joints; use a "
-            "larger bed or scale the design down",
+            "larger bed or scale the design down", crumbs / _MM**3,
         )  # fmt: skip
     return out
 
