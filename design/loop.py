@@ -420,7 +420,8 @@ class LoopState:
     ``miners`` round -> MinedRules; ``boxes`` the rules (or the box of the designs meeting the
     target) the next refinement samples by; ``around`` the last round whose few hits could not
     be mined; ``times`` seconds per stage; ``used`` the folders this run read;
-    ``pilot`` the pilot's verdict; ``mine_target`` the target rules are mined for.
+    ``pilot`` the pilot's verdict; ``mine_target`` the target rules are mined for;
+    ``stalled`` why the search stopped for want of progress ("" when it did not).
     """
 
     table: pd.DataFrame | None = None
@@ -433,6 +434,7 @@ class LoopState:
     used: set = field(default_factory=set)
     pilot: dict | None = None
     mine_target: object = None
+    stalled: str = ""
 
 
 class DesignLoop:
@@ -664,9 +666,35 @@ class DesignLoop:
         if s.until_verified and done and self.more(r):
             say(f"  round {r}: rule {done[0].rank} is verified; no more rounds")
             return True
+        stalled = self._stalled(r)
+        if stalled and self.more(r):
+            say(f"  round {r}: {stalled}; no more rounds")
+            st.stalled = stalled
+            return True
         if not done and not self.more(r) and (s.rounds is None or r < s.rounds):
             say(f"  round {r}: the budget of {s.budget:,} simulations leaves no room for a round")
         return False
+
+    def _stalled(self, r: int) -> str:
+        """Why the search stops for want of progress ("" to go on): a rule has been verified,
+        and the best 95 % lower bound of a verified rule has not risen in the last
+        ``patience`` rounds."""
+        s, hist = self.settings, self.state.history
+        if s.patience is None or not s.until_verified:
+            return ""
+        best, since, where = -1.0, None, None
+        for h in hist:
+            for e in h.rules:
+                lo = None if e.interval is None else e.interval[0]
+                if lo is not None and lo > best + 1e-12:
+                    best, since, where = lo, h.index, e
+        if where is None or r - since < s.patience:
+            return ""
+        return (
+            f"the best verified rule ({where.label}: {_fmt(where.precision)} verified, 95 % "
+            f"interval from {_fmt(best)}) has not improved in {r - since} rounds (--patience "
+            f"{s.patience}); the target may lie at the edge of what these designs reach"
+        )
 
     def _checks(self, r: int, records: list) -> list:
         """Each rule's verification (None: not verified), within the budget."""
@@ -722,7 +750,7 @@ class DesignLoop:
             objective=str(p.objective),
             allow_overlap=p.allow_overlap,
             answer=answer.kind,
-            headline=_headline(answer, st.pilot),
+            headline=_headline(answer, st.pilot, st.stalled),
             chosen=pick(answer.chosen),
             alternatives=tuple(pick(c) for c in answer.alternatives),
             rounds=tuple(st.history),
@@ -786,8 +814,11 @@ def _pilot_info(table: pd.DataFrame, tgt, budget: int, say) -> dict:
     }
 
 
-def _headline(answer: Answer, pilot: Mapping | None) -> str:
-    """The answer's sentence, after why the run stopped if its pilot stopped it."""
+def _headline(answer: Answer, pilot: Mapping | None, stalled: str = "") -> str:
+    """The answer's sentence, after why the run stopped if its pilot stopped it or its search
+    made no progress."""
+    if stalled:
+        return f"The search stopped early: {stalled}. {answer.headline}"
     if pilot and pilot["stopped"]:
         return (
             f"The run stopped after its pilot of {pilot['rows']} designs: "

@@ -109,6 +109,10 @@ class LoopSettings:
         Stop once a rule is verified.
     pilot : int
         Designs simulated first (0: no pilot).
+    patience : int or None
+        Refinement rounds without progress after which the run stops with the best design:
+        once a rule has been verified (at any precision), rounds in which the best verified
+        rule's 95 % lower bound did not rise (None: never stop for that).
     seed : int
     """
 
@@ -121,6 +125,7 @@ class LoopSettings:
     strategy: str = "mixed"
     until_verified: bool = True
     pilot: int = PILOT
+    patience: int | None = 4
     seed: int = 0
 
     def __post_init__(self):
@@ -132,6 +137,7 @@ class LoopSettings:
             ("refine", self.refine, 1 if self.rounds != 0 else 0),
             ("budget", self.budget, 1),
             ("pilot", self.pilot, 0),
+            ("patience", 1 if self.patience is None else self.patience, 1),
         ):
             if isinstance(v, bool) or int(v) != v or v < low:
                 raise ValueError(f"{name} = {v!r} must be an integer >= {low}")

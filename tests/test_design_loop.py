@@ -637,3 +637,35 @@ def test_when_no_design_is_buildable_the_rules_are_mined_for_the_target_alone(tm
     page = report_page_html(tmp_path / "o", res.record)
     assert "No buildable design meets the target: the best, overlapping" in page
     assert "No design meets the target: the nearest" not in page
+
+
+def _noisy(row):
+    """double = 2a plus noise uniform on [-1.35, 1.35] drawn from the design's digits: at most
+    about 87 % of the designs of any box (a near 1) have double > 1."""
+    seed = int(row["a"] * 2**40) ^ int(row["b"] * 2**20)
+    noise = np.random.default_rng(seed).uniform(-1.35, 1.35)
+    return {"double": 2.0 * row["a"] + noise, "mass": row["a"], "overlap": 0.0,
+            "status": CONVERGED}  # fmt: skip
+
+
+def test_a_search_that_stops_improving_ends_early_with_the_best_design(tmp_path):
+    """Rules verified near 80 % never reach the bar: after `patience` rounds in which the best
+    verified lower bound did not rise, the run stops with its best design and says why,
+    long before its budget."""
+    said = []
+    res = run_design(_cheap_scenario(_noisy), "double > 1", tmp_path / "o", samples=100,
+                     pilot=0, refine=30, verify=20, top=1, budget=2000, patience=2, workers=1,
+                     progress=False, files=False, say=said.append)  # fmt: skip
+    s = res.summary
+    stop = [line for line in said if "has not improved in" in line]
+    assert len(stop) == 1 and stop[0].endswith("what these designs reach; no more rounds")
+    assert "(--patience 2)" in stop[0]
+    assert s["headline"].startswith("The search stopped early: the best verified rule")
+    assert s["answer"] == "rule" and s["rule_meets_bar"] is False and s["meets_target"]
+    assert len(res.table) < 2000 / 2
+    # without patience the same search runs on, to the rounds it is given
+    more = run_design(_cheap_scenario(_noisy), "double > 1", tmp_path / "p", samples=100,
+                      pilot=0, refine=30, verify=20, top=1, budget=2000, patience=None,
+                      rounds=len(s["rounds"]) + 1, workers=1, progress=False,
+                      files=False)  # fmt: skip
+    assert len(more.summary["rounds"]) > len(s["rounds"])

@@ -106,6 +106,14 @@ def register(subparsers) -> argparse.ArgumentParser:
         action="store_true",
         help="run every refinement round, also after a rule is verified",
     )
+    p.add_argument(
+        "--patience",
+        type=int,
+        default=4,
+        help="once a rule is verified (at any precision), stop with the best design after this "
+        "many rounds in which the best verified rule's 95 %% lower bound did not rise "
+        "(default 4; 0: never)",
+    )
     p.add_argument("--verify", type=int, default=50, help="fresh designs per verified rule")
     p.add_argument("--top", type=int, default=3, help="rules kept and verified per round")
     p.add_argument("--seed", type=int, default=0)
@@ -140,6 +148,7 @@ def run(args) -> int:
         verify=args.verify, top=args.top, strategy=args.strategy,
         until_verified=not args.all_rounds, seed=args.seed,
         pilot=PILOT if args.pilot is None else args.pilot,
+        patience=None if args.patience == 0 else args.patience,
     )  # fmt: skip
     execution = Execution(
         workers=args.workers, progress=False if args.no_progress else None,
