@@ -31,8 +31,14 @@ rigidly``, ``does not fold rigidly`` (a panel bends by more than :data:`RIGID_BE
 stretches by more than :data:`RIGID_STRAIN`), ``folds off target`` (panels stay flat but
 driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the targets are
 not those of a rigid folding),
-``bifurcation at flat`` (driven creases folded the wrong way: the solve left the flat
-state on another branch) or ``stalls`` (a step would not converge).
+``turns against its assignment`` (driven creases folded more than :data:`WRONG_WAY_DEG` the
+wrong way in the last state; the note gives the fraction at which the first one did) or
+``stalls`` (a step would not converge).
+
+Fold angles are tracked through +-180 degrees: each state's angles are unwrapped against the
+previous stored state along the path (the dihedral angle of two panels is only known modulo
+360 degrees, so a valley that passes 180 degrees would read as a mountain near -180), and
+every verdict uses the unwrapped angles.
 """
 
 from __future__ import annotations
@@ -165,20 +171,24 @@ class FoldResult:
         Pattern vertex coordinates of every state, m (the mean of a vertex's node copies in a
         compliant model).
     fold_angles : (k, ne) float
-        Measured fold angles of every state, degrees (FOLD sign).
+        Measured fold angles of every state, degrees (FOLD sign), unwrapped along the path
+        (a crease folded past 180 degrees reads more than 180, not less than -180).
     rest : (ns,) float
         Spring rest angles of the last state, rad.
     status : Status
         Converged (every step met the tolerance up to ``requested``) or not converged, why.
     verdict : str
-        ``folds rigidly``, ``folds off target``, ``does not fold rigidly``, ``bifurcation at
-        flat`` or ``stalls``.
+        ``folds rigidly``, ``folds off target``, ``does not fold rigidly``, ``turns against
+        its assignment`` or ``stalls``.
     note : str
         One sentence behind the verdict (numbers).
     energy : ModelEnergy
         Energy by panel and crease in the last state.
     wrong_way : (n,) int
         Driven creases folded against their assignment in the last state.
+    wrong_at : float
+        The fraction at which a driven crease first stood more than :data:`WRONG_WAY_DEG`
+        against its assignment along the path (NaN: none did).
     halvings : int
         Steps retried at a smaller size.
     snaps : (n,) float
@@ -205,6 +215,7 @@ class FoldResult:
     halvings: int = 0
     snaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
     elapsed: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    wrong_at: float = float("nan")
 
     @property
     def reached(self) -> float:
@@ -226,7 +237,7 @@ class FoldResult:
     def folded(self, state: int = -1) -> CreasePattern:
         """The pattern in stored state ``state`` (default the last): its vertices moved, flat
         layout, faces and assignments kept, fold angles measured."""
-        a = self.fold_angles[state]
+        a = np.clip(self.fold_angles[state], -180.0, 180.0)  # past 180: flat, on its side
         asg = self.pattern.assignment.copy()
         cls = crease_classes(self.pattern)
         keep = np.isin(asg, ("B", "C")) | ~self.pattern.interior
@@ -432,8 +443,13 @@ def fold_pattern(
     energy = model_energy(structure, Uh[-1], final_rest, n_edges=ne)
     driven = (cls == DRIVEN) & (tgt != 0)
     last = angles[-1]
-    against = (np.sign(last) != np.sign(tgt)) & (np.abs(last) > WRONG_WAY_DEG)
-    wrong = np.flatnonzero(driven & against)
+    against_path = (
+        driven[None] & (np.sign(angles) != np.sign(tgt)[None]) & (np.abs(angles) > WRONG_WAY_DEG)
+    )
+    wrong = np.flatnonzero(against_path[-1])
+    went = np.flatnonzero(against_path.any(axis=1))
+    wrong_at = float(fractions[went[0]]) if went.size else float("nan")
+    came_back = int((against_path.any(axis=0) & ~against_path[-1]).sum())
     ratio = np.where(driven, last / np.where(tgt != 0, tgt, 1.0), 1.0)
     stuck = np.flatnonzero(driven & (ratio < STUCK_RATIO * done)) if done > 0 else wrong[:0]
     e_flat = asm.internal_force(np.zeros((nn, 3)), final_rest)[0]  # held flat: the reference
@@ -447,10 +463,12 @@ def fold_pattern(
     else:
         status = CONVERGED
         if wrong.size:
-            verdict = "bifurcation at flat"
+            verdict = "turns against its assignment"
+            first = int(np.flatnonzero(against_path[went[0]])[0])
             note = (
                 f"{wrong.size} of {int(driven.sum())} driven creases folded against their "
-                f"assignment (first: edge {int(wrong[0])})"
+                f"assignment, the first at {100 * wrong_at:.1f} % (edge {first}): the fold "
+                "took another branch"
             )
         elif bend > RIGID_BEND_DEG or strain > RIGID_STRAIN:
             verdict = "does not fold rigidly"
@@ -476,7 +494,14 @@ def fold_pattern(
             else:
                 note = f"panels bend at most {bend:.2f} deg, stretch at most {strain:.1g}"
     if stalled and wrong.size:
-        note += f"; {wrong.size} driven creases folded against their assignment"
+        note += (
+            f"; {wrong.size} driven creases folded against their assignment (the first at "
+            f"{100 * wrong_at:.1f} %)"
+        )
+    if came_back:
+        note += (
+            f"; {came_back} driven creases turned against their assignment on the way and came back"
+        )
     if snaps:
         where = ", ".join(f"{100 * x:.1f}" for x in snaps[:5])
         note += f"; snaps at {where} % (no nearby equilibrium: the energy minimum beyond)"
@@ -484,7 +509,7 @@ def fold_pattern(
         pattern=base, structure=structure, target=tgt, requested=fraction, fractions=fractions,
         U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
         verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
-        snaps=np.array(snaps), elapsed=np.array(clock),
+        snaps=np.array(snaps), elapsed=np.array(clock), wrong_at=wrong_at,
     )  # fmt: skip
 
 
@@ -536,9 +561,9 @@ def _face_edges(pattern: CreasePattern) -> np.ndarray:
 
 
 def _fold_angles(pattern: CreasePattern, structure: Structure, Uh: np.ndarray) -> np.ndarray:
-    """(k, ne) fold angles, degrees (FOLD sign), from the normals of the panels as modelled
-    (their own node copies in a compliant model, so a crease strip's width does not distort
-    them); 0 for edges of one face."""
+    """(k, ne) fold angles, degrees (FOLD sign), unwrapped along the k states, from the
+    normals of the panels as modelled (their own node copies in a compliant model, so a
+    crease strip's width does not distort them); 0 for edges of one face."""
     X = structure.nodes[None] + Uh
     sizes = np.array([len(f) for f in pattern.faces])
     fv = np.concatenate(pattern.faces)
@@ -572,7 +597,8 @@ def _fold_angles(pattern: CreasePattern, structure: Structure, Uh: np.ndarray) -
     s = -np.einsum("kij,kij->ki", np.cross(na, nb), t)
     c = np.einsum("kij,kij->ki", na, nb)
     out = np.zeros((len(Uh), pattern.n_edges))
-    out[:, e] = np.degrees(np.arctan2(s, c))
+    # unwrapped along the states (axis 0): a crease passing +-180 deg keeps its side
+    out[:, e] = np.degrees(np.unwrap(np.arctan2(s, c), axis=0))
     return out
 
 

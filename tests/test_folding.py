@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -120,3 +121,41 @@ def test_folded_pattern_keeps_layout_and_assignment():
     assert np.array_equal(q.flat, p.flat)
     assert np.array_equal(q.assignment, p.assignment)
     assert q.fold_angle == pytest.approx(p.fold_angle, abs=1e-6)
+
+
+_OS = Path(__file__).parent / "data" / "origami-simulator"
+_PP = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9, nu=0.42)
+
+
+@pytest.mark.parametrize("name", ["pinwheelBase.svg", "russianTriangle.svg"])
+def test_fold_angles_are_tracked_through_180_degrees(name):
+    """Origami Simulator's pinwheel base and Russian triangle at 100 %: valleys pass 180 deg
+    (a dihedral angle known modulo 360 would read them as mountains near -180, which called
+    these folds 'bifurcation at flat'); unwrapped along the path they keep their side."""
+    from holofold.design import scaled_pattern
+    from holofold.geometry import read_pattern
+
+    r = fold_pattern(scaled_pattern(read_pattern(_OS / name), 0.2), 1.0, **_PP)
+    assert r.complete and r.verdict == "folds rigidly", r.summary()
+    assert r.wrong_way.size == 0 and math.isnan(r.wrong_at)
+    a = r.fold_angles
+    assert np.abs(a[-1]).max() > 180.0  # a crease past 180: the case this is about
+    # the folded pattern keeps each crease's side, at most 180 deg (the FOLD convention)
+    f = r.folded()
+    assert np.abs(f.fold_angle).max() == 180.0
+    past = np.abs(a[-1]) > 180.0
+    assert (np.sign(f.fold_angle[past]) == np.sign(r.target[past])).all()
+
+
+def test_a_crease_turning_against_its_assignment_is_reported_with_where_it_started():
+    """Origami Simulator's flapping bird leaves flat on another branch: two driven creases end
+    folded against their assignment; the verdict says so and from which fraction."""
+    from holofold.design import scaled_pattern
+    from holofold.geometry import read_pattern
+
+    r = fold_pattern(scaled_pattern(read_pattern(_OS / "flappingBird.svg"), 0.2), 1.0, **_PP)
+    assert r.verdict == "turns against its assignment" and r.wrong_way.size >= 1
+    assert 0.0 < r.wrong_at <= 0.2 and r.wrong_at in r.fractions
+    assert f"the first at {100 * r.wrong_at:.1f} %" in r.note
+    t, a = r.target[r.wrong_way], r.fold_angles[-1, r.wrong_way]
+    assert (np.sign(a) != np.sign(t)).all() and (np.abs(a) > 10.0).all()
