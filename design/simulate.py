@@ -46,6 +46,7 @@ __all__ = [
     "write_simulation",
     "plot_simulation",
     "pattern_mass",
+    "check_physical",
     "scaled_pattern",
 ]
 
@@ -286,6 +287,30 @@ def pattern_mass(pattern: CreasePattern, setting: PatternSetting) -> float:
     )
 
 
+def check_physical(pattern: CreasePattern, setting: PatternSetting) -> None:
+    """Refuse, in one line, a sheet that cannot exist: creases wider than the panels between
+    them allow (a panel vanishes when its hinge strips are pulled back) or a mass that is not
+    positive. Raises :class:`ParameterError`."""
+    from holofold.geometry import shrunk_panels
+
+    s = setting
+    try:
+        shrunk_panels(pattern, s.crease_width)
+    except ParameterError as exc:
+        size = float(np.ptp(pattern.coords, axis=0).max())
+        raise ParameterError(
+            f"{exc}: creases {s.crease_width * 1e3:.3g} mm wide on a sheet {size * 1e3:.3g} mm "
+            "across; give a narrower crease width or a larger scale"
+        ) from None
+    m = pattern_mass(pattern, s)
+    if not m > 0:
+        raise ParameterError(
+            f"the sheet's mass would be {m * 1e3:.3g} g: its crease strips "
+            f"({s.crease_width * 1e3:.3g} mm wide) cover more than its panels; give a narrower "
+            "crease width"
+        )
+
+
 def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> PatternSimulation:
     """Fold ``pattern`` and load it as ``setting`` says (see the module docstring)."""
     from holofold.mechanics.analyses import load_along, secant_stiffness
@@ -295,6 +320,7 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
     # vertex sets first: a bad set is refused before anything is computed
     sup_ids = [v.select(pattern) for v in s.supports]
     load_ids = [ld.at.select(pattern) for ld in s.loads]
+    check_physical(pattern, s)
     fold = fold_pattern(
         pattern, s.fold, panel_thickness=s.panel_thickness, crease_thickness=s.crease_thickness,
         crease_width=s.crease_width, E=s.material.E, nu=s.material.nu, model=s.model,

@@ -192,6 +192,24 @@ def test_simulate_command_refuses_in_one_line(tmp_path, capsys):
     assert code == 2 and "known: paper" in capsys.readouterr().err
 
 
+def test_a_sheet_too_small_for_its_creases_is_refused_not_given_a_negative_mass(tmp_path, capsys):
+    """The issue's Miura scaled to 3 mm with 1 mm creases: the panels vanish under their hinge
+    strips (before: mass -0.0045 g, 'folds rigidly'); refused in one line, nothing written."""
+    src = tmp_path / "src"
+    assert main(["pattern", "miura", "--m", "4", "--n", "4", "--ext", "0.7", "--gamma", "60",
+                 "--size", "0.1", "-o", str(src)]) == 0  # fmt: skip
+    capsys.readouterr()
+    out = tmp_path / "o"
+    code = main(["simulate", str(src / "pattern.fold"), "--scale", "0.03", "-o", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert "wider than panel" in err and "give a narrower crease width or a larger scale" in err
+    assert not out.exists() or not any(out.iterdir())
+    # at full size the same file folds and weighs what the thinned sheet weighs
+    assert main(["simulate", str(src / "pattern.fold"), "-o", str(tmp_path / "ok")]) == 0
+    assert json.loads((tmp_path / "ok" / "simulation.json").read_text())["mass_kg"] > 0
+
+
 # ------------------------------------------------------------------ scenario kind
 SCENARIO = """
 kind = "pattern"
