@@ -84,13 +84,44 @@ def _pieces(seg, n: int) -> np.ndarray:
 _SE_PX = {"mm": 96 * 0.0393701 / 1e-3, "cm": 96 * 0.393701 / 1e-2, "in": 96 / 0.0254}
 
 
-def _metres_per_px(svg) -> float:
+#: attributes that carry coordinates or lengths: a non-finite number in one is refused (the
+#: SVG parser reads 'nan' and 'inf' as 0, which moves or removes a crease)
+_GEOMETRY_ATTRS = (
+    "x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "r", "rx", "ry", "width", "height", "points",
+    "d", "transform", "viewBox",
+)  # fmt: skip
+
+
+def _check_numbers(name: str, data: bytes) -> None:
+    """Refuse a non-finite number (nan, inf) in a coordinate attribute, in one line."""
+    import re
+
+    attrs = "|".join(_GEOMETRY_ATTRS)
+    pattern = rb"(?<![\w:-])(" + attrs.encode() + rb")\s*=\s*(\"[^\"]*\"|'[^']*')"
+    bad = re.compile(rb"(?i)(?<![a-z])(nan|inf|infinity)(?![a-z])")
+    for m in re.finditer(pattern, data):
+        if bad.search(m.group(2)):
+            line = data.count(b"\n", 0, m.start()) + 1
+            raise FormatError(
+                f"{name}, line {line}: {m.group(1).decode()} holds a number that is not finite "
+                f"({bad.search(m.group(2)).group(1).decode()})"
+            )
+
+
+def _metres_per_px(svg, name: str = "the SVG") -> float:
     import re
 
     width = str(svg.values.get("width", "")).strip()
-    m = re.fullmatch(r"[-+0-9.eE]+\s*([a-z%]*)", width)
+    m = re.fullmatch(r"[-+0-9.eE]+\s*([a-zA-Z%]*)", width)
     unit = m.group(1) if m else ""
-    return 1.0 / _SE_PX[unit] if unit in _SE_PX else PX
+    if unit in ("", "px", "pt", "pc"):  # svgelements turns pt and pc into px at 96 ppi
+        return PX
+    if unit in _SE_PX:
+        return 1.0 / _SE_PX[unit]
+    raise FormatError(
+        f"{name}: width {width!r} is not a length holofold reads (give the width in mm, cm, in "
+        "or px, or none: the drawing's px are then 1/96 in)"
+    )
 
 
 def _without_legend(data: bytes):
@@ -134,7 +165,9 @@ def svg_lines(path, *, curves: str = "refuse"):
     size = os.path.getsize(path)
     if size > MAX_SVG_BYTES:
         raise FormatError(f"{name}: {size} bytes; at most {MAX_SVG_BYTES} (64 MiB) are read")
-    source = _without_legend(Path(path).read_bytes())
+    data = Path(path).read_bytes()
+    _check_numbers(name, data)
+    source = _without_legend(data)
     try:
         svg = se.SVG.parse(source, reify=True, ppi=96.0)
     except Exception as exc:  # noqa: BLE001 - any parse failure of a user file: one line
@@ -228,7 +261,8 @@ def svg_lines(path, *, curves: str = "refuse"):
         )
     S = np.array(segs, float)
     S[..., 1] *= -1.0  # y up
-    return S, np.array(codes, dtype="<U1"), np.array(angles, float), notes, _metres_per_px(svg)
+    mpp = _metres_per_px(svg, name)
+    return S, np.array(codes, dtype="<U1"), np.array(angles, float), notes, mpp
 
 
 def read_svg_pattern(

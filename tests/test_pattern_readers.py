@@ -392,3 +392,34 @@ def test_read_pattern_refuses_in_one_line(tmp_path):
         read_pattern(tmp_path / "x.svg")
     with pytest.raises(ParameterError, match="take no option 'frame'"):
         read_pattern(OS / "simpleVertex.svg", frame=1)
+
+
+_SQUARE = (
+    '<rect x="0" y="0" width="50" height="50" stroke="black" fill="none"/>'
+    '<line x1="0" y1="0" x2="{x2}" y2="50" stroke="#f00"/>'
+)
+
+
+@pytest.mark.parametrize("bad", ["nan", "NaN", "inf", "-Infinity"])
+def test_svg_non_finite_coordinates_are_refused_not_read_as_zero(tmp_path, bad):
+    """svgelements reads 'nan' and 'inf' as 0, which moved the crease to the corner (and the
+    warning said 'drawn twice'); now the line is refused at its attribute."""
+    f = _svg(tmp_path, _SQUARE.format(x2=bad))
+    with pytest.raises(FormatError, match=r"cp.svg, line 1: x2 holds a number that is not finite"):
+        read_pattern(f)
+    ok = read_pattern(_svg(tmp_path, _SQUARE.format(x2="50")))
+    assert ok.n_faces == 2
+
+
+@pytest.mark.parametrize("width", ["100km", "100%", "3ft"])
+def test_svg_width_in_an_unknown_unit_is_refused(tmp_path, width):
+    """width='100km' or '100%' was read as px (13.23 mm across): refused with what to give."""
+    f = _svg(tmp_path, _SQUARE.format(x2="50"),
+             size=f'width="{width}" height="{width}" viewBox="0 0 100 100"')  # fmt: skip
+    with pytest.raises(FormatError, match=f"width '{width}' is not a length holofold reads"):
+        read_pattern(f)
+    for good, mm in (("100mm", 50.0), ("10cm", 50.0), ("72pt", 25.4 / 2), ("96", 25.4 / 2)):
+        g = _svg(tmp_path, _SQUARE.format(x2="50"),
+                 size=f'width="{good}" height="{good}" viewBox="0 0 100 100"')  # fmt: skip
+        p = read_pattern(g)
+        assert np.ptp(p.flat[:, 0]) * 1e3 == pytest.approx(mm, rel=1e-6), good
