@@ -156,7 +156,8 @@ def check_pattern_file(path, setting, options=None, size=None, scale=None, time_
     p = Path(path)
     rec = {"file": str(p), "path": str(p.resolve()), "sha256": file_sha256(p)}
     rec.update(imported=False, reason=None, panels=None, reached=None, verdict=None, note=None)
-    rec.update(largest_strain=None, wrong_way_count=None, collision=None, status=None)
+    rec.update(largest_strain=None, progress=None, wrong_way_count=None, collision=None)
+    rec.update(thick=None, clearance=None, status=None, fold=None)  # same keys on every line
     t0 = time.perf_counter()
     stage = ["import"]
     try:
