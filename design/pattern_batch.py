@@ -196,14 +196,58 @@ def _append_line(fh, rec: dict) -> None:
     os.fsync(fh.fileno())
 
 
+def _failed(path, reason: str) -> dict:
+    """The record of a pattern whose worker process died (a crash below Python)."""
+    p = Path(path)
+    rec = {"file": str(p), "path": str(p.resolve()), "sha256": file_sha256(p)}
+    for key in ("imported", "reason", "panels", "reached", "verdict", "note", "largest_strain",
+                "progress", "wrong_way_count", "collision", "thick", "clearance", "status",
+                "fold"):  # fmt: skip
+        rec[key] = None
+    rec.update(imported=None, reason=reason, seconds=None)
+    return rec
+
+
+def _isolated(path, args, check):
+    """``check(path, *args)`` in a process of its own: a record even if that process dies."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    ctx = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
+    with ProcessPoolExecutor(1, mp_context=ctx) as pool:
+        try:
+            return pool.submit(check, path, *args).result()
+        except BrokenProcessPool:
+            return _failed(path, "crashed: its worker process died")
+
+
+def _in_workers(todo, args, workers, check):
+    """The records of ``todo`` from joblib processes, in order; if a worker process dies (a
+    crash below Python), the files not yet recorded run each in a process of its own."""
+    from joblib import Parallel, delayed
+
+    par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
+    k = 0
+    try:
+        for rec in par(delayed(check)(f, *args) for f in todo):
+            k += 1
+            yield rec
+    except Exception:  # joblib's TerminatedWorkerError and kin: a worker process died
+        for f in todo[k:]:
+            yield _isolated(f, args, check)
+
+
 def run_pattern_batch(
     files, out, setting, options=None, size=None, scale=None, time_limit=None, workers=1,
-    progress=None,
+    progress=None, *, check=None,
 ) -> dict:  # fmt: skip
     """Check every file of ``files`` (see :func:`check_pattern_file`), appending its record
     to the JSON-lines file ``out`` as it finishes; files recorded there already (same resolved
     path and content) are skipped. ``workers`` > 1 (or -1: every core) runs them on joblib
-    processes. ``progress(done, total, failed, record)`` is called after each line.
+    processes (a worker that dies takes no other pattern with it). ``progress(done, total,
+    failed, record)`` is called after each line; ``check`` replaces :func:`check_pattern_file`
+    (same arguments; tests).
     Returns counts: ``total``, ``skipped``, ``checked``, ``failed`` (not imported, crashed or
     timed out)."""
     out = Path(out)
@@ -217,13 +261,11 @@ def run_pattern_batch(
             done.add(key)
             todo.append(f)
     args = (setting, dict(options or {}), size, scale, time_limit)
+    check = check_pattern_file if check is None else check
     if workers == 1 or len(todo) <= 1:
-        recs = (check_pattern_file(f, *args) for f in todo)
+        recs = (check(f, *args) for f in todo)
     else:
-        from joblib import Parallel, delayed
-
-        par = Parallel(n_jobs=workers, return_as="generator", batch_size=1)
-        recs = par(delayed(check_pattern_file)(f, *args) for f in todo)
+        recs = _in_workers(todo, args, workers, check)
     failed = checked = 0
     with open(out, "a", encoding="utf-8") as fh:
         for rec in recs:

@@ -184,3 +184,33 @@ def test_a_crash_while_folding_is_a_line(monkeypatch, tmp_path):
     for r in recs:
         assert r["imported"] is True  # read, then crashed
         assert r["reason"] == "RuntimeError: solver blew up" and r["verdict"] is None
+
+
+def _dies_on_popup(path, *args):
+    """check_pattern_file, except that the process dies (as a segfault would) on popupSimple."""
+    import os
+
+    from holofold.design import check_pattern_file
+
+    if Path(path).name == "popupSimple.svg":
+        os._exit(70)
+    return check_pattern_file(path, *args)
+
+
+@pytest.mark.processes
+def test_a_worker_that_dies_takes_only_its_pattern(patterns, batch, tmp_path):
+    from holofold.design import PatternSetting, run_pattern_batch
+
+    out = tmp_path / "d.jsonl"
+    files = pattern_files([patterns])
+    counts = run_pattern_batch(
+        files, out, PatternSetting(), {"split": "as-needed"}, workers=2, check=_dies_on_popup
+    )
+    assert counts == {"total": 4, "skipped": 0, "checked": 4, "failed": 2}
+    recs = {Path(r["file"]).name: r for r in _lines(out)}
+    assert set(recs) == {*NAMES, "broken.svg"}
+    assert recs["popupSimple.svg"]["reason"] == "crashed: its worker process died"
+    ref = {Path(r["file"]).name: r for r in _lines(batch)}
+    for name in ("simpleVertex.svg", "waterbombBase.svg"):
+        assert recs[name]["verdict"] == ref[name]["verdict"]
+        assert math.isclose(recs[name]["reached"], ref[name]["reached"], rel_tol=1e-9)
