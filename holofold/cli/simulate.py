@@ -16,6 +16,12 @@ on the folded pattern held at the ``--support`` sets. Writes ``folded.fold`` (th
 and the fold path as frames), ``folded.stl``/``folded.obj`` (mm), ``panels.csv`` (energy,
 strain, bend per panel), ``simulation.json`` and ``picture.png``, and prints one status line.
 Lengths in metres.
+
+Several patterns, a folder (searched recursively for the readable formats) or ``-o`` ending in
+``.jsonl`` check every pattern instead and write one JSON line each to ``-o``, resuming a file
+already there (:mod:`holofold.design.pattern_batch`)::
+
+    holofold simulate A.svg B.fold FOLDER/ -o checks.jsonl --workers 2 --time-limit 120
 """
 
 from __future__ import annotations
@@ -29,7 +35,8 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="fold a crease pattern file (FOLD, SVG, DXF, ORIPA), load it, write the results",
         description=__doc__.split("\n\n")[0],
         epilog="Lengths in metres, forces in newtons. Exit status 1 when the fold stops short "
-        "of --fold (the status line says where), 2 on bad input.",
+        "of --fold (the status line says where), 2 on bad input; with several patterns 0 once "
+        "every one has its line (failed ones too), 2 on bad input.",
     )
     p.add_argument(
         "pattern", nargs="+",
