@@ -98,6 +98,13 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "row_status": ["failed_rows", "converged_rows", "row_statuses", "with_state"],
         "faults": ["as_environment_fault"],
+        "pattern_batch": [
+            "pattern_files",
+            "file_sha256",
+            "recorded_files",
+            "check_pattern_file",
+            "run_pattern_batch",
+        ],
         "row_limits": ["RowTimeout", "ON_INVALID", "check_on_invalid", "resolve_row_timeout"],
         "sampling": ["sample_designs", "METHODS"],
         "simulate": [

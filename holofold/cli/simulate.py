@@ -16,6 +16,12 @@ on the folded pattern held at the ``--support`` sets. Writes ``folded.fold`` (th
 and the fold path as frames), ``folded.stl``/``folded.obj`` (mm), ``panels.csv`` (energy,
 strain, bend per panel), ``simulation.json`` and ``picture.png``, and prints one status line.
 Lengths in metres.
+
+Several patterns, a folder (searched recursively for the readable formats) or ``-o`` ending in
+``.jsonl`` check every pattern instead and write one JSON line each to ``-o``, resuming a file
+already there (:mod:`holofold.design.pattern_batch`)::
+
+    holofold simulate A.svg B.fold FOLDER/ -o checks.jsonl --workers 2 --time-limit 120
 """
 
 from __future__ import annotations
@@ -29,9 +35,14 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="fold a crease pattern file (FOLD, SVG, DXF, ORIPA), load it, write the results",
         description=__doc__.split("\n\n")[0],
         epilog="Lengths in metres, forces in newtons. Exit status 1 when the fold stops short "
-        "of --fold (the status line says where), 2 on bad input.",
+        "of --fold (the status line says where), 2 on bad input; with several patterns 0 once "
+        "every one has its line (failed ones too), 2 on bad input.",
     )
-    p.add_argument("pattern", help="crease pattern file: .fold, .svg, .dxf, .opx or .cp")
+    p.add_argument(
+        "pattern", nargs="+",
+        help="crease pattern file: .fold, .svg, .dxf, .opx or .cp; several files or a folder "
+        "(searched recursively for those) check them all: -o is then a JSON-lines file",
+    )  # fmt: skip
     p.add_argument("--fold", type=float, default=1.0, help="fold fraction 0-1 (default 1)")
     p.add_argument("--material", default="pp", help="material name (default pp); see --E")
     p.add_argument("--E", type=float, help="Young's modulus, Pa (overrides the material's)")
@@ -66,7 +77,20 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--increments", type=int, default=5, help="load increments (default 5)")
     p.add_argument("--no-collisions", action="store_true", help="skip the collision check")
     p.add_argument("--units", choices=("mm", "m"), default="mm", help="STL/OBJ unit (mm)")
-    p.add_argument("-o", "--output", required=True, help="output folder")
+    p.add_argument(
+        "-o", "--output", required=True,
+        help="output folder; with several patterns (or a .jsonl name) the JSON-lines file of "
+        "their records, resumed when it exists",
+    )  # fmt: skip
+    p.add_argument(
+        "--workers", type=int, default=1,
+        help="several patterns: worker processes (default 1; -1 = every core)",
+    )  # fmt: skip
+    p.add_argument(
+        "--time-limit", metavar="S", default=None,
+        help="several patterns: seconds per pattern, past which its line says 'timeout' and "
+        "the batch goes on (default: none)",
+    )  # fmt: skip
     return p
 
 
@@ -96,16 +120,16 @@ def run(args) -> int:
 
     import numpy as np
 
-    from holofold.design import (
-        PatternLoad,
-        PatternSetting,
-        scaled_pattern,
-        simulate_pattern,
-        write_simulation,
-    )
+    from holofold.design import scaled_pattern, simulate_pattern, write_simulation
     from holofold.geometry import check_output_folder, check_range, read_pattern, reader_for
-    from holofold.mechanics import Material, get_material
 
+    if _is_batch(args):
+        return _run_batch(args)
+    if args.workers != 1 or args.time_limit is not None:
+        raise ValueError(
+            "--workers and --time-limit are for several patterns (or a folder, or -o *.jsonl)"
+        )
+    args.pattern = args.pattern[0]
     out = Path(args.output)
     check_output_folder(out, "-o")
     reader = reader_for(args.pattern)
@@ -115,6 +139,34 @@ def run(args) -> int:
         raise ValueError(f"{reader.name} files take no --{bad[0]}")
     given = {k: v for k, v in options.items() if v is not None}
     given["split"] = args.split
+    setting = _setting(args)
+    pattern = _read_sized(read_pattern, args, given)
+    if args.size is not None:
+        check_range("--size", args.size, 0.0, None, low_open=True)
+        span = float(
+            np.ptp(pattern.flat if pattern.flat is not None else pattern.coords, axis=0).max()
+        )
+        pattern = scaled_pattern(pattern, args.size / span)
+    elif args.scale is not None:
+        pattern = scaled_pattern(pattern, args.scale)
+    pattern = replace(pattern, meta={**pattern.meta, "source": Path(args.pattern).name})
+    sim = simulate_pattern(pattern, setting)
+    written = write_simulation(sim, out, units=args.units)
+    size = np.ptp(pattern.flat if pattern.flat is not None else pattern.coords, axis=0)
+    print(
+        f"{Path(args.pattern).name}: {pattern.n_vertices} vertices, {pattern.n_faces} panels, "
+        f"{1e3 * size[0]:.4g} x {1e3 * size[1]:.4g} mm, {sim.mass * 1e3:.4g} g; "
+        f"{sim.seconds:.1f} s; wrote {', '.join(p.name for p in written)} to {out}"
+    )
+    print(sim.status_line())
+    return 0 if sim.fold.complete else 1  # 1: the fold stopped short (the status says where)
+
+
+def _setting(args):
+    """The PatternSetting of the parsed arguments."""
+    from holofold.design import PatternLoad, PatternSetting
+    from holofold.mechanics import Material, get_material
+
     mat = get_material(args.material)
     if args.E is not None or args.nu is not None or args.density is not None:
         mat = Material(
@@ -136,26 +188,67 @@ def run(args) -> int:
         model=args.model, supports=tuple(args.support), support_dofs=args.support_dofs,
         loads=loads, collisions=not args.no_collisions,
     )  # fmt: skip
-    pattern = _read_sized(read_pattern, args, given)
+    return setting
+
+
+def _is_batch(args) -> bool:
+    """Several patterns, a folder, or a ``.jsonl`` output: the batch mode."""
+    from pathlib import Path
+
+    return (
+        len(args.pattern) > 1
+        or Path(args.pattern[0]).is_dir()
+        or Path(args.output).suffix.lower() == ".jsonl"
+    )
+
+
+def _run_batch(args) -> int:
+    """Check every pattern, one JSON line each in ``-o`` (resumed); progress on stderr."""
+    import sys
+    from pathlib import Path
+
+    from holofold.design import check_workers, pattern_files, run_pattern_batch
+    from holofold.geometry import check_range, check_writable_folder
+
+    out = Path(args.output)
+    if out.is_dir():
+        raise ValueError(f"-o {out}: a folder; several patterns need a JSON-lines file (.jsonl)")
+    if not out.parent.is_dir():
+        raise ValueError(f"-o {out}: no folder {out.parent}")
+    check_writable_folder(out.parent, f"-o {out}")
+    try:
+        workers = check_workers(args.workers)
+    except ValueError:
+        raise ValueError(f"--workers {args.workers}: must be >= 1 or -1 (every core)") from None
+    limit = None
+    if args.time_limit is not None and str(args.time_limit).lower() not in ("0", "none"):
+        try:
+            limit = float(args.time_limit)
+        except ValueError:
+            raise ValueError(f"--time-limit {args.time_limit!r}: expected seconds") from None
+        check_range("--time-limit", limit, 0.0, None, low_open=True)
     if args.size is not None:
         check_range("--size", args.size, 0.0, None, low_open=True)
-        span = float(
-            np.ptp(pattern.flat if pattern.flat is not None else pattern.coords, axis=0).max()
-        )
-        pattern = scaled_pattern(pattern, args.size / span)
-    elif args.scale is not None:
-        pattern = scaled_pattern(pattern, args.scale)
-    pattern = replace(pattern, meta={**pattern.meta, "source": Path(args.pattern).name})
-    sim = simulate_pattern(pattern, setting)
-    written = write_simulation(sim, out, units=args.units)
-    size = np.ptp(pattern.flat if pattern.flat is not None else pattern.coords, axis=0)
+    files = pattern_files(args.pattern)
+    if not files:
+        raise ValueError(f"no crease-pattern files in {', '.join(args.pattern)}")
+    setting = _setting(args)
+    options = {"unit": args.unit, "tol": args.tol, "frame": args.frame, "curves": args.curves}
+    options["split"] = args.split
+
+    def progress(done, total, failed, rec):
+        what = rec["verdict"] if rec["reason"] is None else f"failed: {rec['reason']}"
+        print(f"[{done}/{total}, {failed} failed] {rec['file']}: {what}", file=sys.stderr)
+
+    counts = run_pattern_batch(
+        files, out, setting, options, size=args.size, scale=args.scale, time_limit=limit,
+        workers=workers, progress=progress,
+    )  # fmt: skip
     print(
-        f"{Path(args.pattern).name}: {pattern.n_vertices} vertices, {pattern.n_faces} panels, "
-        f"{1e3 * size[0]:.4g} x {1e3 * size[1]:.4g} mm, {sim.mass * 1e3:.4g} g; "
-        f"{sim.seconds:.1f} s; wrote {', '.join(p.name for p in written)} to {out}"
+        f"{counts['total']} patterns: {counts['checked']} checked ({counts['failed']} failed), "
+        f"{counts['skipped']} already in {out}"
     )
-    print(sim.status_line())
-    return 0 if sim.fold.complete else 1  # 1: the fold stopped short (the status says where)
+    return 0
 
 
 def _read_sized(read_pattern, args, given):
