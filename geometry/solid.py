@@ -69,7 +69,8 @@ def offset_corners(coords: np.ndarray, faces, inset: np.ndarray) -> np.ndarray:
 
     Every corner moves to the intersection of its two offset side lines, so the offset sides stay
     parallel to the old ones at exactly their inset; a warped polygon is offset in its best-fit
-    plane and keeps its warp. Raises :class:`ParameterError` for a polygon that vanishes.
+    plane and keeps its warp. A straight corner (a T-junction) moves inward by the larger of its
+    two insets. Raises :class:`ParameterError` for a polygon that vanishes.
     """
     faces = [np.asarray(f, np.int64) for f in faces]
     fv = np.concatenate(faces)
@@ -101,14 +102,19 @@ def offset_corners(coords: np.ndarray, faces, inset: np.ndarray) -> np.ndarray:
     a2, d2, o2 = t, inward, d
     cross = a1[:, 0] * a2[:, 1] - a1[:, 1] * a2[:, 0]
     flat = np.abs(cross) < 1e-12
-    if flat.any():
+    back = flat & (np.einsum("ij,ij->i", a1, a2) < 0)
+    if back.any():
         raise ParameterError(
-            f"panel {int(owner[np.flatnonzero(flat)[0]])} has collinear consecutive edges; "
-            "cannot offset it"
+            f"panel {int(owner[np.flatnonzero(back)[0]])} folds back on itself at a corner "
+            "(two consecutive sides run in opposite directions); cannot offset it"
         )
     diff = o2[:, None] * d2 - o1[:, None] * d1
-    s = (diff[:, 0] * a2[:, 1] - diff[:, 1] * a2[:, 0]) / cross
+    s = (diff[:, 0] * a2[:, 1] - diff[:, 1] * a2[:, 0]) / np.where(flat, 1.0, cross)
     shift = o1[:, None] * d1 + s[:, None] * a1
+    # a straight corner (a crease ending on the side of this panel, a T-junction) has no
+    # intersection of the two offset lines: it moves inward by the larger of the two insets,
+    # so the pulled-back panel never reaches over either crease strip
+    shift[flat] = np.maximum(o1, o2)[flat, None] * d2[flat]
     q2 = q + shift
     e2 = q2[nxt] - q2
     area = 0.5 * np.bincount(owner, weights=q2[:, 0] * q2[nxt, 1] - q2[nxt, 0] * q2[:, 1])

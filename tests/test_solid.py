@@ -81,3 +81,24 @@ def test_overlapping_thick_panels_are_reported():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         thick_solid(p, T, W)  # 0.5 mm panels do not
+
+
+def test_a_straight_corner_moves_inward_by_the_larger_inset():
+    """A square with a vertex in the middle of its bottom side (a crease ending there from the
+    panel below, a T-junction): that corner is straight; the offset keeps the panel a rectangle
+    pulled back by the larger inset, where it used to refuse the panel."""
+    from holofold.geometry.solid import offset_corners
+
+    coords = np.array([[0, 0, 0], [0.5, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    # insets of the sides leaving each corner: bottom-left half 0.1, bottom-right half 0.2
+    inset = np.array([0.1, 0.2, 0.0, 0.0, 0.0])
+    q = offset_corners(coords, [np.arange(5)], inset)
+    # the left half's side is 0.1 in, the right half's 0.2; the straight corner takes 0.2
+    assert q[0] == pytest.approx([0.0, 0.1, 0.0], abs=1e-12)
+    assert q[1] == pytest.approx([0.5, 0.2, 0.0], abs=1e-12)
+    assert q[2] == pytest.approx([1.0, 0.2, 0.0], abs=1e-12)
+    with pytest.raises(ParameterError, match="folds back on itself"):
+        offset_corners(
+            np.array([[0, 0, 0], [1, 0, 0], [0.5, 0, 0], [0.5, 1, 0]], float),
+            [np.arange(4)], np.zeros(4),
+        )  # fmt: skip
