@@ -42,9 +42,10 @@ SVG_COLOURS = {
     (255, 0, 255): "U",
 }
 _COLOUR_TOL = 16
-#: what to do with curved lines: refuse curved creases (flatten curved borders and cuts), or
-#: flatten every curve into segments
-CURVE_MODES = ("refuse", "flatten")
+#: what to do with curved lines: refuse curved creases (flatten curved borders and cuts),
+#: flatten every curve into 16 segments, or keep curves (discretised by chord deviation and
+#: piece length, :func:`holofold.geometry.curved.discretise`)
+CURVE_MODES = ("refuse", "flatten", "keep")
 #: the largest SVG file read, bytes (Origami Simulator's largest example is 0.7 MB)
 MAX_SVG_BYTES = 64 * 2**20
 #: metres per SVG px (1/96 inch)
@@ -113,7 +114,7 @@ def _without_legend(data: bytes):
     return io.BytesIO(ET.tostring(root))
 
 
-def svg_lines(path, *, curves: str = "refuse"):
+def svg_lines(path, *, curves: str = "refuse", curve_chord=None, curve_length=None):
     """The straight lines of an SVG crease pattern, in SVG px with y up.
 
     Returns
@@ -125,6 +126,10 @@ def svg_lines(path, *, curves: str = "refuse"):
     notes : list of str
     metres_per_px : float
         The length of one px of ``segments``.
+
+    With ``curves="keep"`` a curve is cut by :func:`~holofold.geometry.curved.discretise` with
+    chord deviation ``curve_chord`` and piece length ``curve_length`` (px; defaults relative to
+    the drawing's larger side, :data:`~holofold.geometry.curved.CHORD_DEFAULT`).
     """
     import svgelements as se
 
@@ -145,6 +150,7 @@ def svg_lines(path, *, curves: str = "refuse"):
     bad_colours: Counter = Counter()
     flattened = 0
     curved_creases = []
+    kept = []
     no_stroke = 0
     for el in svg.elements():
         if not isinstance(el, se.Shape) or isinstance(el, se.Text):
@@ -195,6 +201,13 @@ def svg_lines(path, *, curves: str = "refuse"):
                     continue
                 pts = np.array([[seg.start.x, seg.start.y], [seg.end.x, seg.end.y]])
             else:  # a curve
+                if curves == "keep":
+                    from holofold.geometry.curved import curve_from_svg_segment
+
+                    cv = curve_from_svg_segment(seg, code, ang)
+                    if cv is not None:
+                        kept.append(cv)
+                        continue
                 if code in ("B", "C") or curves == "flatten":
                     pts = _pieces(seg, 16)
                     flattened += 1
@@ -205,6 +218,23 @@ def svg_lines(path, *, curves: str = "refuse"):
                 segs.append([a, b])
                 codes.append(code)
                 angles.append(ang)
+    if kept:
+        from holofold.geometry.curved import CHORD_DEFAULT, LENGTH_DEFAULT, discretise
+
+        pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
+        pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
+        allp = np.concatenate(pts)
+        size = float(np.ptp(allp, axis=0).max()) or 1.0
+        chord = CHORD_DEFAULT * size if curve_chord is None else curve_chord
+        length = LENGTH_DEFAULT * size if curve_length is None else curve_length
+        n_pieces = 0
+        for c in kept:
+            cp = discretise(c, chord=chord, length=length)
+            n_pieces += len(cp) - 1
+            for a, b in zip(cp[:-1], cp[1:], strict=True):
+                segs.append([a, b])
+                codes.append(c.assignment)
+                angles.append(c.fold_angle)
     if curved_creases:
         raise FormatError(
             f"{name}: {len(curved_creases)} curved crease(s) (first: {curved_creases[0]}); "
@@ -217,6 +247,11 @@ def svg_lines(path, *, curves: str = "refuse"):
         notes.append(
             f"{sum(bad_colours.values())} line(s) of other colours left out: {listed}; crease "
             "colours: red M, blue V, black B, green C, yellow F, magenta U"
+        )
+    if kept:
+        notes.append(
+            f"{len(kept)} curve(s) kept, cut into {n_pieces} piece(s) (chord deviation "
+            f"{chord:.3g} px, piece length {length:.3g} px)"
         )
     if flattened:
         notes.append(f"{flattened} curved piece(s) flattened into segments")
