@@ -14,10 +14,12 @@ marks, ``data-role="registration"``), with every ``transform``, CSS class and st
 document's units and ``viewBox`` honoured (one user unit is 1/96 inch unless the document says
 otherwise, so a drawing in millimetres reads in millimetres); elements hidden by ``display:
 none`` are left out. The y axis is turned up, so that the pattern is not mirrored (a mirrored
-pattern swaps mountains and valleys). Straight lines only: a curved border or cut (an arc, a
-circle) is flattened into short segments with a warning; a curved crease is refused unless
-``curves="flatten"``. Then :func:`~holofold.geometry.readers.pattern_from_lines` merges end
-points within ``tol``, splits crossing lines and finds the faces.
+pattern swaps mountains and valleys). By default (``curves="keep"``) a curve (C, Q, S, T, A
+path segments) is cut by :func:`~holofold.geometry.curved.discretise`; ``curves="refuse"``
+refuses curved creases (and flattens curved borders and cuts into 16 segments with a warning),
+``curves="flatten"`` cuts every curve into 16. Then
+:func:`~holofold.geometry.readers.pattern_from_lines` merges end points within ``tol``, splits
+crossing lines and finds the faces.
 """
 
 from __future__ import annotations
@@ -114,7 +116,7 @@ def _without_legend(data: bytes):
     return io.BytesIO(ET.tostring(root))
 
 
-def svg_lines(path, *, curves: str = "refuse", curve_chord=None, curve_length=None):
+def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None):
     """The straight lines of an SVG crease pattern, in SVG px with y up.
 
     Returns
@@ -268,7 +270,7 @@ def svg_lines(path, *, curves: str = "refuse", curve_chord=None, curve_length=No
 
 def read_svg_pattern(
     path, *, tol: float | None = None, unit: float | None = None, split: str = "as-needed",
-    curves: str = "refuse",
+    curves: str = "keep",
 ):  # fmt: skip
     """The crease pattern of an SVG file (see the module docstring), metres.
 
