@@ -66,3 +66,22 @@ def test_svg_c_q_a_read_to_the_analytic_points(tmp_path):
     assert np.allclose(np.hypot(*(arc - centre).T), 40.0, atol=1e-9)
     assert arc[:, 1].max() == pytest.approx(130.0)  # sweep 0 from left to right: below
     assert np.allclose(angles[codes == "V"], 180.0) and any("kept" in n for n in notes)
+
+
+def test_origami_simulator_wavy_pleats_reads_its_curves():
+    from pathlib import Path
+
+    from holofold.geometry import read_pattern
+
+    f = Path(__file__).parent / "data" / "origami-simulator" / "wavy_pleats.svg"
+    S, codes, _, notes, _ = svg_lines(f)
+    assert any(n.startswith("10 curve(s) kept") for n in notes)  # 5 creases x 2 cubics
+    assert (codes == "M").sum() + (codes == "V").sum() == len(S) - 4  # all but the border
+    # every crease runs from the top edge (y = -0.5 px, y up) to the bottom (y = -425.7 px)
+    creases = S[codes != "B"].reshape(-1, 2)
+    assert creases[:, 1].max() == pytest.approx(-0.5) and creases[:, 1].min() == pytest.approx(
+        -425.7
+    )
+    with pytest.warns(Warning):
+        p = read_pattern(f)
+    assert p.n_faces > 6 and np.ptp(p.flat, axis=0).max() > 0
