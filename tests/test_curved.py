@@ -85,3 +85,23 @@ def test_origami_simulator_wavy_pleats_reads_its_curves():
     with pytest.warns(Warning):
         p = read_pattern(f)
     assert p.n_faces > 6 and np.ptp(p.flat, axis=0).max() > 0
+
+
+def test_dxf_arc_crease_kept_on_its_circle(tmp_path):
+    ezdxf = pytest.importorskip("ezdxf", reason="ezdxf is needed for DXF files")
+    from holofold.geometry.dxf_reader import dxf_lines
+
+    doc = ezdxf.new()
+    doc.header["$INSUNITS"] = 4  # mm
+    doc.layers.add("SCORE_M")
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (100, 0), (100, 100), (0, 100)], close=True)
+    msp.add_arc((50, 50), 10, 0, 90, dxfattribs={"layer": "SCORE_M"})
+    doc.saveas(tmp_path / "a.dxf")
+    S, codes, _, _, _ = dxf_lines(tmp_path / "a.dxf")
+    arc = S[codes == "M"].reshape(-1, 2)
+    assert len(arc) >= 2 * 8  # a quarter circle, chord deviation 1e-3 of 10 mm
+    r = np.hypot(*(arc - 50.0).T)  # ezdxf traces an arc by cubic Beziers: within its tolerance
+    assert np.abs(r - 10.0).max() <= 1e-3 * 10.0
+    with pytest.raises(Exception, match="curved crease"):
+        dxf_lines(tmp_path / "a.dxf", curves="refuse")
