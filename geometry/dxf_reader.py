@@ -12,10 +12,11 @@ the entity is transparent, where the angle is 180 x (1 - transparency) (the opac
 Origami Simulator's SVG).
 
 Entities: ``LINE``, ``LWPOLYLINE`` and ``POLYLINE`` (straight pieces; bulges are arcs),
-``ARC``, ``CIRCLE``, ``ELLIPSE``, ``SPLINE`` (curves: flattened for borders and cuts, refused
-for creases unless ``curves="flatten"``) and ``INSERT`` (block references, exploded with their
-transformation). Units from ``$INSUNITS`` (unitless drawings are read as millimetres, with a
-warning); ``unit`` (metres per drawing unit) overrides.
+``ARC``, ``CIRCLE``, ``ELLIPSE``, ``SPLINE`` and polyline bulges (curves: by default,
+``curves="keep"``, cut by ezdxf's adaptive flattening to a chord deviation of 1e-3 of the
+curve's extent; ``"refuse"`` refuses curved creases) and ``INSERT`` (block references, exploded
+with their transformation). Units from ``$INSUNITS`` (unitless drawings are read as
+millimetres, with a warning); ``unit`` (metres per drawing unit) overrides.
 """
 
 from __future__ import annotations
@@ -97,7 +98,7 @@ def _entities(space, depth: int = 0):
             yield e
 
 
-def dxf_lines(path, *, curves: str = "refuse"):
+def dxf_lines(path, *, curves: str = "keep"):
     """The straight lines of a DXF crease pattern: (segments (n, 2, 2) in drawing units,
     codes, fold angles in degrees, metres per drawing unit, notes)."""
     try:
@@ -106,8 +107,8 @@ def dxf_lines(path, *, curves: str = "refuse"):
         from ezdxf import units as ezunits
     except ImportError as exc:  # a dependency of holofold: the environment is broken
         raise EnvironmentFault(f"ezdxf cannot be imported ({exc}); pip install ezdxf") from None
-    if curves not in ("refuse", "flatten"):
-        raise ParameterError(f"curves = {curves!r}; allowed: refuse, flatten")
+    if curves not in ("refuse", "flatten", "keep"):
+        raise ParameterError(f"curves = {curves!r}; allowed: refuse, flatten, keep")
     name = Path(path).name
     size = Path(path).stat().st_size
     if size > MAX_DXF_BYTES:
@@ -158,7 +159,7 @@ def dxf_lines(path, *, curves: str = "refuse"):
                 skipped[f"{t} on {e.dxf.get('layer', '0')}"] += 1
                 continue
             curved = t in _CURVES or p.has_curves
-            if curved and code not in ("B", "C") and curves != "flatten":
+            if curved and code not in ("B", "C") and curves == "refuse":
                 curved_creases += 1
                 continue
             pieces = []
@@ -207,7 +208,7 @@ def dxf_lines(path, *, curves: str = "refuse"):
 
 
 def read_dxf_pattern(path, *, tol: float | None = None, unit: float | None = None,
-                     split: str = "as-needed", curves: str = "refuse"):  # fmt: skip
+                     split: str = "as-needed", curves: str = "keep"):  # fmt: skip
     """The crease pattern of a DXF file (see the module docstring), metres."""
     from holofold.geometry.readers import pattern_from_lines
 

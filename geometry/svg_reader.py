@@ -14,10 +14,12 @@ marks, ``data-role="registration"``), with every ``transform``, CSS class and st
 document's units and ``viewBox`` honoured (one user unit is 1/96 inch unless the document says
 otherwise, so a drawing in millimetres reads in millimetres); elements hidden by ``display:
 none`` are left out. The y axis is turned up, so that the pattern is not mirrored (a mirrored
-pattern swaps mountains and valleys). Straight lines only: a curved border or cut (an arc, a
-circle) is flattened into short segments with a warning; a curved crease is refused unless
-``curves="flatten"``. Then :func:`~holofold.geometry.readers.pattern_from_lines` merges end
-points within ``tol``, splits crossing lines and finds the faces.
+pattern swaps mountains and valleys). By default (``curves="keep"``) a curve (C, Q, S, T, A
+path segments) is cut by :func:`~holofold.geometry.curved.discretise`; ``curves="refuse"``
+refuses curved creases (and flattens curved borders and cuts into 16 segments with a warning),
+``curves="flatten"`` cuts every curve into 16. Then
+:func:`~holofold.geometry.readers.pattern_from_lines` merges end points within ``tol``, splits
+crossing lines and finds the faces.
 """
 
 from __future__ import annotations
@@ -42,9 +44,10 @@ SVG_COLOURS = {
     (255, 0, 255): "U",
 }
 _COLOUR_TOL = 16
-#: what to do with curved lines: refuse curved creases (flatten curved borders and cuts), or
-#: flatten every curve into segments
-CURVE_MODES = ("refuse", "flatten")
+#: what to do with curved lines: refuse curved creases (flatten curved borders and cuts),
+#: flatten every curve into 16 segments, or keep curves (discretised by chord deviation and
+#: piece length, :func:`holofold.geometry.curved.discretise`)
+CURVE_MODES = ("refuse", "flatten", "keep")
 #: the largest SVG file read, bytes (Origami Simulator's largest example is 0.7 MB)
 MAX_SVG_BYTES = 64 * 2**20
 #: metres per SVG px (1/96 inch)
@@ -144,7 +147,7 @@ def _without_legend(data: bytes):
     return io.BytesIO(ET.tostring(root))
 
 
-def svg_lines(path, *, curves: str = "refuse"):
+def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None):
     """The straight lines of an SVG crease pattern, in SVG px with y up.
 
     Returns
@@ -156,6 +159,10 @@ def svg_lines(path, *, curves: str = "refuse"):
     notes : list of str
     metres_per_px : float
         The length of one px of ``segments``.
+
+    With ``curves="keep"`` a curve is cut by :func:`~holofold.geometry.curved.discretise` with
+    chord deviation ``curve_chord`` and piece length ``curve_length`` (px; defaults relative to
+    the drawing's larger side, :data:`~holofold.geometry.curved.CHORD_DEFAULT`).
     """
     import svgelements as se
 
@@ -178,6 +185,7 @@ def svg_lines(path, *, curves: str = "refuse"):
     bad_colours: Counter = Counter()
     flattened = 0
     curved_creases = []
+    kept = []
     no_stroke = 0
     for el in svg.elements():
         if not isinstance(el, se.Shape) or isinstance(el, se.Text):
@@ -228,6 +236,13 @@ def svg_lines(path, *, curves: str = "refuse"):
                     continue
                 pts = np.array([[seg.start.x, seg.start.y], [seg.end.x, seg.end.y]])
             else:  # a curve
+                if curves == "keep":
+                    from holofold.geometry.curved import curve_from_svg_segment
+
+                    cv = curve_from_svg_segment(seg, code, ang)
+                    if cv is not None:
+                        kept.append(cv)
+                        continue
                 if code in ("B", "C") or curves == "flatten":
                     pts = _pieces(seg, 16)
                     flattened += 1
@@ -238,6 +253,23 @@ def svg_lines(path, *, curves: str = "refuse"):
                 segs.append([a, b])
                 codes.append(code)
                 angles.append(ang)
+    if kept:
+        from holofold.geometry.curved import CHORD_DEFAULT, LENGTH_DEFAULT, discretise
+
+        pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
+        pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
+        allp = np.concatenate(pts)
+        size = float(np.ptp(allp, axis=0).max()) or 1.0
+        chord = CHORD_DEFAULT * size if curve_chord is None else curve_chord
+        length = LENGTH_DEFAULT * size if curve_length is None else curve_length
+        n_pieces = 0
+        for c in kept:
+            cp = discretise(c, chord=chord, length=length)
+            n_pieces += len(cp) - 1
+            for a, b in zip(cp[:-1], cp[1:], strict=True):
+                segs.append([a, b])
+                codes.append(c.assignment)
+                angles.append(c.fold_angle)
     if curved_creases:
         raise FormatError(
             f"{name}: {len(curved_creases)} curved crease(s) (first: {curved_creases[0]}); "
@@ -250,6 +282,11 @@ def svg_lines(path, *, curves: str = "refuse"):
         notes.append(
             f"{sum(bad_colours.values())} line(s) of other colours left out: {listed}; crease "
             "colours: red M, blue V, black B, green C, yellow F, magenta U"
+        )
+    if kept:
+        notes.append(
+            f"{len(kept)} curve(s) kept, cut into {n_pieces} piece(s) (chord deviation "
+            f"{chord:.3g} px, piece length {length:.3g} px)"
         )
     if flattened:
         notes.append(f"{flattened} curved piece(s) flattened into segments")
@@ -267,7 +304,7 @@ def svg_lines(path, *, curves: str = "refuse"):
 
 def read_svg_pattern(
     path, *, tol: float | None = None, unit: float | None = None, split: str = "as-needed",
-    curves: str = "refuse",
+    curves: str = "keep",
 ):  # fmt: skip
     """The crease pattern of an SVG file (see the module docstring), metres.
 

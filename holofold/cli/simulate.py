@@ -62,7 +62,9 @@ def register(subparsers) -> argparse.ArgumentParser:
         "--split", choices=("as-needed", "all", "none"), default="as-needed",
         help="which faces to triangulate (default: the non-convex ones)",
     )  # fmt: skip
-    p.add_argument("--curves", choices=("refuse", "flatten"), help="curved creases (SVG, DXF)")
+    p.add_argument(
+        "--curves", choices=("refuse", "flatten", "keep"), help="curved creases (SVG, DXF)"
+    )
     p.add_argument("--support", action="append", default=[], help="vertex set held (repeat)")
     p.add_argument("--support-dofs", default="xyz", help="fixed directions (default xyz)")
     p.add_argument("--load", action="append", default=[], help="vertex set loaded (repeat)")
