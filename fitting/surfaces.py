@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from holofold.geometry.errors import FormatError, ParameterError, check_range
+from holofold.geometry.mesh_reader import mesh_difference, read_mesh
 from holofold.geometry.units import LENGTH_UNITS, length_factor
 
 __all__ = [
@@ -393,18 +394,15 @@ def read_surface(path, units: str = "m", *, check_size: bool = True) -> TargetSu
         )
     if not path.is_file():
         raise SurfaceError(f"surface file {str(path)!r} does not exist")
+    # the file's own numbers, checked before trimesh may drop or repair anything
+    V, F = read_mesh(path, max_faces=MAX_SURFACE_FACES)
     try:
-        mesh = trimesh.load(path, file_type=suffix, force="mesh", process=True)
-    except Exception as exc:  # trimesh raises many types for damaged files
-        raise FormatError(f"cannot read {path.name!r} as .{suffix}: {exc}") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise FormatError(f"{path.name!r} holds no triangles")
-    if len(mesh.faces) > MAX_SURFACE_FACES:
-        raise SurfaceError(
-            f"{path.name!r} has {len(mesh.faces)} triangles, more than {MAX_SURFACE_FACES}"
-        )
-    if not np.isfinite(mesh.vertices).all():
-        raise FormatError(f"{path.name!r} has non-finite vertex coordinates")
+        mesh = trimesh.Trimesh(V, F, process=True)
+    except Exception as exc:  # trimesh raises many types for odd meshes
+        raise FormatError(f"cannot build a mesh from {path.name!r}: {exc}") from None
+    said = mesh_difference(path.name, V, F, mesh)
+    if said:
+        warnings.warn(said, UserWarning, stacklevel=2)
     mesh.remove_unreferenced_vertices()
     mesh.apply_scale(k)
     size = float(np.ptp(mesh.vertices, axis=0).max())
