@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from holofold.geometry import CreasePattern, ParameterError, check_range
+from holofold.geometry.physical import check_sheet
 from holofold.geometry.vertex_sets import VertexSet, parse_vertex_set
 from holofold.mechanics.folding import MODELS, FoldResult, crease_classes, fold_pattern
 from holofold.mechanics.materials import Material, get_material
@@ -295,6 +296,16 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
     # vertex sets first: a bad set is refused before anything is computed
     sup_ids = [v.select(pattern) for v in s.supports]
     load_ids = [ld.at.select(pattern) for ld in s.loads]
+    # a sheet that cannot be physical (creases wider than its panels, a unit mistake) is
+    # refused before any folding (geometry.physical)
+    check_sheet(pattern, panel_thickness=s.panel_thickness, crease_thickness=s.crease_thickness,
+                crease_width=s.crease_width)  # fmt: skip
+    mass = pattern_mass(pattern, s)
+    if not mass > 0:
+        raise ParameterError(
+            f"the pattern would weigh {1e3 * mass:.4g} g: its creases "
+            f"({1e3 * s.crease_width:.4g} mm wide) take more than its panels"
+        )
     fold = fold_pattern(
         pattern, s.fold, panel_thickness=s.panel_thickness, crease_thickness=s.crease_thickness,
         crease_width=s.crease_width, E=s.material.E, nu=s.material.nu, model=s.model,
