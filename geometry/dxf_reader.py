@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from holofold.geometry.bounded import check_dxf_pattern
 from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
 
 __all__ = ["read_dxf_pattern", "dxf_lines", "LAYER_CODES", "ACI_CODES", "MAX_DXF_BYTES"]
@@ -112,6 +113,7 @@ def dxf_lines(path, *, curves: str = "refuse"):
     size = Path(path).stat().st_size
     if size > MAX_DXF_BYTES:
         raise FormatError(f"{name}: {size} bytes; at most {MAX_DXF_BYTES} (64 MiB) are read")
+    check_dxf_pattern(path)  # lines and block INSERT expansion, before ezdxf loads it
     try:
         doc = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as exc:

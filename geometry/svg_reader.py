@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from holofold.geometry.bounded import check_svg_pattern
 from holofold.geometry.errors import FormatError, ParameterError
 
 __all__ = ["read_svg_pattern", "svg_lines", "SVG_COLOURS", "CURVE_MODES", "MAX_SVG_BYTES"]
@@ -134,6 +135,7 @@ def svg_lines(path, *, curves: str = "refuse"):
     size = os.path.getsize(path)
     if size > MAX_SVG_BYTES:
         raise FormatError(f"{name}: {size} bytes; at most {MAX_SVG_BYTES} (64 MiB) are read")
+    check_svg_pattern(path)  # counts after <use> expansion, finite numbers, root size unit
     source = _without_legend(Path(path).read_bytes())
     try:
         svg = se.SVG.parse(source, reify=True, ppi=96.0)
@@ -186,7 +188,12 @@ def svg_lines(path, *, curves: str = "refuse"):
         try:
             path_el = se.Path(el)
         except Exception:  # noqa: BLE001
-            continue
+            if code in ("B", "C"):
+                continue
+            raise FormatError(
+                f"{name}: element {el.id or type(el).__name__} in a crease colour ({code}) "
+                "cannot be read as a path"
+            ) from None
         for seg in path_el.segments():
             if isinstance(seg, se.Move):
                 continue
