@@ -258,8 +258,8 @@ def check_svg_pattern(path) -> None:
         if count > limit:
             raise FormatError(
                 f"SVG file {name!r} has {'over ' if count >= 10 * limit else ''}"
-                f"{min(count, 10 * limit):,} {what} once its <use> references are expanded; at most {limit:,} "
-                "(docs/limits.md)"
+                f"{min(count, 10 * limit):,} {what} once its <use> references are expanded; "
+                f"at most {limit:,} (docs/limits.md)"
             )
 
 
