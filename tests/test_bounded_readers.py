@@ -105,3 +105,31 @@ def test_long_cp_refused_and_content_never_quoted(tmp_path):
     with pytest.raises(FormatError) as err:
         read_pattern(secret)
     assert "secretsalt" not in str(err.value) and "root" not in str(err.value)
+
+
+def test_lock_never_opened_through_a_symlink(tmp_path):
+    from holofold.design.folder_lock import LOCK_NAME, folder_lock
+
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / LOCK_NAME).symlink_to(victim)
+    with pytest.raises(OSError, match="symbolic link"), folder_lock(out):
+        pass
+    assert victim.read_text() == "precious"
+
+
+def test_no_write_through_a_linked_subfolder(tmp_path):
+    from holofold.design.folder_lock import LOCK_NAME
+    from holofold.geometry.outputs import write_text
+
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / LOCK_NAME).write_text("{}")
+    (out / "chunks").symlink_to(elsewhere, target_is_directory=True)
+    with pytest.raises(OSError, match="symbolic link"):
+        write_text(out / "chunks" / "part-0.txt", "x")
+    assert list(elsewhere.iterdir()) == []
