@@ -133,3 +133,19 @@ def test_no_write_through_a_linked_subfolder(tmp_path):
     with pytest.raises(OSError, match="symbolic link"):
         write_text(out / "chunks" / "part-0.txt", "x")
     assert list(elsewhere.iterdir()) == []
+
+
+@pytest.mark.processes
+def test_dxf_bytes_equal_across_clean_runs(tmp_path):
+    """Two clean processes write the same DXF bytes (dates, GUIDs and handles fixed)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import math,sys; import holofold.geometry as g; "
+        "p = g.miura_sheet(3, 3, a=0.02, b=0.025, gamma=math.radians(60), ext=1.0); "
+        "sys.stdout.write(g.export_dxf(p))"
+    )
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, check=True,
+                           timeout=120).stdout for _ in range(2)]  # fmt: skip
+    assert len(runs[0]) > 1000 and runs[0] == runs[1]
