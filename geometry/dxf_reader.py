@@ -117,10 +117,12 @@ def dxf_lines(path, *, curves: str = "refuse"):
     try:
         doc = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as exc:
-        raise FormatError(f"{name}: not a readable DXF file ({exc})") from None
+        why = " ".join(str(exc).split())[:200]  # one line
+        raise FormatError(f"{name}: not a readable DXF file ({why})") from None
     except Exception as exc:  # noqa: BLE001 - a malformed file: one line
         raise FormatError(
-            f"{name}: not a readable DXF file ({type(exc).__name__}: {exc})"
+            f"{name}: not a readable DXF file ({type(exc).__name__}: "
+            f"{' '.join(str(exc).split())[:200]})"
         ) from None
     notes = []
     insunits = int(doc.header.get("$INSUNITS", 0) or 0)
