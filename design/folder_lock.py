@@ -135,7 +135,15 @@ def folder_lock(folder, *, wait: float | None = None, say=None):
                 _HELD[key] -= 1
         return
     path = folder / LOCK_NAME
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    # never through a symlink: out/.holofold.lock -> ../victim would truncate the victim
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
+    except OSError as exc:
+        if path.is_symlink():
+            raise OSError(
+                f"{path} is a symbolic link; a lock file is never opened through one: remove it"
+            ) from None
+        raise exc
     try:
         if not _try_lock(fd):
             if not wait:

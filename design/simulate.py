@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from holofold.geometry import CreasePattern, ParameterError, check_range
+from holofold.geometry.physical import check_sheet
 from holofold.geometry.vertex_sets import VertexSet, parse_vertex_set
 from holofold.mechanics.folding import MODELS, FoldResult, crease_classes, fold_pattern
 from holofold.mechanics.materials import Material, get_material
@@ -288,25 +289,17 @@ def pattern_mass(pattern: CreasePattern, setting: PatternSetting) -> float:
 
 
 def check_physical(pattern: CreasePattern, setting: PatternSetting) -> None:
-    """Refuse, in one line, a sheet that cannot exist: creases wider than the panels between
-    them allow (a panel vanishes when its hinge strips are pulled back) or a mass that is not
+    """Refuse, in one line, a sheet that cannot exist (geometry.physical.check_sheet: extent,
+    thicknesses, creases wider than the panels between them allow) or a mass that is not
     positive. Raises :class:`ParameterError`."""
-    from holofold.geometry import shrunk_panels
-
     s = setting
-    try:
-        shrunk_panels(pattern, s.crease_width)
-    except ParameterError as exc:
-        size = float(np.ptp(pattern.coords, axis=0).max())
-        raise ParameterError(
-            f"{exc}: creases {s.crease_width * 1e3:.3g} mm wide on a sheet {size * 1e3:.3g} mm "
-            "across; give a narrower crease width or a larger scale"
-        ) from None
+    check_sheet(pattern, panel_thickness=s.panel_thickness, crease_thickness=s.crease_thickness,
+                crease_width=s.crease_width)  # fmt: skip
     m = pattern_mass(pattern, s)
     if not m > 0:
         raise ParameterError(
-            f"the sheet's mass would be {m * 1e3:.3g} g: its crease strips "
-            f"({s.crease_width * 1e3:.3g} mm wide) cover more than its panels; give a narrower "
+            f"the sheet would weigh {m * 1e3:.4g} g: its crease strips "
+            f"({s.crease_width * 1e3:.4g} mm wide) take more than its panels; give a narrower "
             "crease width"
         )
 

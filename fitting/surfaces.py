@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from holofold.geometry.errors import FormatError, ParameterError, check_range
-from holofold.geometry.mesh_file_checks import check_loaded_vertices, check_mesh_file
+from holofold.geometry.mesh_reader import mesh_difference, read_mesh
 from holofold.geometry.units import LENGTH_UNITS, length_factor
 
 __all__ = [
@@ -394,36 +394,16 @@ def read_surface(path, units: str = "m", *, check_size: bool = True) -> TargetSu
         )
     if not path.is_file():
         raise SurfaceError(f"surface file {str(path)!r} does not exist")
-    # the file's own counts and lines first, then the arrays as read, before trimesh may
-    # drop (non-finite vertices and their triangles) or repair anything
-    check_mesh_file(path, suffix, MAX_SURFACE_FACES)
+    # the file's own numbers, checked before trimesh may drop or repair anything
+    V, F = read_mesh(path, max_faces=MAX_SURFACE_FACES)
     try:
-        mesh = trimesh.load(path, file_type=suffix, force="mesh", process=False)
-    except Exception as exc:  # trimesh raises many types for damaged files
-        raise FormatError(f"cannot read {path.name!r} as .{suffix}: {_reason(exc)}") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise FormatError(f"{path.name!r} holds no triangles")
-    if len(mesh.faces) > MAX_SURFACE_FACES:
-        raise SurfaceError(
-            f"{path.name!r} has {len(mesh.faces)} triangles, more than {MAX_SURFACE_FACES}"
-        )
-    check_loaded_vertices(path.name, mesh.vertices)
-    faces = np.asarray(mesh.faces)
-    if faces.min() < 0 or faces.max() >= len(mesh.vertices):
-        raise FormatError(f"{path.name!r} has triangles whose vertices do not exist")
-    if (np.abs(mesh.vertices) > 1e12).any():
-        raise FormatError(f"{path.name!r} has coordinates beyond 1e12: not a part's size")
-    n_read = len(faces)
-    mesh.merge_vertices()  # STL stores every triangle's corners apart: join them
-    mesh.update_faces(mesh.nondegenerate_faces())
+        mesh = trimesh.Trimesh(V, F, process=True)
+    except Exception as exc:  # trimesh raises many types for odd meshes
+        raise FormatError(f"cannot build a mesh from {path.name!r}: {exc}") from None
+    said = mesh_difference(path.name, V, F, mesh)
+    if said:
+        warnings.warn(said, UserWarning, stacklevel=2)
     mesh.remove_unreferenced_vertices()
-    if len(mesh.faces) < n_read:
-        warnings.warn(
-            f"{path.name!r}: {n_read - len(mesh.faces)} of its {n_read} triangles have no area "
-            "(two corners at one point, or three on a line) and are left out",
-            UserWarning,
-            stacklevel=2,
-        )
     if len(mesh.faces) == 0:
         raise FormatError(f"{path.name!r} holds no triangle with an area")
     mesh.apply_scale(k)

@@ -101,6 +101,11 @@ class Bed:
                 f"bed {text!r} is read in millimetres: {max(mm):g} mm is no printer's bed "
                 "(metres given? 0.25 m is 250)"
             )
+        if max(mm) > 10_000:
+            raise ParameterError(
+                f"bed {text!r} is read in millimetres: {max(mm):.4g} mm ({max(mm) / 1000:.4g} m) "
+                "is no printer's bed (at most 10,000 mm)"
+            )
         return cls(*(v / 1000.0 for v in mm))
 
     def __str__(self) -> str:

@@ -51,6 +51,9 @@ __all__ = [
     "CutterOptions",
 ]
 
+#: the finest dash, gap or vertex gap drawn, mm (no laser or blade resolves less)
+MIN_CUT_MM = 0.01
+
 #: the roles of a line; each FOLD assignment has one (:data:`ROLE_OF`)
 ROLES = ("boundary", "cut", "mountain", "valley", "flat", "unassigned", "registration")
 #: FOLD assignment -> role (J, triangulation lines, are not drawn)
@@ -285,6 +288,12 @@ def cutter_drawing(
             "Simulator builds its faces from them); dashes and vertex gaps are for the laser "
             "and cricut profiles"
         )
+    for what, v in (("dash", dash), ("gap", gap), ("vertex_gap", vgap)):
+        if 0 < v < MIN_CUT_MM:
+            raise ParameterError(
+                f"{what} {v:.3g} mm is under {MIN_CUT_MM:g} mm, finer than any cutter draws; "
+                "give 0 (none) or at least that"
+            )
     if dash > 0 and gap <= 0:
         raise ParameterError("dashed creases need a gap > 0 between the dashes (mm)")
     two = side != "both"

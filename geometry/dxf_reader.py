@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from holofold.geometry.bounded import check_dxf_pattern
 from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
 
 __all__ = ["read_dxf_pattern", "dxf_lines", "LAYER_CODES", "ACI_CODES", "MAX_DXF_BYTES"]
@@ -113,13 +114,16 @@ def dxf_lines(path, *, curves: str = "keep"):
     size = Path(path).stat().st_size
     if size > MAX_DXF_BYTES:
         raise FormatError(f"{name}: {size} bytes; at most {MAX_DXF_BYTES} (64 MiB) are read")
+    check_dxf_pattern(path)  # lines and block INSERT expansion, before ezdxf loads it
     try:
         doc = ezdxf.readfile(str(path))
     except (OSError, ezdxf.DXFError) as exc:
-        raise FormatError(f"{name}: not a readable DXF file ({exc})") from None
+        why = " ".join(str(exc).split())[:200]  # one line
+        raise FormatError(f"{name}: not a readable DXF file ({why})") from None
     except Exception as exc:  # noqa: BLE001 - a malformed file: one line
         raise FormatError(
-            f"{name}: not a readable DXF file ({type(exc).__name__}: {exc})"
+            f"{name}: not a readable DXF file ({type(exc).__name__}: "
+            f"{' '.join(str(exc).split())[:200]})"
         ) from None
     notes = []
     insunits = int(doc.header.get("$INSUNITS", 0) or 0)

@@ -550,6 +550,10 @@ def _read(source) -> CreasePattern:
     for key, n, what in physical:
         if key in d:
             meta[key.split(":", 1)[1]] = list(_numbers(d, key, n, what))
+    reach = float(np.abs(np.asarray(coords3, float)).max(initial=0.0))
+    if not reach <= 1e4:  # 10 km: beyond any sheet, and 1e300 overflowed the face checks
+        _fail(f"a vertex lies {reach:.3g} m from the origin, beyond 1e4 m; check the "
+              "coordinates and frame_unit")  # fmt: skip
     try:
         return CreasePattern(coords3, faces, edges, asg, ang, flat=flat, meta=meta)
     except ValueError as exc:

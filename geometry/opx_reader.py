@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from holofold.geometry.bounded import check_token_count
 from holofold.geometry.errors import FormatError, ParameterError
 
 __all__ = ["read_opx_pattern", "read_cp_pattern", "ORIPA_TYPES", "MAX_ORIPA_BYTES"]
@@ -52,6 +53,7 @@ def _value(obj, prop: str, kind: type, default):
 def opx_lines(path):
     """(segments (n, 2, 2) ORIPA units y up, codes, angles, notes) of an ``.opx`` file."""
     name = Path(path).name
+    check_token_count(path, b"OriLineProxy", ".opx file", "lines")
     try:
         root = ET.fromstring(_read_text(path))
     except ET.ParseError as exc:
@@ -77,6 +79,7 @@ def opx_lines(path):
 def cp_lines(path):
     """(segments, codes, angles, notes) of a ``.cp`` file (``type x0 y0 x1 y1`` per line)."""
     name = Path(path).name
+    check_token_count(path, b"\n", ".cp file", "lines")
     try:
         text = _read_text(path).decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -92,7 +95,7 @@ def cp_lines(path):
             x0, y0, x1, y1 = (float(v) for v in parts[1:5])
         except (ValueError, IndexError):
             raise FormatError(
-                f"{name}: line {k} = {line.strip()[:60]!r}; expected 'type x0 y0 x1 y1'"
+                f"{name}: line {k} is not 'type x0 y0 x1 y1' (five numbers)"
             ) from None
         if t not in ORIPA_TYPES:
             aux += 1

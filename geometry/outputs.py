@@ -78,6 +78,18 @@ def _umask() -> int:
     return mask
 
 
+def _refuse_linked_subfolder(path: Path) -> None:
+    """Refuse writing into a folder that is a symbolic link inside a locked output folder (a
+    ``chunks`` link to another directory would be written through). A file that is a link is
+    safe already: the rename replaces the link, never its target."""
+    parent = path.parent
+    if parent.is_symlink() and (parent.parent / ".holofold.lock").exists():
+        raise OSError(
+            f"{parent} is a symbolic link inside the output folder {parent.parent}; files are "
+            "never written through one: remove it"
+        )
+
+
 def atomic_write(path, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` on a temporary path beside ``path``, then rename it to ``path``.
 
@@ -85,6 +97,7 @@ def atomic_write(path, write: Callable[[str], None]) -> Path:
     the permissions of a normally created one (0666 less the umask), not mkstemp's 0600.
     """
     path = Path(path)
+    _refuse_linked_subfolder(path)
     fd, tmp = tempfile.mkstemp(prefix=".holofold-", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:

@@ -230,6 +230,10 @@ def finish_pattern(
     return pattern
 
 
+#: the farthest a drawn crease may lie from the origin, m (a 1 km sheet; 1e300 overflowed scipy)
+MAX_DRAWN_METRES = 1e4
+
+
 def pattern_from_lines(
     segments, assignment, fold_angle, *, name: str, unit: float, tol: float | None = None,
     split: str = "as-needed", meta: dict | None = None, notes=(),
@@ -243,6 +247,14 @@ def pattern_from_lines(
         raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
     if tol is not None and not (np.isfinite(tol) and tol > 0):
         raise ParameterError(f"tol = {tol!r} must be a distance > 0 in drawing units")
+    S = np.asarray(segments, float)
+    if S.size and not np.isfinite(S).all():
+        raise FormatError(f"{name}: a line has a coordinate that is not a finite number")
+    if S.size and np.abs(S).max() * unit > MAX_DRAWN_METRES:
+        raise FormatError(
+            f"{name}: a line reaches {np.abs(S).max() * unit:.3g} m from the origin, beyond "
+            f"{MAX_DRAWN_METRES:g} m; check the drawing's numbers and unit"
+        )
     try:
         arr = arrange_lines(segments, assignment, fold_angle, tol=tol)
     except FormatError as exc:

@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from holofold.geometry.bounded import check_svg_pattern
 from holofold.geometry.errors import FormatError, ParameterError
 
 __all__ = ["read_svg_pattern", "svg_lines", "SVG_COLOURS", "CURVE_MODES", "MAX_SVG_BYTES"]
@@ -85,30 +86,6 @@ def _pieces(seg, n: int) -> np.ndarray:
 # 96 / 25.4); a px of a document sized in those units is undone with the same factor, so a
 # drawing in millimetres reads back to the nanometre
 _SE_PX = {"mm": 96 * 0.0393701 / 1e-3, "cm": 96 * 0.393701 / 1e-2, "in": 96 / 0.0254}
-
-
-#: attributes that carry coordinates or lengths: a non-finite number in one is refused (the
-#: SVG parser reads 'nan' and 'inf' as 0, which moves or removes a crease)
-_GEOMETRY_ATTRS = (
-    "x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "r", "rx", "ry", "width", "height", "points",
-    "d", "transform", "viewBox",
-)  # fmt: skip
-
-
-def _check_numbers(name: str, data: bytes) -> None:
-    """Refuse a non-finite number (nan, inf) in a coordinate attribute, in one line."""
-    import re
-
-    attrs = "|".join(_GEOMETRY_ATTRS)
-    pattern = rb"(?<![\w:-])(" + attrs.encode() + rb")\s*=\s*(\"[^\"]*\"|'[^']*')"
-    bad = re.compile(rb"(?i)(?<![a-z])(nan|inf|infinity)(?![a-z])")
-    for m in re.finditer(pattern, data):
-        if bad.search(m.group(2)):
-            line = data.count(b"\n", 0, m.start()) + 1
-            raise FormatError(
-                f"{name}, line {line}: {m.group(1).decode()} holds a number that is not finite "
-                f"({bad.search(m.group(2)).group(1).decode()})"
-            )
 
 
 def _metres_per_px(svg, name: str = "the SVG") -> float:
@@ -172,9 +149,8 @@ def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None
     size = os.path.getsize(path)
     if size > MAX_SVG_BYTES:
         raise FormatError(f"{name}: {size} bytes; at most {MAX_SVG_BYTES} (64 MiB) are read")
-    data = Path(path).read_bytes()
-    _check_numbers(name, data)
-    source = _without_legend(data)
+    check_svg_pattern(path)  # counts after <use> expansion, finite numbers, root size unit
+    source = _without_legend(Path(path).read_bytes())
     try:
         svg = se.SVG.parse(source, reify=True, ppi=96.0)
     except Exception as exc:  # noqa: BLE001 - any parse failure of a user file: one line
@@ -227,7 +203,12 @@ def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None
         try:
             path_el = se.Path(el)
         except Exception:  # noqa: BLE001
-            continue
+            if code in ("B", "C"):
+                continue
+            raise FormatError(
+                f"{name}: element {el.id or type(el).__name__} in a crease colour ({code}) "
+                "cannot be read as a path"
+            ) from None
         for seg in path_el.segments():
             if isinstance(seg, se.Move):
                 continue

@@ -408,7 +408,7 @@ def test_svg_non_finite_coordinates_are_refused_not_read_as_zero(tmp_path, bad):
     """svgelements reads 'nan' and 'inf' as 0, which moved the crease to the corner (and the
     warning said 'drawn twice'); now the line is refused at its attribute."""
     f = _svg(tmp_path, _SQUARE.format(x2=bad))
-    with pytest.raises(FormatError, match=r"cp.svg, line 1: x2 holds a number that is not finite"):
+    with pytest.raises(FormatError, match=r"'cp.svg': <line> x2 is not a finite number \(line 1\)"):
         read_pattern(f)
     ok = read_pattern(_svg(tmp_path, _SQUARE.format(x2="50")))
     assert ok.n_faces == 2
@@ -419,7 +419,7 @@ def test_svg_width_in_an_unknown_unit_is_refused(tmp_path, width):
     """width='100km' or '100%' was read as px (13.23 mm across): refused with what to give."""
     f = _svg(tmp_path, _SQUARE.format(x2="50"),
              size=f'width="{width}" height="{width}" viewBox="0 0 100 100"')  # fmt: skip
-    with pytest.raises(FormatError, match=f"width '{width}' is not a length holofold reads"):
+    with pytest.raises(FormatError, match=f'root width="{width}" is not a length in px, mm, cm'):
         read_pattern(f)
     for good, mm in (("100mm", 50.0), ("10cm", 50.0), ("72pt", 25.4 / 2), ("96", 25.4 / 2)):
         g = _svg(tmp_path, _SQUARE.format(x2="50"),

@@ -312,6 +312,15 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
     pattern, source, model = _read_pattern(doc.sub("pattern", required=True))
     E, nu, density = read_material(doc)
     at, dofs, loads = read_supports_and_loads(doc, "'press'", pattern)
+    if loads and dofs == "xyz":  # a mistake of the file: refused once, not stored as rows
+        from holofold.geometry.vertex_sets import parse_vertex_set
+
+        held = {int(i) for v in at for i in parse_vertex_set(v).select(pattern)}
+        if len(held) < 3:
+            raise doc.error(
+                f"the supports hold {len(held)} vertex(es): the pattern could turn as a whole "
+                "under every load; hold at least three vertices not on one line"
+            )
     tol, max_iter = read_solver(doc)
     setting = PatternScenarioSetting(
         pattern=pattern, source=source, material=Material("file", E, nu, density), model=model,

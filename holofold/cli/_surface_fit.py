@@ -108,6 +108,11 @@ def run_surface(args) -> int:
     limit = None
     if args.fold_time_limit is not None:
         limit = check_range("--fold-time-limit", args.fold_time_limit, 0.0, None, low_open=True)
+    if getattr(args, "thick", "centred") != "centred" and args.panel_thickness is None:
+        raise ParameterError(
+            f"--thick {args.thick} needs --panel-thickness and --crease-width: "
+            "without a panel thickness there are no thick panels to offset"
+        )
     if getattr(args, "printable", False):
         missing = [f"--{n.replace('_', '-')}" for n in ("panel_thickness", "crease_width",
                    "crease_thickness") if getattr(args, n) is None]  # fmt: skip

@@ -214,6 +214,11 @@ def _validate(args) -> dict:
         check_range("--panel-thickness", args.panel_thickness, 0.0, None, low_open=True)
         check_range("--crease-width", args.crease_width, 0.0, None, low_open=True)
         opts["solid"] = True
+    if args.thick != "centred" and args.panel_thickness is None:
+        raise ParameterError(
+            f"--thick {args.thick} needs --panel-thickness and --crease-width: "
+            "without a panel thickness there are no thick panels to offset"
+        )
     if args.no_overlap and not (args.auto and opts.get("solid")):
         raise ParameterError("--no-overlap needs --auto, --panel-thickness and --crease-width")
     if args.printable:

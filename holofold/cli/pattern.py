@@ -123,6 +123,11 @@ def run(args) -> int:
         check_range("--crease-thickness", args.crease_thickness, 0.0, None, low_open=True)
     elif args.crease_thickness is not None:
         raise ParameterError("--crease-thickness is for --printable; add --printable")
+    if args.thick != "centred" and args.thickness is None:
+        raise ParameterError(
+            f"--thick {args.thick} needs --thickness: without a panel "
+            "thickness there are no thick panels to offset"
+        )
     written = write_fabrication_set(
         pattern,
         args.output,

@@ -1,0 +1,156 @@
+"""Bounded, validating crease-pattern readers (issue 33 items 3 and 4)."""
+
+import time
+
+import pytest
+
+from holofold.geometry import read_pattern
+from holofold.geometry.bounded import MAX_PATTERN_ELEMENTS, path_data_problem
+from holofold.geometry.errors import FormatError
+
+SQ = (
+    '<line x1="0" y1="0" x2="100" y2="0" stroke="#000"/>'
+    '<line x1="100" y1="0" x2="100" y2="100" stroke="#000"/>'
+    '<line x1="100" y1="100" x2="0" y2="100" stroke="#000"/>'
+    '<line x1="0" y1="100" x2="0" y2="0" stroke="#000"/>'
+)
+HEAD = (
+    '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '
+    'width="{w}" height="100mm" viewBox="0 0 100 100">'
+)
+DIAG = '<line x1="{x}" y1="0" x2="100" y2="100" stroke="#f00"/>'
+
+
+def _svg(tmp_path, body, w="100mm", name="p.svg"):
+    p = tmp_path / name
+    p.write_text(HEAD.format(w=w) + SQ + body + "</svg>")
+    return p
+
+
+def _refused(path, match):
+    t0 = time.perf_counter()
+    with pytest.raises(FormatError, match=match):
+        read_pattern(path)
+    return time.perf_counter() - t0
+
+
+def test_clean_svg_still_reads(tmp_path):
+    p = read_pattern(_svg(tmp_path, DIAG.format(x=0)))
+    assert p.n_faces == 2
+
+
+@pytest.mark.parametrize("x", ["nan", "inf", "-Infinity", "NaN"])
+def test_svg_non_finite_coordinate_refused(tmp_path, x):
+    _refused(_svg(tmp_path, DIAG.format(x=x)), "not a finite number")
+
+
+@pytest.mark.parametrize("w", ["100km", "100%", "100furlong"])
+def test_svg_root_size_in_unknown_unit_refused(tmp_path, w):
+    _refused(_svg(tmp_path, DIAG.format(x=0), w=w), "not a length")
+
+
+def test_svg_malformed_crease_path_refused(tmp_path):
+    _refused(_svg(tmp_path, '<path d="M 0 0 L 100 Q" stroke="#f00"/>'), "path data")
+
+
+def test_path_data_checker():
+    for good in ["M0,0L10,10z", "M 0 0 L 1 2 3 4 Z", "M0 0 h10v10H0Z", "M1e-3-2.5.5.5",
+                 "M 0 0 A 5 5 0 0 1 10 10"]:  # fmt: skip
+        assert path_data_problem(good) is None, good
+    for bad in ["M 0 0 L 100 Q", "m 0 0 l 1", "M 0 0 L 1 x", "0 0 L 1 1"]:
+        assert path_data_problem(bad) is not None, bad
+
+
+def test_html_named_svg_refused(tmp_path):
+    p = tmp_path / "page.svg"
+    p.write_text("<html><body>hi</body></html>")
+    _refused(p, "root element is not <svg>")
+
+
+def test_use_doubling_bomb_refused_fast(tmp_path):
+    body = '<defs><line id="l0" x1="0" y1="0" x2="1" y2="1" stroke="#f00"/>'
+    for i in range(1, 26):
+        body += f'<g id="l{i}"><use xlink:href="#l{i - 1}"/><use xlink:href="#l{i - 1}"/></g>'
+    body += '</defs><use xlink:href="#l25"/>'
+    _refused(_svg(tmp_path, body), f"at most {MAX_PATTERN_ELEMENTS:,}")
+
+
+def test_use_cycle_refused(tmp_path):
+    body = '<g id="a"><use xlink:href="#b"/></g><g id="b"><use xlink:href="#a"/></g>'
+    _refused(_svg(tmp_path, body), "reference cycle")
+
+
+def _dxf_bomb(path, levels=30):
+    d = ["0", "SECTION", "2", "BLOCKS", "0", "BLOCK", "2", "B0", "0", "LINE", "8", "0",
+         "10", "0", "20", "0", "11", "1", "21", "1", "0", "ENDBLK"]  # fmt: skip
+    for i in range(1, levels + 1):
+        d += ["0", "BLOCK", "2", f"B{i}", "0", "INSERT", "2", f"B{i - 1}", "0", "INSERT", "2",
+              f"B{i - 1}", "0", "ENDBLK"]  # fmt: skip
+    d += ["0", "ENDSEC", "0", "SECTION", "2", "ENTITIES", "0", "INSERT", "2", f"B{levels}",
+          "0", "ENDSEC", "0", "EOF"]  # fmt: skip
+    path.write_text("\n".join(d) + "\n")
+    return path
+
+
+def test_dxf_insert_doubling_bomb_refused(tmp_path):
+    _refused(_dxf_bomb(tmp_path / "bomb.dxf"), "block INSERTs are expanded")
+
+
+def test_long_cp_refused_and_content_never_quoted(tmp_path):
+    p = tmp_path / "long.cp"
+    p.write_text("".join(f"2 {i} 0 {i} 1\n" for i in range(MAX_PATTERN_ELEMENTS + 5)))
+    _refused(p, "lines")
+    secret = tmp_path / "shadow.cp"
+    secret.write_text("root:$6$secretsalt$hash:19000:0:99999:7:::\n")
+    with pytest.raises(FormatError) as err:
+        read_pattern(secret)
+    assert "secretsalt" not in str(err.value) and "root" not in str(err.value)
+
+
+def test_lock_never_opened_through_a_symlink(tmp_path):
+    from holofold.design.folder_lock import LOCK_NAME, folder_lock
+
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / LOCK_NAME).symlink_to(victim)
+    with pytest.raises(OSError, match="symbolic link"), folder_lock(out):
+        pass
+    assert victim.read_text() == "precious"
+
+
+def test_no_write_through_a_linked_subfolder(tmp_path):
+    from holofold.design.folder_lock import LOCK_NAME
+    from holofold.geometry.outputs import write_text
+
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / LOCK_NAME).write_text("{}")
+    (out / "chunks").symlink_to(elsewhere, target_is_directory=True)
+    with pytest.raises(OSError, match="symbolic link"):
+        write_text(out / "chunks" / "part-0.txt", "x")
+    assert list(elsewhere.iterdir()) == []
+
+
+@pytest.mark.processes
+@pytest.mark.xfail(
+    strict=False,
+    reason="issue 33 item 7 open: ezdxf's OBJECTS section orders LAYOUT and ACDBPLACEHOLDER "
+    "differently in about 1 process in 5 (seen at byte 7234), so two clean runs can differ",
+)
+def test_dxf_bytes_equal_across_clean_runs(tmp_path):
+    """Two clean processes write the same DXF bytes (dates, GUIDs and handles fixed)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import math,sys; import holofold.geometry as g; "
+        "p = g.miura_sheet(3, 3, a=0.02, b=0.025, gamma=math.radians(60), ext=1.0); "
+        "sys.stdout.write(g.export_dxf(p))"
+    )
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, check=True,
+                           timeout=120).stdout for _ in range(2)]  # fmt: skip
+    assert len(runs[0]) > 1000 and runs[0] == runs[1]
