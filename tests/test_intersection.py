@@ -105,3 +105,24 @@ def test_fold_below_the_touch_is_not_stopped():
     assert r.verdict == "folds rigidly" and r.complete and math.isnan(r.touch_at)
     off = fold_pattern(_strip(), 1.0, check_intersections=False, **SECTION)
     assert off.complete and has_intersections(off.coords[-1], p.faces)
+
+
+def test_simulation_files_of_a_touching_fold_are_clean(tmp_path):
+    """holofold simulate's files for the strip: every FOLD frame is checked independently (the
+    numpy test) and is clean; the summary says where the fold stopped and which panels."""
+    import json
+
+    from holofold.design import PatternSetting, simulate_pattern, write_simulation
+
+    sim = simulate_pattern(_strip(), PatternSetting())
+    assert sim.fold.verdict == "folds until panels touch"
+    write_simulation(sim, tmp_path / "out")
+    frames = json.loads((tmp_path / "out" / "folded.fold").read_text())["file_frames"]
+    faces = _strip().faces
+    for fr in frames:
+        X = np.array(fr["vertices_coords"], float)
+        assert len(intersecting_faces(X, faces)) == 0
+    summary = json.loads((tmp_path / "out" / "simulation.json").read_text())
+    assert summary["fold"]["touch_faces"] == [0, 2]
+    assert 120 / 179 < summary["fold"]["touch_at"] <= 123 / 179 + 1e-9
+    assert summary["status_line"].startswith("folds until panels touch")
