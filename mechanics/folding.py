@@ -556,14 +556,16 @@ def fold_pattern(
 
 def _first_intersecting(pattern: CreasePattern, coords: np.ndarray):
     """``(k, (face, face))``: the first stored state whose panels pass through each other and
-    two faces that do (-1, -1 where only IPC Toolkit saw it); None when every state is clean."""
+    two faces that do; None when every state is clean."""
     from holofold.mechanics.intersection import has_intersections, intersecting_faces
 
+    # IPC Toolkit screens (fast); the numpy test confirms and locates: IPC Toolkit also flags
+    # flat states with coincident coplanar cut edges (kirigami), which do not cross
     for k in range(len(coords)):
         if has_intersections(coords[k], pattern.faces):
             pairs = intersecting_faces(coords[k], pattern.faces)
-            where = (int(pairs[0, 0]), int(pairs[0, 1])) if len(pairs) else (-1, -1)
-            return k, where
+            if len(pairs):
+                return k, (int(pairs[0, 0]), int(pairs[0, 1]))
     return None
 
 

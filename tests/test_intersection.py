@@ -126,3 +126,13 @@ def test_simulation_files_of_a_touching_fold_are_clean(tmp_path):
     assert summary["fold"]["touch_faces"] == [0, 2]
     assert 120 / 179 < summary["fold"]["touch_at"] <= 123 / 179 + 1e-9
     assert summary["status_line"].startswith("folds until panels touch")
+
+
+def test_coincident_cut_edges_in_a_flat_sheet_do_not_cross():
+    """A cut (two vertex copies on one line, as in kirigami) in a flat sheet: coplanar, touching,
+    not crossing (IPC Toolkit's has_intersections flags such flat states; the fold confirms
+    with this test before it stops)."""
+    X = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 0], [1, 0, 0], [0, -1, 0]], float)
+    F = [[0, 1, 2], [3, 5, 4]]
+    assert len(intersecting_faces(X, F)) == 0
+    assert not has_intersections(X, F, backend="numpy")
