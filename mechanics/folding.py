@@ -33,7 +33,9 @@ driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the 
 not those of a rigid folding),
 ``turns against its assignment`` (driven creases folded more than :data:`WRONG_WAY_DEG` the
 wrong way in the last state; the note gives the fraction at which the first one did) or
-``stalls`` (a step would not converge).
+``stalls`` (a step would not converge), or ``folds until panels touch`` (a state had panels
+passing through each other: the fold stops at the last clean state; no success verdict is
+given for an intersecting state, see :mod:`holofold.mechanics.intersection`).
 
 Fold angles are tracked through +-180 degrees: each state's angles are unwrapped against the
 previous stored state along the path (the dihedral angle of two panels is only known modulo
@@ -178,8 +180,8 @@ class FoldResult:
     status : Status
         Converged (every step met the tolerance up to ``requested``) or not converged, why.
     verdict : str
-        ``folds rigidly``, ``folds off target``, ``does not fold rigidly``, ``turns against
-        its assignment`` or ``stalls``.
+        ``folds rigidly``, ``folds off target``, ``does not fold rigidly``, ``folds until
+        panels touch``, ``turns against its assignment`` or ``stalls``.
     note : str
         One sentence behind the verdict (numbers).
     energy : ModelEnergy
@@ -189,6 +191,11 @@ class FoldResult:
     wrong_at : float
         The fraction at which a driven crease first stood more than :data:`WRONG_WAY_DEG`
         against its assignment along the path (NaN: none did).
+    touch_at : float
+        The fraction of the first state in which panels passed through each other (the fold
+        stops at the state before it; NaN: every state was clean).
+    touch_where : (int, int)
+        Two faces that pass through each other there ((-1, -1): none, or not located).
     halvings : int
         Steps retried at a smaller size.
     snaps : (n,) float
@@ -216,6 +223,8 @@ class FoldResult:
     snaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
     elapsed: np.ndarray = field(default_factory=lambda: np.zeros(1))
     wrong_at: float = float("nan")
+    touch_at: float = float("nan")
+    touch_where: tuple[int, int] = (-1, -1)
 
     @property
     def reached(self) -> float:
@@ -293,6 +302,7 @@ def fold_pattern(
     profile: Profile = PHYSICAL,
     time_limit: float | None = None,
     extrapolate: bool = False,
+    check_intersections: bool = True,
 ) -> FoldResult:
     """Fold ``pattern`` towards ``fraction`` x its target fold angles (see the module
     docstring).
@@ -330,6 +340,11 @@ def fold_pattern(
         Start each step's Newton iterations from the secant extrapolation of the last two
         states instead of the last one (a smooth path, such as a rigid folding, then takes
         fewer iterations per step and allows larger steps; default False).
+    check_intersections : bool
+        Check every stored state for panels passing through each other
+        (:func:`~holofold.mechanics.intersection.has_intersections`); the first that does
+        stops the fold at the last clean state (verdict ``folds until panels touch``).
+        Default True.
 
     Returns
     -------
@@ -438,6 +453,17 @@ def fold_pattern(
     fractions = np.array(fr)
     Uh = np.stack(Us)
     coords = _vertex_coords(base, structure, Uh)
+    touch_at, touch_where = float("nan"), (-1, -1)
+    hit = _first_intersecting(base, coords) if check_intersections else None
+    if hit is not None:  # the fold stops at the last clean state
+        k, touch_where = hit
+        touch_at = float(fractions[k])
+        keep = max(k, 1)
+        fractions, Uh, coords = fractions[:keep], Uh[:keep], coords[:keep]
+        clock = clock[:keep]
+        snaps = [x for x in snaps if x <= fractions[-1]]
+        done = float(fractions[-1])
+        stalled = ""
     angles = _fold_angles(base, structure, Uh)
     final_rest = rest(done)
     energy = model_energy(structure, Uh[-1], final_rest, n_edges=ne)
@@ -456,12 +482,21 @@ def fold_pattern(
     share = energy.panel_share if energy.total > 1e-9 * e_flat else 0.0
     bend = float(np.degrees(energy.panel_bend.max(initial=0.0)))
     strain = float(energy.panel_strain.max(initial=0.0))
+    touched = ""
+    if hit is not None:
+        a, b = touch_where
+        touched = (
+            f"panels {a} and {b} pass through each other at {100 * touch_at:.1f} %; the fold "
+            f"stops at the last clean state ({100 * done:.1f} %)"
+        )
     if stalled:
         verdict = "stalls"
         note = stalled
         status = Status.not_converged(f"fold stops at {100 * done:.1f} %: {stalled}")
     else:
         status = CONVERGED
+        if touched:
+            status = Status.not_converged(f"fold stops at {100 * done:.1f} %: {touched}")
         if wrong.size:
             verdict = "turns against its assignment"
             first = int(np.flatnonzero(against_path[went[0]])[0])
@@ -470,6 +505,11 @@ def fold_pattern(
                 f"assignment, the first at {100 * wrong_at:.1f} % (edge {first}): the fold "
                 "took another branch"
             )
+            if touched:
+                note += f"; then {touched}"
+        elif touched:
+            verdict = "folds until panels touch"
+            note = f"{touched}; panels bend at most {bend:.2f} deg, stretch at most {strain:.2g}"
         elif bend > RIGID_BEND_DEG or strain > RIGID_STRAIN:
             verdict = "does not fold rigidly"
             p = int(np.argmax(energy.panel_bend))
@@ -510,7 +550,23 @@ def fold_pattern(
         U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
         verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
         snaps=np.array(snaps), elapsed=np.array(clock), wrong_at=wrong_at,
+        touch_at=touch_at, touch_where=touch_where,
     )  # fmt: skip
+
+
+def _first_intersecting(pattern: CreasePattern, coords: np.ndarray):
+    """``(k, (face, face))``: the first stored state whose panels pass through each other and
+    two faces that do; None when every state is clean."""
+    from holofold.mechanics.intersection import has_intersections, intersecting_faces
+
+    # IPC Toolkit screens (fast); the numpy test confirms and locates: IPC Toolkit also flags
+    # flat states with coincident coplanar cut edges (kirigami), which do not cross
+    for k in range(len(coords)):
+        if has_intersections(coords[k], pattern.faces):
+            pairs = intersecting_faces(coords[k], pattern.faces)
+            if len(pairs):
+                return k, (int(pairs[0, 0]), int(pairs[0, 1]))
+    return None
 
 
 def _relax(asm, U, rest, tol, max_iter: int = 400):

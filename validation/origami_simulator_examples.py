@@ -42,12 +42,15 @@ def _files(root: Path) -> list[Path]:
     return sorted(p for p in assets.rglob("*") if p.suffix.lower() in (".svg", ".fold"))
 
 
-def run(root: Path, limit: float) -> list[dict]:
+def run(root: Path, limit: float, check: bool = True, only: str = "") -> list[dict]:
     rows = []
     for path in _files(root):
+        if only not in path.as_posix():
+            continue
         rel = path.relative_to(path.parents[1]).as_posix()
         row = {"file": rel, "imported": "", "panels": "", "reached": "", "verdict": "",
-               "t50": "", "t100": "", "note": ""}  # fmt: skip
+               "t50": "", "t100": "", "touch_at": "", "wrong_at": "", "intersecting": "",
+               "note": ""}  # fmt: skip
         t0 = time.perf_counter()
         try:
             with warnings.catch_warnings():
@@ -62,7 +65,7 @@ def run(root: Path, limit: float) -> list[dict]:
         p = scaled_pattern(p, SIZE / float(np.ptp(p.flat, axis=0).max()))
         row.update(imported="yes", panels=p.n_faces, read_s=round(t_read, 2))
         try:
-            r = fold_pattern(p, 1.0, time_limit=limit, **SECTION)
+            r = fold_pattern(p, 1.0, time_limit=limit, check_intersections=check, **SECTION)
         except (ValueError, RuntimeError, ArithmeticError) as exc:
             row.update(verdict="error", note=f"{type(exc).__name__}: {exc}")
             rows.append(row)
@@ -73,6 +76,10 @@ def run(root: Path, limit: float) -> list[dict]:
             verdict=r.verdict,
             t50=round(float(r.elapsed[k50[0]]), 1) if k50.size else "",
             t100=round(float(r.elapsed[-1]), 1) if r.complete else "",
+            touch_at=round(r.touch_at, 3) if np.isfinite(r.touch_at) else "",
+            wrong_at=round(r.wrong_at, 3) if np.isfinite(r.wrong_at) else "",
+            # checked independently of the fold's own check: the numpy test on every state
+            intersecting=_intersecting(p, r.coords),
             note=r.note,
         )
         rows.append(row)
@@ -80,13 +87,26 @@ def run(root: Path, limit: float) -> list[dict]:
     return rows
 
 
+def _intersecting(p, coords) -> str:
+    """'' when every stored state is clean, else the fraction index of the first that is not
+    (numpy test, independent of IPC Toolkit)."""
+    from holofold.mechanics.intersection import intersecting_faces
+
+    bad = [k for k in range(len(coords)) if len(intersecting_faces(coords[k], p.faces))]
+    return f"state {bad[0]} of {len(coords) - 1}" if bad else "no"
+
+
 def table(rows: list[dict]) -> str:
-    head = "| file | imported | panels | 50 % (s) | 100 % (s) | reached | verdict at the end |"
-    out = [head, "|---|---|---|---|---|---|---|"]
+    head = (
+        "| file | imported | panels | 50 % (s) | 100 % (s) | reached | verdict at the end | "
+        "touch at | wrong at | intersecting |"
+    )
+    out = [head, "|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         out.append(
             f"| {r['file']} | {r['imported']} | {r['panels']} | {r['t50'] or '-'} | "
-            f"{r['t100'] or '-'} | {r['reached']} | {r['verdict']} |"
+            f"{r['t100'] or '-'} | {r['reached']} | {r['verdict']} | {r['touch_at'] or '-'} | "
+            f"{r['wrong_at'] or '-'} | {r['intersecting'] or '-'} |"
         )
     return "\n".join(out)
 
@@ -110,6 +130,14 @@ def summary(rows: list[dict]) -> str:
     for r in imported:
         verdicts[r["verdict"]] = verdicts.get(r["verdict"], 0) + 1
     lines.append("verdicts: " + ", ".join(f"{k} {v}" for k, v in sorted(verdicts.items())))
+    crossed = [r for r in imported if str(r["intersecting"]).startswith("state")]
+    good = ("folds rigidly", "does not fold rigidly", "folds off target")
+    lines.append(
+        f"contact stops {sum(r['touch_at'] != '' for r in imported)}; wrong-way "
+        f"{sum(r['wrong_at'] != '' for r in imported)}; paths with an intersecting state "
+        f"{len(crossed)}, of them with a success verdict "
+        f"{sum(r['verdict'] in good for r in crossed)}"
+    )
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     lines.append(f"load average during the run (1 min, at the end): {load:.2f}")
     return "\n".join(lines)
@@ -120,8 +148,13 @@ def main(argv=None) -> int:
     ap.add_argument("root", type=Path, help="Origami Simulator checkout or its assets folder")
     ap.add_argument("--limit", type=float, default=300.0, help="seconds per fold (default 300)")
     ap.add_argument("--csv", type=Path, help="write the rows to this CSV file too")
+    ap.add_argument("--only", default="", help="only files whose path contains this")
+    ap.add_argument(
+        "--no-intersections", action="store_true",
+        help="fold without stopping where panels pass through each other (the old behaviour)",
+    )  # fmt: skip
     args = ap.parse_args(argv)
-    rows = run(args.root, args.limit)
+    rows = run(args.root, args.limit, not args.no_intersections, args.only)
     print(table(rows))
     print()
     print(summary(rows))
