@@ -32,6 +32,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "kernels": ["KERNEL_PATHS", "KernelPath", "KernelWarning", "check_environment"],
         "bars": ["bar_forces", "bar_strain"],
         "compat": ["Profile", "PAPER", "PHYSICAL"],
+        "contact": ["PanelContact", "contact_model", "has_ipctk"],
         "fold_check": [
             "FoldCheck",
             "check_fold",

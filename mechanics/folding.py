@@ -303,6 +303,7 @@ def fold_pattern(
     time_limit: float | None = None,
     extrapolate: bool = False,
     check_intersections: bool = True,
+    contact=None,
 ) -> FoldResult:
     """Fold ``pattern`` towards ``fraction`` x its target fold angles (see the module
     docstring).
@@ -345,6 +346,9 @@ def fold_pattern(
         (:func:`~holofold.mechanics.intersection.has_intersections`); the first that does
         stops the fold at the last clean state (verdict ``folds until panels touch``).
         Default True.
+    contact : bool or PanelContact, optional
+        Barrier contact between the thick panels with collision-free steps
+        (:mod:`~holofold.mechanics.contact`, needs ``holofold[contact]``); default off.
 
     Returns
     -------
@@ -395,6 +399,11 @@ def fold_pattern(
         return crease_rest_targets(structure, theta, profile=profile)
 
     asm = Assembler(structure)
+    # --- contact hook (issue 32 item 2) ---
+    from holofold.mechanics.contact import contact_model
+
+    panels = contact_model(contact, structure, asm, thickness=float(tp.max()) if contact else None)
+    # --- end contact hook ---
     nn = structure.n_nodes
     U = np.zeros((nn, 3))
     _, f_full = asm.internal_force(U, rest(max(fraction, 1e-3)))
@@ -424,8 +433,11 @@ def fold_pattern(
             structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
             max_iter=max_iter, U0=U0, assembler=asm,
         )  # fmt: skip
-        if res.ok and np.isfinite(res.U).all():
-            U = res.U.copy()
+        accepted = res.U if res.ok and np.isfinite(res.U).all() else None
+        if panels is not None:  # contact hook: keep the step collision free (issue 32 item 2)
+            accepted = panels.step(asm, U, accepted, rest(nxt), tol, max_iter)
+        if accepted is not None:
+            U = accepted.copy()
             done = nxt
             fr.append(done)
             Us.append(U.copy())
@@ -436,6 +448,8 @@ def fold_pattern(
             # no equilibrium near the last one: a limit point; the sheet snaps to another
             # equilibrium, found by minimising the energy (Levenberg-Marquardt)
             relaxed = _relax(asm, U, rest(nxt), tol)
+            if panels is not None and relaxed is not None:  # contact hook
+                relaxed = panels.step(asm, U, relaxed, rest(nxt), tol, max_iter)
             if relaxed is not None:
                 U = relaxed
                 done = nxt

@@ -1,0 +1,257 @@
+"""Barrier contact between thick panels, with collision-free steps (issue 32 item 2).
+
+:class:`PanelContact` wraps the IPC Toolkit (``ipctk``, MIT; optional extra
+``holofold[contact]``) over a model's panel triangles: a smooth log barrier between
+point-triangle and edge-edge pairs (Incremental Potential Contact), in its thickness-offset form
+for shells: the distance between mid-surfaces minus ``dmin`` = the panel thickness (two half
+thicknesses touch), activated below ``dhat`` = the panel thickness beyond that. Primitives that
+share a vertex are never paired (ipctk's CollisionMesh excludes them). Energy J, gradient (ndof,)
+N and sparse Hessian (ndof x ndof) N/m on the model's DOFs (3 per node, node-major, as in
+:class:`~holofold.mechanics.assembly.Assembler`).
+
+The barrier stiffness ``kappa`` (N/m, energy = kappa * b(d) with b in m^2) is the median of the
+diagonal of the model's own tangent at the flat state: the barrier at half its activation
+distance is about as stiff as one node of the sheet, so contact forces stop panels without
+dominating the elastic solve.
+
+:meth:`PanelContact.step` is the hook of :func:`~holofold.mechanics.folding.fold_pattern`: it
+keeps the contact-free Newton result unchanged when the straight path to it is collision free
+and no pair is active there (then contact costs one broad phase + CCD per step), otherwise it
+solves the step again with the barrier in the residual and tangent and every Newton update
+limited by continuous collision detection, so that no accepted state intersects.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from holofold.geometry.errors import EnvironmentFault, ParameterError
+
+__all__ = ["PanelContact", "contact_model", "has_ipctk", "intersects"]
+
+INSTALL = "panel contact needs the IPC Toolkit: pip install 'holofold[contact]' (ipctk)"
+CCD_SAFETY = 0.9  # fraction of the collision-free step taken
+
+
+def has_ipctk() -> bool:
+    """True where ``ipctk`` imports."""
+    try:
+        import ipctk  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _ipctk():
+    try:
+        import ipctk
+    except ImportError as exc:
+        raise EnvironmentFault(INSTALL) from exc
+    return ipctk
+
+
+class PanelContact:
+    """Barrier contact over ``structure.triangles`` (nodes of ``structure.nodes``).
+
+    Parameters
+    ----------
+    structure : Structure
+        Model with panel triangles (nt, 3) and ``tri_thickness`` (nt,) m.
+    thickness : float, optional
+        Panel thickness, m (default: the largest ``tri_thickness``): ``dmin`` and ``dhat``.
+    kappa : float, optional
+        Barrier stiffness, N/m (default: see the module docstring; needs ``stiffness``).
+    stiffness : float, optional
+        The model's stiffness scale, N/m (median tangent diagonal), for the default kappa.
+    """
+
+    def __init__(self, structure, thickness=None, kappa=None, stiffness=None):
+        ipc = _ipctk()
+        tri = structure.triangles
+        if tri is None or len(tri) == 0:
+            raise ParameterError("panel contact: the model has no panel triangles")
+        if thickness is None:
+            tt = structure.tri_thickness
+            if tt is None:
+                raise ParameterError("panel contact: give the panel thickness")
+            thickness = float(np.max(tt))
+        thickness = float(thickness)
+        if not thickness > 0 or not math.isfinite(thickness):
+            raise ParameterError(f"panel contact: thickness = {thickness!r}; allowed: > 0 m")
+        if kappa is None:
+            if stiffness is None or not stiffness > 0:
+                raise ParameterError("panel contact: give kappa > 0 or the model's stiffness")
+            kappa = float(stiffness)
+        self.ipc = ipc
+        self.X0 = np.asfortranarray(structure.nodes, dtype=float)
+        faces = np.asfortranarray(tri, dtype=np.int32)
+        edges = np.asfortranarray(ipc.edges(faces), dtype=np.int32)
+        self.mesh = ipc.CollisionMesh(self.X0, edges, faces)
+        self.dmin = thickness
+        self.dhat = thickness
+        self.kappa = float(kappa)
+        self.barrier = ipc.BarrierPotential(self.dhat, self.kappa)
+        self.n_dof = self.X0.size
+        self.last_active = 0
+        self.newton_steps = 0
+        X = self.X0
+        if ipc.has_intersections(self.mesh, X):
+            raise ParameterError("panel contact: the panels intersect in the starting state")
+        c = self._collisions(X)
+        if len(c) and not np.isfinite(self.barrier(c, self.mesh, X)):
+            raise ParameterError(
+                f"panel contact: panels closer than the thickness {thickness:g} m at the start"
+            )
+
+    # ----------------------------------------------------------------- evaluation
+    def _pos(self, U) -> np.ndarray:
+        return np.asfortranarray(self.X0 + np.asarray(U, float).reshape(-1, 3))
+
+    def _collisions(self, X):
+        c = self.ipc.NormalCollisions()
+        c.build(self.mesh, X, self.dhat, self.dmin)
+        return c
+
+    def energy(self, U) -> float:
+        """Barrier energy at displacement ``U`` ((nn, 3) or (ndof,), m), J (inf if touching)."""
+        X = self._pos(U)
+        c = self._collisions(X)
+        return float(self.barrier(c, self.mesh, X)) if len(c) else 0.0
+
+    def gradient(self, U) -> np.ndarray:
+        """Barrier gradient (ndof,), N."""
+        X = self._pos(U)
+        c = self._collisions(X)
+        if not len(c):
+            return np.zeros(self.n_dof)
+        return np.asarray(self.barrier.gradient(c, self.mesh, X)).ravel()
+
+    def hessian(self, U):
+        """Barrier Hessian (csc ndof x ndof), N/m."""
+        import scipy.sparse as sp
+
+        X = self._pos(U)
+        c = self._collisions(X)
+        if not len(c):
+            return sp.csc_matrix((self.n_dof, self.n_dof))
+        return self.barrier.hessian(c, self.mesh, X)
+
+    def evaluate(self, U, psd: bool = True):
+        """(energy J, gradient (ndof,) N, Hessian csc N/m, active pairs); the Hessian projected
+        to positive semi-definite per pair when ``psd`` (for Newton)."""
+        import scipy.sparse as sp
+
+        X = self._pos(U)
+        c = self._collisions(X)
+        n = len(c)
+        if not n:
+            return 0.0, np.zeros(self.n_dof), sp.csc_matrix((self.n_dof, self.n_dof)), 0
+        proj = self.ipc.PSDProjectionMethod.CLAMP if psd else self.ipc.PSDProjectionMethod.NONE
+        E = float(self.barrier(c, self.mesh, X))
+        g = np.asarray(self.barrier.gradient(c, self.mesh, X)).ravel()
+        H = self.barrier.hessian(c, self.mesh, X, proj)
+        return E, g, H, n
+
+    def active(self, U) -> int:
+        """Number of pairs closer than ``dmin + dhat``."""
+        return len(self._collisions(self._pos(U)))
+
+    def free_step(self, U0, U1) -> float:
+        """Largest fraction in [0, 1] of the straight path ``U0 -> U1`` on which no two
+        primitives come closer than ``dmin`` (CCD)."""
+        return float(
+            self.ipc.compute_collision_free_stepsize(
+                self.mesh, self._pos(U0), self._pos(U1), self.dmin
+            )
+        )
+
+    def intersects(self, U) -> bool:
+        """True if the mid-surfaces intersect at ``U`` (ipctk ``has_intersections``)."""
+        return bool(self.ipc.has_intersections(self.mesh, self._pos(U)))
+
+    # ----------------------------------------------------------------- the Newton hook
+    def step(self, asm, U_prev, U_trial, rest, tol, max_iter: int = 30):
+        """The accepted state of one fold step: ``U_trial`` (the contact-free equilibrium, or
+        None) itself if the path ``U_prev -> U_trial`` is collision free and no pair is active
+        at ``U_trial``; else the equilibrium with the barrier from ``U_prev`` (Newton with
+        CCD-limited, energy-decreasing updates), or None if that does not reach ``tol``."""
+        if U_trial is not None and np.isfinite(U_trial).all():
+            if self.free_step(U_prev, U_trial) >= 1.0 and self.active(U_trial) == 0:
+                self.last_active = 0
+                return U_trial
+        return self._solve(asm, np.asarray(U_prev, float).reshape(-1, 3), rest, tol, max_iter)
+
+    def _solve(self, asm, U, rest, tol, max_iter):
+        from scipy.sparse.linalg import splu
+
+        free = asm.free_dofs
+        U = U.ravel().copy()
+
+        def total(Uv):
+            b = self.energy(Uv)
+            return asm.internal_force(Uv, rest)[0] + b if math.isfinite(b) else math.inf
+
+        for _ in range(max(4 * max_iter, 60)):
+            e, f, K = asm.evaluate_reduced(U, rest, dense=False)
+            eb, gb, Hb, n = self.evaluate(U)
+            self.last_active = n
+            r = -(f + gb)[free]
+            if math.sqrt(r @ r) <= tol:
+                return U.reshape(-1, 3)
+            A = (K + Hb[free][:, free]).tocsc()
+            try:
+                d = splu(A).solve(r)
+            except RuntimeError:
+                return None
+            if not np.isfinite(d).all():
+                return None
+            self.newton_steps += 1
+            trial = U.copy()
+            trial[free] += d
+            alpha = min(1.0, self.free_step(U, trial))
+            if alpha < 1.0:
+                alpha *= CCD_SAFETY
+            E0 = e + eb
+            slope = -float(r @ d)
+            while alpha > 1e-12:
+                cand = U.copy()
+                cand[free] += alpha * d
+                Ec = total(cand)
+                if Ec <= E0 + 1e-4 * alpha * slope or (
+                    alpha == 1.0 and abs(Ec - E0) <= 1e-12 * abs(E0)
+                ):
+                    break
+                alpha *= 0.5
+            else:
+                return None
+            U = cand
+        return None
+
+
+def contact_model(contact, structure, asm=None, thickness=None):
+    """The :class:`PanelContact` of ``fold_pattern(contact=...)``: None for None/False, the
+    given one, or (True) one built with kappa from ``asm``'s tangent at the flat state."""
+    if contact is None or contact is False:
+        return None
+    if isinstance(contact, PanelContact):
+        return contact
+    if contact is not True:
+        raise ParameterError(f"contact = {contact!r}; allowed: None, False, True, PanelContact")
+    _ipctk()
+    stiffness = None
+    if asm is not None:
+        K = asm.evaluate_reduced(np.zeros(asm.n_dof), dense=False)[2]
+        diag = np.abs(K.diagonal())
+        stiffness = float(np.median(diag[diag > 0])) if (diag > 0).any() else 1.0
+    return PanelContact(structure, thickness=thickness, stiffness=stiffness)
+
+
+def intersects(structure, U) -> bool:
+    """True if the panel triangles of ``structure`` displaced by ``U`` intersect (ipctk)."""
+    ipc = _ipctk()
+    X = np.asfortranarray(structure.nodes + np.asarray(U, float).reshape(-1, 3))
+    faces = np.asfortranarray(structure.triangles, dtype=np.int32)
+    mesh = ipc.CollisionMesh(X, np.asfortranarray(ipc.edges(faces), dtype=np.int32), faces)
+    return bool(ipc.has_intersections(mesh, X))

@@ -1,0 +1,96 @@
+"""Barrier contact between thick panels (mechanics/contact.py, issue 32 item 2)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from holofold.geometry import CreasePattern, miura_sheet
+from holofold.mechanics import fold_pattern
+
+pytest.importorskip("ipctk", reason="ipctk not installed: pip install 'holofold[contact]'")
+
+from holofold.mechanics.contact import PanelContact, intersects  # noqa: E402
+
+SECTION = dict(panel_thickness=1e-3, crease_thickness=0.3e-3, crease_width=1e-3)
+
+
+class _Two:
+    """Two parallel unit-ish triangles pairs (two square panels) 1.5 mm apart in z."""
+
+    def __init__(self, gap=1.5e-3):
+        sq = np.array([[0, 0, 0], [0.01, 0, 0], [0.01, 0.01, 0], [0, 0.01, 0]], float)
+        self.nodes = np.vstack([sq, sq + [0.002, 0.003, gap]])
+        self.triangles = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
+        self.tri_thickness = np.full(4, 1e-3)
+
+
+def test_barrier_gradient_and_hessian_match_finite_differences():
+    s = _Two()
+    pc = PanelContact(s, kappa=1e3)
+    rng = np.random.default_rng(1)
+    U = rng.normal(scale=1e-5, size=s.nodes.shape)
+    assert pc.active(U) > 0 and 0 < pc.energy(U) < math.inf
+    g, H = pc.gradient(U), pc.hessian(U).toarray()
+    h = 1e-9
+    gf = np.empty(U.size)
+    Hf = np.empty((U.size, U.size))
+    for i in range(U.size):
+        e = np.zeros(U.size)
+        e[i] = h
+        gf[i] = (pc.energy(U.ravel() + e) - pc.energy(U.ravel() - e)) / (2 * h)
+        Hf[:, i] = (pc.gradient(U.ravel() + e) - pc.gradient(U.ravel() - e)) / (2 * h)
+    assert np.abs(g - gf).max() <= 1e-6 * np.abs(g).max()
+    assert np.abs(H - Hf).max() <= 1e-6 * np.abs(H).max()
+
+
+def test_parallel_panels_pushed_together_stop_at_a_gap():
+    s = _Two()
+    pc = PanelContact(s, kappa=1e3)
+    U1 = np.zeros_like(s.nodes)
+    U1[4:, 2] = -3e-3  # straight through the lower panel
+    a = pc.free_step(np.zeros_like(U1), U1)
+    assert 0 < a < 1
+    X = s.nodes + 0.9 * a * U1
+    gap = X[4:, 2].min() - X[:4, 2].max()
+    assert gap > pc.dmin  # stops before the mid-surfaces come closer than the thickness
+    assert not pc.intersects(0.9 * a * U1)
+
+
+def _z_fold():
+    """Two outer panels (0.7 w wide) folding valley 175 deg onto a middle panel (w): their
+    edges meet at about 133 deg and pass through each other without contact."""
+    w = 0.03
+    xs = np.array([-0.7, 0, 1, 1.7]) * w
+    flat = np.array([[x, y] for y in (0, 0.02) for x in xs])
+    faces = [[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6]]
+    p = CreasePattern.from_faces(np.c_[flat, np.zeros(len(flat))], faces, flat=flat)
+    asg = np.where(p.interior, "V", "B")
+    ang = np.where(p.interior, 175.0, 0.0)
+    return CreasePattern(p.coords, p.faces, p.edges, asg, ang, flat=flat)
+
+
+def test_self_intersecting_fold_is_kept_clean_by_contact():
+    p = _z_fold()
+    # without contact and without the intersection check the fold passes through itself
+    off = fold_pattern(p, 1.0, check_intersections=False, **SECTION)
+    assert off.complete and intersects(off.structure, off.U[-1])
+    # the check alone stops it at the last clean state, about where contact holds it
+    checked = fold_pattern(p, 1.0, **SECTION)
+    assert checked.verdict == "folds until panels touch"
+    assert 0.7 < checked.touch_at < 0.85
+    on = fold_pattern(p, 1.0, contact=True, time_limit=4.0, **SECTION)
+    assert not any(intersects(on.structure, U) for U in on.U)
+    assert on.reached < 0.95  # the outer panels stop where they touch (about 76 %)
+    assert on.fold_angles[-1][p.interior] == pytest.approx([133.0, 133.0], abs=3.0)
+
+
+def test_contact_without_active_pairs_changes_nothing():
+    folded = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.6)
+    off = fold_pattern(folded, 1.0, **SECTION)
+    on = fold_pattern(folded, 1.0, contact=True, **SECTION)
+    assert on.verdict == off.verdict
+    scale = np.abs(off.U[-1]).max()
+    assert np.abs(on.U[-1] - off.U[-1]).max() <= 1e-9 * scale
