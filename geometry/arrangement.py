@@ -186,7 +186,9 @@ def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None)
     n_short = int((L > 1e-9 * tol / REL_TOL).sum() - (~short).sum())  # zero-length ones: silent
     if n_short:
         notes.append(f"{n_short} line(s) shorter than the merge tolerance {tol:.3g} dropped")
-        S, asg, ang = S[~short], asg[~short], ang[~short]
+    # zero-length lines (a point drawn as a line) are dropped too, without a note: before, they
+    # stayed when no other line was short and divided by their zero length in _splits
+    S, asg, ang = S[~short], asg[~short], ang[~short]
     if not len(S):
         raise FormatError("no lines longer than the merge tolerance")
     P, Q = S[:, 0], S[:, 1]

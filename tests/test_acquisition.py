@@ -25,7 +25,7 @@ def test_likely_designs_go_where_the_target_is():
     sc = _toy()
     X = sample_designs(sc, 600, seed=0)[["a", "b", "c"]]
     hit = (X["a"] > 0.85) & (X["b"] > 0.85)  # 2 % of the space
-    m = ForestRuleMiner(n_estimators=30, random_state=0).fit(X, hit)
+    m = ForestRuleMiner(n_estimators=30, n_rules=1, random_state=0).fit(X, hit)
     new = likely_designs(sc, m, 100, seed=1, start=5000, candidates=5000)
     assert len(new) == 100 and new["sample"].tolist() == list(range(5000, 5100))
     inside = ((new["a"] > 0.85) & (new["b"] > 0.85)).mean()

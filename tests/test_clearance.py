@@ -1,6 +1,7 @@
 """Overlap volume and clearance of folded thick panels, against exact numbers and manifold3d."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -9,7 +10,7 @@ from holofold.fitting import fit_strip
 from holofold.geometry import miura_sheet, panel_clearance, panel_overlap, printability
 from holofold.geometry.clearance import _triangle_distance
 from holofold.geometry.pattern import CreasePattern
-from holofold.geometry.solid import thick_solid
+from holofold.geometry.solid import SolidWarning, thick_solid
 
 
 def _two_squares(gap: float, shift: float = 0.0) -> CreasePattern:
@@ -43,8 +44,13 @@ def test_two_panels_at_a_crease_overlap_like_manifold_says():
     p = CreasePattern.from_faces(coords, [[0, 2, 3, 1], [0, 1, 5, 4]])
     for t, w in ((1e-3, 0.0), (1e-3, 0.5e-3), (0.5e-3, 2e-3)):
         parts = thick_solid(p, t, w, union=False)
-        exact = sum(s.volume for s in parts) - thick_solid(p, t, w).volume
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            exact = sum(s.volume for s in parts) - thick_solid(p, t, w).volume
         assert panel_overlap(p, t, w) == pytest.approx(max(exact, 0.0), rel=1e-4, abs=1e-15)
+        # the union says so exactly when the panels overlap
+        warned = [x for x in said if issubclass(x.category, SolidWarning)]
+        assert len(warned) == (1 if exact > 1e-15 else 0), (t, w, exact)
     assert panel_overlap(p, 0.5e-3, 2e-3) == 0.0
     assert panel_clearance(p, 1e-3) == math.inf  # the two share vertices: no pair to measure
 

@@ -340,7 +340,7 @@ def test_the_rule_box_chart_shows_the_rules_thresholds():
     rng = np.random.default_rng(0)
     X = pd.DataFrame({"a": rng.uniform(0, 1, 400), "b": rng.uniform(0, 1, 400)})
     y = (X["a"] > 0.6).to_numpy()
-    miner = ForestRuleMiner(n_estimators=20, random_state=0).fit(X, y)
+    miner = ForestRuleMiner(n_estimators=20, n_rules=1, random_state=0).fit(X, y)
     mm = {n: Column(n, "m", display="mm") for n in "ab"}
     fig = plot_rule_boxes(miner, X, 0, columns=mm)
     texts = [t.get_text() for t in fig.axes[0].texts]

@@ -59,7 +59,7 @@ def _table(n=400, seed=0):
 
 def test_failed_rows_are_left_out_and_features_must_be_named():
     df = _table()
-    mined = mine_rules(df, "y > 0.8", features=["a", "b"], n_estimators=20)
+    mined = mine_rules(df, "y > 0.8", features=["a", "b"], n_estimators=20, n_rules=1)
     assert mined.n_failed == 10 and len(mined.table) == 390
     with pytest.raises(ValueError, match="list them with --features"):
         mine_rules(df, "y > 0.8")

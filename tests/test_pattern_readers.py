@@ -426,3 +426,16 @@ def test_svg_width_in_an_unknown_unit_is_refused(tmp_path, width):
                  size=f'width="{good}" height="{good}" viewBox="0 0 100 100"')  # fmt: skip
         p = read_pattern(g)
         assert np.ptp(p.flat[:, 0]) * 1e3 == pytest.approx(mm, rel=1e-6), good
+
+
+def test_a_zero_length_line_is_dropped_without_a_division_by_zero():
+    """A point drawn as a line (Origami Simulator's russianTriangle.svg has one) stayed in the
+    arrangement when no other line was short and divided by its zero length (RuntimeWarning)."""
+    from holofold.geometry.arrangement import arrange_lines
+
+    square = [[[0, 0], [1, 0]], [[1, 0], [1, 1]], [[1, 1], [0, 1]], [[0, 1], [0, 0]]]
+    segs = np.array([*square, [[0, 0], [1, 1]], [[0.5, 0.5], [0.5, 0.5]]], float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        arr = arrange_lines(segs, ["B"] * 4 + ["V", "M"], [0, 0, 0, 0, 90, -90])
+    assert len(arr.faces) == 2 and len(arr.edges) == 5 and not arr.notes

@@ -540,7 +540,7 @@ def _real_pictures(folder):
     )
     X = table[["offset", "m"]]
     y = parse_target("offset < 0.2 & m >= 12", X.columns).evaluate(X)
-    miner = ForestRuleMiner(n_estimators=10, min_support=5, random_state=0)
+    miner = ForestRuleMiner(n_estimators=10, min_support=5, n_rules=1, random_state=0)
     miner.fit(X, y)
     offset = {"offset": Column("offset", "m", display="m")}
     save_figure(plot_rule_boxes(miner, X, 0, columns=offset), folder / "rule.png")
