@@ -7,6 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
+from holofold.fitting import CurveSelectionWarning
 from holofold.fitting.curve_files import CurveUnitWarning, read_points_csv, read_svg_curve
 from holofold.fitting.curves import (
     CurveError,
@@ -124,7 +125,10 @@ def test_svg(tmp_path):
     # y down in SVG -> z up: the arc bulges to +z; origin at the first point
     np.testing.assert_allclose(p, [[0, 0], [100, 100], [200, 0]], atol=1e-3)
     np.testing.assert_allclose(half.length, np.pi * 100, rtol=1e-6)
-    arch = load_curve(str(f))  # first path
+    with pytest.warns(
+        CurveSelectionWarning, match=r"has 2 paths \(ids arch, half\); read the first"
+    ):
+        arch = load_curve(str(f))  # first path
     np.testing.assert_allclose(arch(np.array([0.5])), [[200.0, 150.0]], atol=1e-2)
     assert arch.scaled(0.01).length == pytest.approx(arch.length * 0.01, rel=1e-12)
     direct = PlanarCurve.from_svg_path("M 0 0 L 3 -4")

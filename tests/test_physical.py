@@ -17,7 +17,8 @@ def _miura():
 
 def test_scaled_down_pattern_refused_before_folding():
     small = scaled_pattern(_miura(), 0.03)  # panels ~0.6 mm, default 1 mm crease width
-    with pytest.raises(ParameterError, match="mm"):
+    # 2.6 mm across: warned as an unlikely size, then refused (1 mm creases on 0.6 mm panels)
+    with pytest.raises(ParameterError, match="mm"), pytest.warns(SheetWarning, match="2.598 mm"):
         simulate_pattern(small, PatternSetting())
 
 
