@@ -1,7 +1,9 @@
 """Bounded, validating crease-pattern readers (issue 33 items 3 and 4)."""
 
 import time
+import warnings
 
+import numpy as np
 import pytest
 
 from holofold.geometry import read_pattern
@@ -163,3 +165,49 @@ def test_outputs_bytes_equal_across_processes():
     sizes = [int(h.split(":")[0]) for h in runs[0]]
     assert len(sizes) == 7 and min(sizes) > 1000, sizes
     assert runs[1] == runs[0] and runs[2] == runs[0]
+
+
+def test_fold_crease_across_faces_is_refused(tmp_path):
+    """A mountain drawn across faces with no vertex at the crossings was ignored (a side of no
+    face, so no hinge) and the pattern 'folded rigidly'; now refused with one line."""
+    import json
+    import math
+
+    import holofold.geometry as g
+
+    p = g.miura_sheet(2, 2, a=0.02, b=0.025, gamma=math.radians(60), ext=1.0)
+    d = json.loads(g.export(p, tmp_path / "clean.fold").read_text())
+    n = len(d["vertices_coords"])
+    (x0, y0), (x1, y1) = np.min(p.flat, axis=0), np.max(p.flat, axis=0)
+    dim = len(d["vertices_coords"][0])
+    ends = [[x0 + 1e-3, 0.51 * (y0 + y1), 0.0], [x1 - 1e-3, 0.49 * (y0 + y1), 0.0]]
+    d["vertices_coords"] += [v[:dim] for v in ends]
+    for key in [k for k in d if k.startswith("edges_")]:
+        d[key].append([n, n + 1] if key == "edges_vertices" else d[key][-1])
+    d["edges_assignment"][-1] = "M"
+    (tmp_path / "cross.fold").write_text(json.dumps(d))
+    assert g.read_pattern(tmp_path / "clean.fold").n_edges == len(d["edges_vertices"]) - 1
+    last = len(d["edges_vertices"]) - 1
+    with pytest.raises(FormatError, match=rf"1 crease\(s\) \(edge {last}, M\) on no face side"):
+        g.read_pattern(tmp_path / "cross.fold")
+
+
+def test_obj_cut_at_a_line_end_is_said(tmp_path):
+    """An OBJ cut at 90 % at a line end is a valid OBJ with fewer faces; the vertices left in
+    no triangle are said (it was fitted without a word)."""
+    import trimesh
+
+    from holofold.geometry.mesh_reader import MeshWarning, read_mesh
+
+    m = trimesh.creation.icosphere(3, radius=50.0)
+    data = trimesh.exchange.obj.export_obj(m).encode()
+    (tmp_path / "whole.obj").write_bytes(data)
+    k = data.rfind(b"\n", 0, int(0.9 * len(data))) + 1
+    (tmp_path / "cut.obj").write_bytes(data[:k])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        V, F = read_mesh(tmp_path / "whole.obj")
+    assert (len(V), len(F)) == (642, 1280)
+    with pytest.warns(MeshWarning, match=r"'cut.obj': \d+ of 642 vertices are in no triangle"):
+        V, F = read_mesh(tmp_path / "cut.obj")
+    assert 0 < len(F) < 1280
