@@ -211,3 +211,19 @@ def test_obj_cut_at_a_line_end_is_said(tmp_path):
     with pytest.warns(MeshWarning, match=r"'cut.obj': \d+ of 642 vertices are in no triangle"):
         V, F = read_mesh(tmp_path / "cut.obj")
     assert 0 < len(F) < 1280
+
+
+@pytest.mark.parametrize("t", [1e-6, 1e-9])
+def test_kept_fraction_of_thin_slabs_is_at_most_one(t):
+    """Bevels only remove material: a 1 nm slab said '110 % of the slabs kept'. The loss is
+    proportional to t (a bevel removes t^2 per crease length), so a thin slab keeps ~100 %."""
+    import math
+
+    import holofold.geometry as g
+    from holofold.geometry.thick import thick_panels
+
+    p = g.miura_sheet(4, 4, a=0.02139, b=0.025, gamma=math.radians(60), ext=0.7)
+    kept = thick_panels(p, t, 0.0, "tapered").kept
+    loss_1mm = 1.0 - thick_panels(p, 1e-3, 0.0, "tapered").kept
+    assert 0.02 < loss_1mm < 0.04
+    assert 1.0 - 2 * loss_1mm * t / 1e-3 <= kept <= 1.0
