@@ -227,3 +227,23 @@ def test_kept_fraction_of_thin_slabs_is_at_most_one(t):
     loss_1mm = 1.0 - thick_panels(p, 1e-3, 0.0, "tapered").kept
     assert 0.02 < loss_1mm < 0.04
     assert 1.0 - 2 * loss_1mm * t / 1e-3 <= kept <= 1.0
+
+
+def test_full_disk_names_the_file(tmp_path):
+    """A write that fails on a full disk (ENOSPC on the open file) names the file it was
+    writing, and leaves neither it nor a temporary file behind."""
+    import errno
+    import os
+
+    from holofold.geometry.outputs import atomic_write
+
+    def full(tmp):
+        with open(tmp, "w") as fh:
+            fh.write("x")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    target = tmp_path / "pattern.svg"
+    with pytest.raises(OSError, match=r"cannot write .*pattern\.svg: No space left") as err:
+        atomic_write(target, full)
+    assert err.value.errno == errno.ENOSPC and "\n" not in str(err.value)
+    assert list(tmp_path.iterdir()) == []
