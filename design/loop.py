@@ -858,6 +858,10 @@ def _say_chosen(say, summary: DesignSummary, tgt, out: Path, columns: Mapping) -
     feats = ", ".join(f"{k} = {_shown(columns, k, v)}" for k, v in c.features.items())
     perf = ", ".join(f"{k} = {_shown(columns, k, c.performance.get(k))}" for k in tgt.columns)
     state = "meets the target" if c.meets else "does NOT meet the target (nearest)"
+    fab = summary.fabrication
+    if c.meets and fab is not None and not (fab.film or fab.fits or fab.pieces):
+        # the part line below says why; a bare 'meets the target' contradicted it
+        state += f", but its part cannot be printed on the {fab.bed_text} bed"
     say(
         f"chosen: {feats}\n  {perf}; {state}; worst margin {c.worst_margin:.3g}; answer "
         f"{summary.answer!r}; rule verified precision {_fmt(vp)}{below}; files in {out}/"

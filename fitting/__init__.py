@@ -43,6 +43,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "MAX_SVG_NESTING",
             "MAX_SVG_ELEMENTS",
             "MAX_SVG_POINTS",
+            "MAX_CSV_POINTS",
             "PLAUSIBLE_SIZE",
             "check_curve_size",
             "read_points_csv",

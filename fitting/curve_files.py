@@ -40,6 +40,7 @@ __all__ = [
     "MAX_SVG_NESTING",
     "MAX_SVG_ELEMENTS",
     "MAX_SVG_POINTS",
+    "MAX_CSV_POINTS",
     "PLAUSIBLE_SIZE",
     "check_curve_size",
     "read_points_csv",
@@ -67,6 +68,9 @@ MAX_SVG_ELEMENTS = 20_000
 #: the most path points (coordinate pairs of ``d`` and ``points``) after expansion:
 #: svgelements takes about 40 us per segment (100,000 in one path: 4 s)
 MAX_SVG_POINTS = 200_000
+#: the most rows of a points file (CSV/TXT), its size at most MAX_SVG_BYTES: the rows are parsed
+#: at about 4 us each, so a 2,000,000-row file took over 10 s before it was counted
+MAX_CSV_POINTS = 200_000
 
 
 class CurveUnitWarning(UserWarning):
@@ -123,6 +127,11 @@ def read_points_csv(
     k = length_factor(units)
     path = _checked_input(path, "points file")
     try:
+        size = path.stat().st_size
+        if size > MAX_SVG_BYTES:
+            raise CurveFormatError(
+                f"points file {str(path)!r}: {size} bytes; at most {MAX_SVG_BYTES} are read"
+            )
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise CurveFormatError(f"points file {str(path)!r} is not a UTF-8 text file") from None
@@ -132,6 +141,11 @@ def read_points_csv(
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise CurveFormatError(f"points file {str(path)!r} is empty")
+    if len(lines) > MAX_CSV_POINTS + 1:
+        raise CurveFormatError(
+            f"points file {str(path)!r} has {len(lines):,} rows; at most {MAX_CSV_POINTS:,} "
+            "points are read (docs/limits.md)"
+        )
     try:
         delim = csv.Sniffer().sniff(lines[0], delimiters=",;\t ").delimiter
     except csv.Error:

@@ -21,7 +21,13 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "arrangement": ["Arrangement", "arrange_lines"],
         "cuts": ["separate_cuts"],
         "physical": ["check_sheet", "sheet_mass", "SheetWarning", "SHEET_EXTENT"],
-        "mesh_reader": ["read_mesh", "mesh_difference", "MESH_TYPES", "MAX_MESH_FACES"],
+        "mesh_reader": [
+            "read_mesh",
+            "mesh_difference",
+            "MeshWarning",
+            "MESH_TYPES",
+            "MAX_MESH_FACES",
+        ],
         "export": ["export", "EXPORT_TYPES", "Format", "FORMATS", "register_format"],
         "fabrication": [
             "FabricationFile",

@@ -11,8 +11,9 @@ stroke width. Creases are drawn as the cutter profile says
 ``origami-simulator`` profile (a reader rebuilds the crease graph from them), dashes with gaps
 at the vertices with ``laser``. Every ``LINE`` carries no text; the fold angle of a crease is
 not in a DXF (use the FOLD file). The header's dates and GUIDs are fixed (ezdxf's
-``write_fixed_meta_data_for_testing``, set only while writing), so a design always gives the same
-bytes.
+``write_fixed_meta_data_for_testing``, set only while writing) and its CLASS entries are
+registered in sorted order (ezdxf takes them from a ``set``), so a design always gives the same
+bytes, in every process.
 """
 
 from __future__ import annotations
@@ -111,6 +112,20 @@ def _dxf_text(ezdxf, prof: CutterProfile, draw) -> str:
     for c in draw.holes:
         pts = hole_points(c, draw.hole_radius) * flip + shift
         msp.add_lwpolyline(pts[:-1].tolist(), close=True, dxfattribs={"layer": "REGISTRATION"})
+    _fix_class_order(doc)
     stream = io.StringIO()
     doc.write(stream)
     return stream.getvalue()
+
+
+def _fix_class_order(doc) -> None:
+    """Register the CLASS entries of the entity types in use in sorted order.
+
+    ``Drawing.write`` adds them in the order of a ``set`` of type names, which follows the
+    string hash of the process (``PYTHONHASHSEED``): ``LAYOUT`` and ``ACDBPLACEHOLDER`` swapped
+    in about 1 process in 4. Classes already registered keep their place, so the CLASSES
+    section, and the file, is the same in every process.
+    """
+    doc.commit_pending_changes()
+    for dxftype in sorted(doc.entitydb.dxf_types_in_use()):
+        doc.classes.add_class(dxftype)

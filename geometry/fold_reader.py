@@ -199,12 +199,33 @@ def read_fold_pattern(path, *, frame: int | None = None, unit: float | None = No
         for n in notes:
             warnings.warn(f"{name}: {n}", PatternWarning, stacklevel=2)
         return pattern  # a 3-D pattern only: cuts and splits need a flat layout
+    _check_creases_on_faces(pattern, where)
     coords3 = pattern.coords if folded is not None else None
     return finish_pattern(
         pattern.flat, pattern.faces, pattern.edges, pattern.assignment, pattern.fold_angle,
         name=name, notes=notes, split=split, meta={**pattern.meta, "kind": "fold", "source": name},
         coords3=coords3,
     )  # fmt: skip
+
+
+def _check_creases_on_faces(pattern, where: str) -> None:
+    """Refuse a mountain or valley that is a side of no face: the model folds only face sides,
+    so a crease drawn across faces with no vertex at the crossings (or dangling) was ignored
+    and the pattern 'folded rigidly' without it."""
+    sides = set()
+    for f in pattern.faces:
+        f = [int(v) for v in f]
+        sides.update(frozenset(e) for e in zip(f, f[1:] + f[:1], strict=True))
+    loose = [
+        i for i, (e, a) in enumerate(zip(pattern.edges, pattern.assignment, strict=True))
+        if a in ("M", "V") and frozenset(int(v) for v in e) not in sides
+    ]  # fmt: skip
+    if loose:
+        raise FormatError(
+            f"{where}: {len(loose)} crease(s) (edge {loose[0]}, "
+            f"{pattern.assignment[loose[0]]}) on no face side: a crease crossing faces needs "
+            "vertices at the crossings, with the faces split there"
+        )
 
 
 def _planar(fr: dict):

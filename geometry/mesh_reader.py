@@ -13,6 +13,7 @@ polygons fanned).
 from __future__ import annotations
 
 import struct
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +27,13 @@ __all__ = [
     "MAX_MESH_COORD",
     "read_mesh",
     "mesh_difference",
+    "MeshWarning",
 ]
+
+
+class MeshWarning(UserWarning):
+    """A mesh file read whole that looks incomplete (vertices that are in no triangle)."""
+
 
 #: file types read
 MESH_TYPES = ("stl", "obj", "ply", "off")
@@ -140,7 +147,15 @@ def _checked(V, F, name, max_faces):
             f"{name!r}: triangle {j + 1} refers to a vertex that does not exist "
             f"(the file has {len(V)} vertices)"
         )
-    used = V[np.unique(F)]
+    ids = np.unique(F)
+    if len(ids) < len(V):
+        warnings.warn(
+            f"{name!r}: {len(V) - len(ids)} of {len(V)} vertices are in no triangle: is the "
+            "file cut short? (only its triangles are used)",
+            MeshWarning,
+            stacklevel=3,
+        )
+    used = V[ids]
     centred = used - used.mean(axis=0)
     s = np.linalg.svd(centred, compute_uv=False) if len(used) >= 2 else np.zeros(3)
     if not (s[0] > 0 and s[1] > 1e-9 * s[0]):

@@ -41,8 +41,10 @@ def _value(obj, prop: str, kind: type, default):
     for v in obj.iter("void"):
         if v.get("property") == prop:
             child = next(iter(v), None)
-            if child is None or child.text is None:
+            if child is None:
                 return default
+            if child.text is None or not child.text.strip():
+                raise FormatError(f"property {prop} is empty")
             try:
                 return kind(child.text.strip())
             except ValueError:

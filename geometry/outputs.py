@@ -106,6 +106,12 @@ def atomic_write(path, write: Callable[[str], None]) -> Path:
         fault_point("write")  # test-only (HOLOFOLD_TEST_FAULT); nothing when unset
         os.replace(tmp, path)
         fault_point("written")
+    except OSError as exc:  # a full disk named no path (the write fails on an open file)
+        Path(tmp).unlink(missing_ok=True)
+        if exc.filename is not None and str(path) in str(exc):
+            raise
+        why = exc.strerror or type(exc).__name__
+        raise OSError(exc.errno, f"cannot write {path}: {why}") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -24,6 +24,7 @@ crossing lines and finds the faces.
 
 from __future__ import annotations
 
+import math
 import os
 from collections import Counter
 from pathlib import Path
@@ -92,8 +93,17 @@ def _metres_per_px(svg, name: str = "the SVG") -> float:
     import re
 
     width = str(svg.values.get("width", "")).strip()
-    m = re.fullmatch(r"[-+0-9.eE]+\s*([a-zA-Z%]*)", width)
-    unit = m.group(1) if m else ""
+    m = re.fullmatch(r"([-+0-9.eE]+)\s*([a-zA-Z%]*)", width)
+    unit = m.group(2) if m else ""
+    if m and not 0 < _float_or_nan(m.group(1)) < math.inf:
+        raise FormatError(f"{name}: width {width!r} is not a length > 0")
+    box = svg.values.get("viewBox")
+    if box is not None:
+        vb = [_float_or_nan(v) for v in re.split(r"[\s,]+", str(box).strip())]
+        if len(vb) != 4 or not np.isfinite(vb).all() or vb[2] <= 0 or vb[3] <= 0:
+            raise FormatError(
+                f"{name}: viewBox is not four numbers 'x y width height' with width, height > 0"
+            )
     if unit in ("", "px", "pt", "pc"):  # svgelements turns pt and pc into px at 96 ppi
         return PX
     if unit in _SE_PX:
@@ -102,6 +112,14 @@ def _metres_per_px(svg, name: str = "the SVG") -> float:
         f"{name}: width {width!r} is not a length holofold reads (give the width in mm, cm, in "
         "or px, or none: the drawing's px are then 1/96 in)"
     )
+
+
+def _float_or_nan(text: str) -> float:
+    """``float(text)``, NaN where it is not a number."""
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
 
 
 def _without_legend(data: bytes):
@@ -297,6 +315,10 @@ def read_svg_pattern(
     from holofold.geometry.readers import pattern_from_lines
 
     name = Path(path).name
+    if unit is not None and not (
+        isinstance(unit, int | float) and math.isfinite(unit) and unit > 0
+    ):
+        raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
     S, codes, angles, notes, per_px = svg_lines(path, curves=curves)
     meta = {"kind": "svg", "source": name}
     return pattern_from_lines(

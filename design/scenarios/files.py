@@ -52,6 +52,8 @@ def read_scenario(path: str | os.PathLike) -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioFileError(f"{path.name}: not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses per level of nested arrays and tables
+        raise ScenarioFileError(f"{path.name}: arrays or tables nested too deep") from None
     doc = Section(data, f"{path.name}: top level", path.resolve().parent)
     known = kind_names()
     kind = doc.choice("kind", known)
