@@ -52,3 +52,27 @@ def test_a_stalled_fold_names_its_panel_bending():
     # a rigid fold of the same pattern says nothing of the kind
     ok = fold_pattern(p, 1.0, **kw)
     assert ok.verdict == "folds rigidly" and "bend up to" not in ok.note
+
+
+def test_a_run_stopped_by_a_signal_counts_in_the_time_total(tmp_path, monkeypatch):
+    import json
+
+    import pytest
+
+    from holofold.design import loop
+    from holofold.design.loop import DesignLoop, run_design
+
+    def stopped(self):  # 1.25 s of simulation, then Ctrl-C (or SIGTERM as SystemExit)
+        self.state.times["database"] += 1.25
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(DesignLoop, "database", stopped)
+    out = tmp_path / "out"
+    with pytest.raises(KeyboardInterrupt):
+        run_design("arch", "Zstiff > 150", out, samples=20, progress=False)
+    runs = json.loads((out / "runs.json").read_text())
+    assert len(runs) == 1 and runs[0]["interrupted"] is True
+    assert runs[0]["stages"]["database"] == pytest.approx(1.25, abs=1e-3)
+    # the next run's totals include the interrupted run's seconds and count it
+    t = loop._Ledger(out).timings({"database": 0.5})
+    assert t.all_runs["database"] == pytest.approx(1.75, abs=2e-3) and t.runs == 2
