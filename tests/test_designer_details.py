@@ -76,3 +76,22 @@ def test_a_run_stopped_by_a_signal_counts_in_the_time_total(tmp_path, monkeypatc
     # the next run's totals include the interrupted run's seconds and count it
     t = loop._Ledger(out).timings({"database": 0.5})
     assert t.all_runs["database"] == pytest.approx(1.75, abs=2e-3) and t.runs == 2
+
+
+def test_laser_cutter_files_come_with_a_visible_preview(tmp_path, capsys):
+    import matplotlib.image as mpimg
+
+    out = tmp_path / "m"
+    argv = ["pattern", "miura", "--m", "4", "--n", "4", "--gamma", "60", "--ext", "0.6",
+            "--size", "0.2", "--profile", "laser", "-o", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    capsys.readouterr()
+    svg = next(out.glob("*.svg"))
+    assert "0.01" in svg.read_text()  # the SVG keeps the laser's hairlines
+    png = next(out.glob("*_preview.png"))
+    img = mpimg.imread(png)[..., :3]
+    inked = (img < 0.9).any(axis=2).mean()
+    assert 0.005 < inked < 0.5  # lines a viewer sees, not a blank (or black) page
+    red = (img[..., 0] > 0.8) & (img[..., 1] < 0.3) & (img[..., 2] < 0.3)
+    blue = (img[..., 2] > 0.8) & (img[..., 0] < 0.3) & (img[..., 1] < 0.3)
+    assert red.sum() > 100 and blue.sum() > 100  # red cut outline, blue mountain scores
