@@ -321,12 +321,15 @@ class _Ledger:
             total[k] += v
         return Timings(dict(this), total, len(self.runs) + 1)
 
-    def append(self, this: dict) -> None:
+    def append(self, this: dict, *, interrupted: bool = False) -> None:
+        """Add this invocation's seconds per stage; ``interrupted`` for a run stopped by a
+        signal before it wrote its answer (its seconds still count in the total)."""
         stamp = datetime.now(UTC).isoformat(timespec="seconds")
-        write_json(
-            self.path,
-            [*self.runs, {"started": stamp, "stages": {k: round(v, 3) for k, v in this.items()}}],
-        )
+        run = {"started": stamp, "stages": {k: round(v, 3) for k, v in this.items()}}
+        if interrupted:
+            run["interrupted"] = True
+        write_json(self.path, [*self.runs, run])
+        self.runs.append(run)
 
 
 def _earlier_rows(sc: Scenario, roots: Sequence[Path], used: set) -> pd.DataFrame | None:
@@ -459,9 +462,13 @@ class DesignLoop:
     def run(self) -> DesignOutcome:
         self.out.mkdir(parents=True, exist_ok=True)
         ledger = _Ledger(self.out)
-        if self.database():
-            self.search()
-        answer, everything = self.choose()
+        try:
+            if self.database():
+                self.search()
+            answer, everything = self.choose()
+        except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM turned into SystemExit
+            ledger.append(self.state.times, interrupted=True)  # still in the time total
+            raise
         return self.write(answer, everything, ledger)
 
     # ------------------------------------------------------------------ helpers

@@ -46,6 +46,12 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "get_profile",
             "register_profile",
         ],
+        "cutter_preview": [
+            "write_cutter_preview",
+            "needs_preview",
+            "PREVIEW_LINE_PT",
+            "HAIRLINE_MM",
+        ],
         "dxf": ["DXF_LAYERS", "export_dxf"],
         "thick": [
             "TECHNIQUES",

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from holofold.geometry.cutter import CutterOptions
+from holofold.geometry.cutter_preview import needs_preview
 from holofold.geometry.errors import ParameterError, check_range
 from holofold.geometry.export import export
 from holofold.geometry.mesh import MESH_UNITS
@@ -79,6 +80,10 @@ FILES = {
     "svg_back": (
         "{pattern}_back.svg",
         "SVG, pass 2 (back, mirrored): valley scores and cuts, {profile} profile (mm)",
+    ),
+    "preview": (
+        "{pattern}_preview.png",
+        "PNG preview of the SVG with visible strokes (cutters read the SVG and DXF, not this)",
     ),
     "dxf": (
         "{pattern}.dxf", "DXF of the flat crease pattern, a layer per role, {profile} profile (mm)"
@@ -291,6 +296,12 @@ def write_fabrication_set(
         if cutter.two_sided:
             add("svg_front", layout, side="front", **drawing)
             add("svg_back", layout, side="back", **drawing)
+        if needs_preview(cutter.profile):  # hairlines: the SVG looks blank in a viewer
+            from holofold.geometry.cutter_preview import write_cutter_preview
+
+            path = out / FILES["preview"][0].format(**fill)
+            files.append(FabricationFile("preview", write_cutter_preview(layout, path, **drawing),
+                                         FILES["preview"][1]))  # fmt: skip
         add("dxf", layout, **drawing)
     elif plan_view is not None:
         from holofold.geometry.outputs import write_text

@@ -67,6 +67,7 @@ __all__ = [
     "MAX_FOLD_DEG",
     "RIGID_BEND_DEG",
     "RIGID_STRAIN",
+    "BEND_NOTE_DEG",
     "MODELS",
 ]
 
@@ -76,6 +77,9 @@ MAX_FOLD_DEG = 179.0
 #: :data:`RIGID_STRAIN` does not fold rigidly
 RIGID_BEND_DEG = 3.0
 RIGID_STRAIN = 1e-3
+#: a verdict that is not about bending (``stalls``, ``turns against its assignment``) still
+#: names panel bending beyond this, degrees: a stalled fold can hide panels bent by 80 deg
+BEND_NOTE_DEG = 5.0
 #: a driven crease counts as folded the wrong way beyond this angle of the wrong sign, degrees
 WRONG_WAY_DEG = 10.0
 #: the bar-and-hinge models a pattern can be folded with
@@ -547,6 +551,11 @@ def fold_pattern(
                 note = "the folded state is stress free (the targets are compatible)"
             else:
                 note = f"panels bend at most {bend:.2f} deg, stretch at most {strain:.1g}"
+    if verdict in ("stalls", "turns against its assignment") and bend > BEND_NOTE_DEG:
+        note += (
+            f"; panels bend up to {bend:.0f} deg (panel {int(np.argmax(energy.panel_bend))}) "
+            f"and stretch up to {strain:.2g}"
+        )
     if stalled and wrong.size:
         note += (
             f"; {wrong.size} driven creases folded against their assignment (the first at "

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from contextlib import contextmanager
 from pathlib import Path
 
 from holofold.cli._fabrication import add_cutter_arguments, cutter_options
@@ -155,6 +156,28 @@ def run(args) -> int:
         say=lambda text: print(text, flush=True),
     )  # fmt: skip
     output = DesignFiles(db=args.db, mesh_units=args.units, cutter=cutter_options(args))
-    out = run_design(problem, folder=args.output, settings=settings, execution=execution,
-                     output=output)  # fmt: skip
+    with _sigterm_as_exit():  # a run stopped by SIGTERM still counts in runs.json's total
+        out = run_design(problem, folder=args.output, settings=settings, execution=execution,
+                         output=output)  # fmt: skip
     return 0 if out.met else 1
+
+
+@contextmanager
+def _sigterm_as_exit():
+    """SIGTERM raises SystemExit(143) in the main thread (the loop records the run's seconds
+    before it exits); the previous handler is restored after."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, _frame):
+        raise SystemExit(128 + signum)
+
+    before = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, before)
