@@ -33,9 +33,11 @@ driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the 
 not those of a rigid folding),
 ``turns against its assignment`` (driven creases folded more than :data:`WRONG_WAY_DEG` the
 wrong way in the last state; the note gives the fraction at which the first one did) or
-``stalls`` (a step would not converge), or ``folds until panels touch`` (a state had panels
-passing through each other: the fold stops at the last clean state; no success verdict is
-given for an intersecting state, see :mod:`holofold.mechanics.intersection`).
+``stalls`` (a step would not converge, and neither the energy minimisation nor the
+pseudo-transient flow of :mod:`holofold.mechanics.leave_flat` found an equilibrium beyond),
+or ``folds until panels touch`` (a state had panels passing through each other: the fold
+stops at the last clean state; no success verdict is given for an intersecting state, see
+:mod:`holofold.mechanics.intersection`).
 
 Fold angles are tracked through +-180 degrees: each state's angles are unwrapped against the
 previous stored state along the path (the dihedral angle of two panels is only known modulo
