@@ -33,9 +33,11 @@ driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the 
 not those of a rigid folding),
 ``turns against its assignment`` (driven creases folded more than :data:`WRONG_WAY_DEG` the
 wrong way in the last state; the note gives the fraction at which the first one did) or
-``stalls`` (a step would not converge), or ``folds until panels touch`` (a state had panels
-passing through each other: the fold stops at the last clean state; no success verdict is
-given for an intersecting state, see :mod:`holofold.mechanics.intersection`).
+``stalls`` (a step would not converge, and neither the energy minimisation nor the
+pseudo-transient flow of :mod:`holofold.mechanics.leave_flat` found an equilibrium beyond),
+or ``folds until panels touch`` (a state had panels passing through each other: the fold
+stops at the last clean state; no success verdict is given for an intersecting state, see
+:mod:`holofold.mechanics.intersection`).
 
 Fold angles are tracked through +-180 degrees: each state's angles are unwrapped against the
 previous stored state along the path (the dihedral angle of two panels is only known modulo
@@ -359,6 +361,7 @@ def fold_pattern(
     FoldResult
     """
     from holofold.mechanics.assembly import Assembler
+    from holofold.mechanics.leave_flat import flow_to_equilibrium
     from holofold.mechanics.solvers import solve_selffold
 
     fraction = check_range("fraction", fraction, 0.0, 1.0)
@@ -419,6 +422,7 @@ def fold_pattern(
     done, h, halvings = 0.0, h0, 0
     fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
+    flows: list[float] = []  # steps carried by pseudo-transient flow where Newton stalled
     stalled = ""
     import time
 
@@ -452,6 +456,11 @@ def fold_pattern(
             # no equilibrium near the last one: a limit point; the sheet snaps to another
             # equilibrium, found by minimising the energy (Levenberg-Marquardt)
             relaxed = _relax(asm, U, rest(nxt), tol)
+            flowed = False
+            if relaxed is None:  # stalled without a limit found: pseudo-transient flow
+                left = None if time_limit is None else time_limit - (time.perf_counter() - started)
+                flow = flow_to_equilibrium(asm, U, rest(nxt), tol, max_steps=400, time_limit=left)
+                relaxed, flowed = (flow.U, True) if flow.converged else (None, False)
             if panels is not None and relaxed is not None:  # contact hook
                 relaxed = panels.step(asm, U, relaxed, rest(nxt), tol, max_iter)
             if relaxed is not None:
@@ -460,7 +469,7 @@ def fold_pattern(
                 fr.append(done)
                 Us.append(U.copy())
                 clock.append(time.perf_counter() - started)
-                snaps.append(done)
+                (flows if flowed else snaps).append(done)
                 h = h0
                 continue
             why = "; ".join(res.status.reasons) or "non-finite displacement"
@@ -480,6 +489,7 @@ def fold_pattern(
         fractions, Uh, coords = fractions[:keep], Uh[:keep], coords[:keep]
         clock = clock[:keep]
         snaps = [x for x in snaps if x <= fractions[-1]]
+        flows = [x for x in flows if x <= fractions[-1]]
         done = float(fractions[-1])
         stalled = ""
     angles = _fold_angles(base, structure, Uh)
@@ -565,6 +575,9 @@ def fold_pattern(
         note += (
             f"; {came_back} driven creases turned against their assignment on the way and came back"
         )
+    if flows:
+        where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
+        note += f"; Newton stalled at {where} % and a pseudo-transient flow carried the fold on"
     if snaps:
         where = ", ".join(f"{100 * x:.1f}" for x in snaps[:5])
         note += f"; snaps at {where} % (no nearby equilibrium: the energy minimum beyond)"

@@ -96,8 +96,14 @@ def test_a_limit_point_is_passed_by_a_snap():
 
 def test_a_step_that_cannot_converge_stops_the_fold(monkeypatch):
     import holofold.mechanics.folding as folding
+    import holofold.mechanics.leave_flat as leave_flat
 
     monkeypatch.setattr(folding, "_relax", lambda *a, **k: None)  # no snap either
+    # nor the pseudo-transient fallback (tests/test_leave_flat.py: it carries this fold on)
+    monkeypatch.setattr(
+        leave_flat, "flow_to_equilibrium",
+        lambda asm, U, *a, **k: leave_flat.FlowResult(U, False, float("inf"), 0),
+    )  # fmt: skip
     p = miura_sheet(2, 2, a=0.02, b=0.02, gamma=1.0, ext=0.6)
     r = fold_pattern(p, 1.0, max_iter=2, **SECTION)  # one Newton iteration per step
     assert r.verdict == "stalls" and not r.complete and not r.status.converged
