@@ -51,6 +51,7 @@ __all__ = [
     "validate_designs",
     "evaluate_designs",
     "iter_results",
+    "plan_tasks",
     "results_table",
     "progress_bar",
     "check_scheduler",
@@ -253,7 +254,7 @@ def _raise_environment_fault(scenario: Scenario, exc: BaseException) -> None:
 BATCH_ROWS = 16
 
 
-def _batches(scenario: Scenario, rows: list) -> list[list[int]]:
+def plan_tasks(scenario: Scenario, rows: list) -> list[list[int]]:
     """Positions of ``rows`` in tasks: one row each, or up to :data:`BATCH_ROWS` rows with the
     same ``scenario.batch_key`` when the scenario evaluates batches."""
     if scenario.evaluate_batch is None or scenario.batch_key is None or len(rows) <= 1:
@@ -560,6 +561,7 @@ def iter_results(
     address: str | None = None,
     limit_threads: bool = True,
     row_timeout: float | None = None,
+    tasks: list[list[int]] | None = None,
 ) -> Iterator[tuple[int, dict]]:
     """Simulate validated ``rows``, yielding ``(position, output)`` as each row finishes.
 
@@ -572,14 +574,17 @@ def iter_results(
     never an exception. Close the iterator (:func:`contextlib.closing`) to cancel what is
     still running. ``row_timeout``: seconds per row (None: no limit; a batch of k rows has
     k times as long, and past it its rows run again one by one); a row past its limit is
-    ``failed: timeout after ... s``.
+    ``failed: timeout after ... s``. ``tasks`` (joblib only): the positions of ``rows`` to
+    simulate, task by task (default :func:`plan_tasks` of every row); a resume passes the
+    tasks of an uninterrupted run that are still missing, so each row keeps its batch.
     """
     if rows:  # the environment before any row: a fault here is never a row's outcome
         check_environment()
     if address is not None:
         yield from _iter_on_dask(scenario, rows, limit_threads, address, row_timeout)
         return
-    tasks = _batches(scenario, rows)
+    if tasks is None:
+        tasks = plan_tasks(scenario, rows)
     args = (limit_threads, row_timeout)
     if workers == 1 or len(tasks) <= 1:
         outs = (_evaluate_batch(scenario, [rows[i] for i in t], *args) for t in tasks)

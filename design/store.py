@@ -33,7 +33,6 @@ import io
 import logging
 import os
 import re
-import time
 import warnings
 from contextlib import closing
 from pathlib import Path
@@ -42,6 +41,7 @@ import numpy as np
 import pandas as pd
 
 from holofold.design.folder_lock import folder_lock
+from holofold.design.row_checkpoints import CHECKPOINT_SECONDS, RowCheckpoint, move_damaged
 from holofold.design.row_limits import resolve_row_timeout
 from holofold.design.row_status import STATE_COLUMNS, stale_rows, with_state
 from holofold.design.runner import (
@@ -50,6 +50,7 @@ from holofold.design.runner import (
     dask_scheduler,
     evaluate_designs,
     iter_results,
+    plan_tasks,
     progress_bar,
     results_table,
     validate_designs,
@@ -86,6 +87,7 @@ def build_database(
     on_invalid: str = "fail",
     row_timeout: float | str | None = None,
     retry_failed: bool = False,
+    checkpoint: float = CHECKPOINT_SECONDS,
 ) -> pd.DataFrame:
     """Simulate ``designs`` into ``folder``, resuming whatever an earlier run left there.
 
@@ -97,9 +99,12 @@ def build_database(
     folder : path
         Database folder (created if needed).
     chunk_size : int
-        Rows per result chunk: the unit of work lost at most when a run is interrupted.
-        With joblib each chunk is finished before the next starts; on Dask it only sets how
-        often results are written (see ``scheduler``).
+        Rows per result chunk. With joblib each chunk is finished before the next starts; on
+        Dask every missing row is submitted at once (see ``scheduler``).
+    checkpoint : float
+        Seconds between two writes of the finished rows of the chunk in flight
+        (:mod:`holofold.design.row_checkpoints`): a killed run loses at most this much
+        finished work plus the rows still running. 0 writes after every row.
     workers : int
         Worker processes per chunk (joblib), or of the local Dask cluster with
         ``scheduler="local"``.
@@ -149,7 +154,7 @@ def build_database(
     with folder_lock(folder):  # one writer per folder, for the whole run
         _build_locked(
             scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
-            on_invalid, timeout, retry_failed,
+            on_invalid, timeout, retry_failed, float(checkpoint),
         )  # fmt: skip
         _check_own(folder, designs, meta)
         return load_database(folder, _write=True)
@@ -157,7 +162,7 @@ def build_database(
 
 def _build_locked(
     scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
-    on_invalid, timeout, retry_failed=False,
+    on_invalid, timeout, retry_failed=False, every=CHECKPOINT_SECONDS,
 ) -> None:  # fmt: skip
     """The body of :func:`build_database`, run holding the folder's lock."""
     chunks = folder / "chunks"
@@ -193,6 +198,7 @@ def _build_locked(
     done = scan_chunks(folder, designs, chunk_size)
     _redo_stale(scenario, designs, done, chunk_size, workers, scheduler, on_invalid, timeout,
                 retry_failed)  # fmt: skip
+    RowCheckpoint.discard_done(chunks, done)
     todo = [k for k in range(n_chunks) if k not in done]
     if len(todo) < n_chunks:
         log.info("resuming: %d of %d chunks already done", n_chunks - len(todo), n_chunks)
@@ -209,21 +215,57 @@ def _build_locked(
             # one cluster for the whole run; every missing row is submitted at once
             with dask_scheduler(scheduler, workers) as address:
                 _build_on_dask(
-                    scenario, designs, checked, todo, chunk_size, chunks, address, bar, timeout
-                )
-        else:
-            for k in todo:
-                part = designs.iloc[k * chunk_size : (k + 1) * chunk_size]
-                res = evaluate_designs(
-                    scenario, part, workers=workers, progress=False, log_warnings=False,
-                    on_invalid=on_invalid, row_timeout=timeout or 0,
+                    scenario, designs, checked, todo, chunk_size, chunks, address, bar, timeout,
+                    every,
                 )  # fmt: skip
-                write_chunk(res, chunks, k)
-                if bar is not None:
-                    bar.update(len(part))
+        else:
+            invalid = checked.invalid_outputs(scenario)
+            for k in todo:
+                _build_chunk(
+                    scenario, designs, checked, invalid, k, chunk_size, chunks, workers, bar,
+                    timeout, every,
+                )  # fmt: skip
     finally:
         if bar is not None:
             bar.close()
+
+
+def _build_chunk(
+    scenario, designs, checked, invalid, k, chunk_size, chunks, workers, bar, timeout, every
+) -> None:  # fmt: skip
+    """Simulate chunk ``k`` with joblib and write it: the table
+    :func:`~holofold.design.runner.evaluate_designs` gives for its rows. The rows a killed run
+    checkpointed are taken back, the others simulated in the same tasks (batches of one
+    ``batch_key``) as an uninterrupted run, so a resume gives the same outputs."""
+    n = len(designs)
+    lo, hi = k * chunk_size, min(n, (k + 1) * chunk_size)
+    outs = [invalid.get(i) for i in range(lo, hi)]
+    where = [i for i in checked.positions if lo <= i < hi]
+    mine = dict(zip(checked.positions, checked.rows, strict=True))
+    rows = [mine[i] for i in where]
+    keep = RowCheckpoint(chunks, k, lo, hi, scenario.performance_names, every)
+    saved = keep.load()
+    tasks = []
+    for task in plan_tasks(scenario, rows):
+        if all(where[j] in saved for j in task):  # a task all of whose rows were kept
+            for j in task:
+                outs[where[j] - lo] = saved[where[j]]
+        else:
+            tasks.append(task)
+    if bar is not None:
+        bar.update(sum(o is not None for o in outs))  # invalid rows and rows taken back
+    if tasks:
+        results = iter_results(
+            scenario, rows, workers=workers, row_timeout=timeout, tasks=tasks
+        )  # fmt: skip
+        with closing(results):
+            for j, out in results:
+                outs[where[j] - lo] = out
+                keep.add(where[j], out)
+                if bar is not None:
+                    bar.update(1)
+    write_chunk(results_table(scenario, designs.iloc[lo:hi], outs), chunks, k)
+    keep.discard()
 
 
 def _check_designs(folder: Path, designs: pd.DataFrame) -> None:
@@ -382,18 +424,6 @@ def _stored_layout(meta_path: Path, chunks: Path, n_rows: int) -> int | None:
     return None
 
 
-def _damaged(path: Path, why: str) -> None:
-    aside = path.parent / "damaged"
-    aside.mkdir(exist_ok=True)
-    dest = aside / f"{path.name}.{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}"
-    os.replace(path, dest)
-    warnings.warn(
-        f"damaged chunk {path.name} ({why}) moved to {dest.relative_to(path.parent.parent)}; "
-        "its rows will be simulated again",
-        stacklevel=3,
-    )
-
-
 def scan_chunks(
     folder, designs: pd.DataFrame, chunk_size: int, *, move: bool = True
 ) -> dict[int, Path]:
@@ -414,7 +444,7 @@ def scan_chunks(
         m = _CHUNK.match(p.name)
         if m is None:
             if move:
-                _damaged(p, "not a chunk name")
+                move_damaged(p, "not a chunk name")
             continue
         k = int(m[1])
         data = p.read_bytes()
@@ -429,7 +459,7 @@ def scan_chunks(
             why = _content_problem(data, designs.iloc[k * chunk_size : (k + 1) * chunk_size])
         if why:
             if move:
-                _damaged(p, why)
+                move_damaged(p, why)
             continue
         if m[2] is None and move:  # older layout: add the checksum to the name
             named = p.with_name(f"part-{k:05d}-{_digest(data)}.parquet")
@@ -475,6 +505,7 @@ def _build_on_dask(
     address: str,
     bar,
     timeout: float | None,
+    every: float = CHECKPOINT_SECONDS,
 ) -> None:
     """Simulate the chunks ``todo`` on the Dask scheduler at ``address``.
 
@@ -494,6 +525,9 @@ def _build_on_dask(
         Progress bar, advanced by one per finished row.
     timeout : float or None
         Time limit per row, seconds.
+    every : float
+        Seconds between two checkpoints of a chunk's finished rows (rows run one by one on
+        Dask, so a resume gives the same outputs).
     """
     n = len(designs)
     spans = {k: (k * chunk_size, min(n, (k + 1) * chunk_size)) for k in todo}
@@ -502,21 +536,31 @@ def _build_on_dask(
     rows = dict(zip(checked.positions, checked.rows, strict=True))
     owner, pending = [], []
     invalid = checked.invalid_outputs(scenario)
+    keep = {
+        k: RowCheckpoint(chunks, k, lo, hi, scenario.performance_names, every)
+        for k, (lo, hi) in spans.items()
+    }
 
-    def done(k: int, pos: int, out: dict) -> None:
+    def done(k: int, pos: int, out: dict, *, new: bool = True) -> None:
         outs[k][pos] = out
         left[k] -= 1
         if bar is not None:
             bar.update(1)
+        if new:
+            keep[k].add(spans[k][0] + pos, out)
         if not left[k]:
             lo, hi = spans[k]
             # the same table as evaluate_designs(scenario, part) would give
             write_chunk(results_table(scenario, designs.iloc[lo:hi], outs.pop(k)), chunks, k)
+            keep.pop(k).discard()
 
     for k, (lo, hi) in spans.items():
+        saved = keep[k].load()
         for i in range(lo, hi):
             if i in invalid:
-                done(k, i - lo, invalid[i])
+                done(k, i - lo, invalid[i], new=False)
+            elif i in saved:
+                done(k, i - lo, saved[i], new=False)
             else:
                 owner.append((k, i - lo))
                 pending.append(rows[i])
@@ -543,6 +587,7 @@ def generate_database(
     on_invalid: str = "skip",
     row_timeout: float | str | None = None,
     retry_failed: bool = False,
+    checkpoint: float = CHECKPOINT_SECONDS,
 ) -> pd.DataFrame:
     """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
 
@@ -566,6 +611,7 @@ def generate_database(
         scenario, designs, folder, chunk_size=chunk_size, workers=workers, progress=progress,
         meta={"seed": seed, "method": method, "ranges": recorded}, scheduler=scheduler,
         on_invalid=on_invalid, row_timeout=row_timeout, retry_failed=retry_failed,
+        checkpoint=checkpoint,
     )  # fmt: skip
     if csv:
         write_table(db, Path(folder) / "database.csv")

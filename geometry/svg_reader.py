@@ -94,7 +94,7 @@ def _metres_per_px(svg, name: str = "the SVG") -> float:
 
     width = str(svg.values.get("width", "")).strip()
     m = re.fullmatch(r"([-+0-9.eE]+)\s*([a-zA-Z%]*)", width)
-    unit = m.group(2) if m else ""
+    unit = m.group(2).lower() if m else ""  # a known unit: bounded.check_svg_pattern saw to it
     if m and not 0 < _float_or_nan(m.group(1)) < math.inf:
         raise FormatError(f"{name}: width {width!r} is not a length > 0")
     box = svg.values.get("viewBox")
@@ -106,12 +106,7 @@ def _metres_per_px(svg, name: str = "the SVG") -> float:
             )
     if unit in ("", "px", "pt", "pc"):  # svgelements turns pt and pc into px at 96 ppi
         return PX
-    if unit in _SE_PX:
-        return 1.0 / _SE_PX[unit]
-    raise FormatError(
-        f"{name}: width {width!r} is not a length holofold reads (give the width in mm, cm, in "
-        "or px, or none: the drawing's px are then 1/96 in)"
-    )
+    return 1.0 / _SE_PX[unit]
 
 
 def _float_or_nan(text: str) -> float:

@@ -5,7 +5,7 @@ same iterations and statuses), whatever the others do (converge, stall, fail).""
 import numpy as np
 import pytest
 
-from holofold.design.runner import BATCH_ROWS, _batches, evaluate_designs
+from holofold.design.runner import BATCH_ROWS, evaluate_designs, plan_tasks
 from holofold.design.scenarios import arch
 from holofold.mechanics import BatchAssembler, solve_newton, solve_newton_batch
 from holofold.mechanics.analyses import load_along, secant_stiffness, secant_stiffness_batch
@@ -87,12 +87,12 @@ def test_newton_batch_keeps_failures_and_stalls_per_design():
         BatchAssembler([ok, ok.with_supports(np.zeros((5, 3), bool))])
 
 
-def test_runner_batches_rows_of_one_m_and_gives_each_row_its_own_outputs():
+def test_runnerplan_tasks_rows_of_one_m_and_gives_each_row_its_own_outputs():
     rows = _rows(8, 3) + _rows(12, 2) + _rows(8, 2)
     import pandas as pd
 
     table = pd.DataFrame(rows)
-    tasks = _batches(arch.SCENARIO, table.to_dict("records"))
+    tasks = plan_tasks(arch.SCENARIO, table.to_dict("records"))
     assert sorted(len(t) for t in tasks) == [2, 5] and BATCH_ROWS >= 5
     res = evaluate_designs("arch", table)
     for i, r in enumerate(rows):

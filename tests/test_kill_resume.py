@@ -99,3 +99,26 @@ def test_design_loop_killed_at_chosen_points_resumes_to_the_same_design(tmp_path
         assert got[key] == ref[key], key
     assert got["database"]["rows"] == ref["database"]["rows"]
     assert len(killed) >= 5, killed
+
+
+def test_a_kill_mid_chunk_keeps_the_rows_finished_before_it(tmp_path):
+    # one chunk of 60 rows, checkpoints after every row (the default is every 5 s): a kill -9
+    # when the 30th row arrives leaves the 29 before it, and the resume ends exactly
+    script = (
+        "import sys; from holofold.design.store import generate_database; "
+        "generate_database('arch', 60, sys.argv[1], seed=5, chunk_size=60, workers=2, "
+        "checkpoint=float(sys.argv[2]), progress=False)"
+    )
+    ref = _run([sys.executable, "-c", script, str(tmp_path / "ref"), "5"])
+    assert ref.returncode == 0, ref.stderr
+    argv = [sys.executable, "-c", script, str(tmp_path / "db"), "0"]
+    assert _run(argv, "kill:row:30").returncode == -signal.SIGKILL
+    (kept,) = (tmp_path / "db" / "chunks").glob("rows-00000-*.parquet")
+    assert len(pd.read_parquet(kept)) == 29
+    assert not list((tmp_path / "db" / "chunks").glob("part-*"))
+    r = _run(argv)
+    assert r.returncode == 0, r.stderr
+    db = pd.read_parquet(tmp_path / "db" / "database.parquet")
+    pd.testing.assert_frame_equal(db, pd.read_parquet(tmp_path / "ref" / "database.parquet"),
+                                  check_exact=True)  # fmt: skip
+    assert not list((tmp_path / "db" / "chunks").glob("rows-*"))

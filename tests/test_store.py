@@ -63,22 +63,22 @@ def test_a_range_must_match_the_kind_of_feature(capsys, tmp_path):
 def test_interrupted_build_resumes_without_duplicates(scen, tmp_path, monkeypatch):
     designs = sample_designs(scen, 7, seed=1)
     calls = []
-    real = store.evaluate_designs
+    real = store.iter_results
 
-    def counting(scenario, part, **kw):
-        calls.append(list(part["sample"]))
+    def counting(scenario, rows, **kw):
+        calls.append(sum(len(t) for t in kw["tasks"]))
         if len(calls) == 2 and not hasattr(counting, "interrupted"):
             counting.interrupted = True
             raise KeyboardInterrupt
-        return real(scenario, part, **kw)
+        return real(scenario, rows, **kw)
 
-    monkeypatch.setattr(store, "evaluate_designs", counting)
+    monkeypatch.setattr(store, "iter_results", counting)
     with pytest.raises(KeyboardInterrupt):
         store.build_database(scen, designs, tmp_path / "db", chunk_size=3)
     assert len(list((tmp_path / "db" / "chunks").glob("*.parquet"))) == 1
     calls.clear()
     db = store.build_database(scen, designs, tmp_path / "db", chunk_size=3)
-    assert calls == [[3, 4, 5], [6]]  # only the missing chunks were simulated
+    assert calls == [3, 1]  # only the rows of the missing chunks (3-5, 6) were simulated
     assert list(db["sample"]) == list(range(7))
     assert (db["status"] == "converged").all()
     again = pd.read_parquet(tmp_path / "db" / "database.parquet")

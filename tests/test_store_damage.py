@@ -122,19 +122,19 @@ def test_resume_with_another_chunk_size_uses_the_stored_layout(
     designs, reference, tmp_path, monkeypatch, first, second
 ):
     db = tmp_path / "db"
-    real = store.evaluate_designs
+    real = store.iter_results
     calls = []
 
-    def interrupted(scenario, part, **kw):
-        calls.append(len(part))
+    def interrupted(scenario, rows, **kw):
+        calls.append(len(rows))
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return real(scenario, part, **kw)
+        return real(scenario, rows, **kw)
 
-    monkeypatch.setattr(store, "evaluate_designs", interrupted)
+    monkeypatch.setattr(store, "iter_results", interrupted)
     with pytest.raises(KeyboardInterrupt):
         store.build_database(CHEAP, designs, db, chunk_size=first)
-    monkeypatch.setattr(store, "evaluate_designs", real)
+    monkeypatch.setattr(store, "iter_results", real)
     out, said, simulated = _rebuild(designs, db, chunk_size=second)
     assert len(out) == N and out["sample"].tolist() == list(range(N))  # none lost or doubled
     pd.testing.assert_frame_equal(out, reference, check_exact=True)
