@@ -77,3 +77,18 @@ def test_thick_offset_without_thickness_refused(tmp_path, capsys):
     code = main([*args, "--gamma", "60", "--thick", "offset", "-o", str(tmp_path / "o")])
     assert code == 2 and "needs --thickness" in capsys.readouterr().err
     assert not (tmp_path / "o" / "pattern.fold").exists()
+
+
+def test_sheet_whose_creases_are_wider_than_any_panel_refused_once(tmp_path):
+    # "1 m panels on a 6 cm sheet": crease widths 5-8 cm on a 6 cm sheet of 8-16 panels
+    # (panels at most 7.5 mm across) made every row a failed row, exit 0
+    from holofold.design import read_scenario
+
+    text = (Path(__file__).parents[1] / "examples" / "pa12_miura_sheet.toml").read_text()
+    text = text.replace("size_x = 0.2 ", "size_x = 0.06").replace("size_y = 0.2", "size_y = 0.06")
+    path = tmp_path / "six.toml"
+    path.write_text(text.replace("W = [4.0e-3, 8.0e-3]", "W = [0.05, 0.08]"))
+    with pytest.raises(ValueError, match=r"as wide as the widest panel of any design \(0.0075 m"):
+        read_scenario(path)
+    path.write_text(text.replace("W = [4.0e-3, 8.0e-3]", "W = [1e-3, 2e-3]"))
+    assert read_scenario(path).name == "pa12-miura-sheet"  # narrower creases: a scenario

@@ -753,6 +753,15 @@ def _check_features(doc: Section, sheet: dict, features: tuple[Column, ...]) -> 
             f"{where['m']} = {counts['m']} x {where['n']} = {counts['n']}: the largest sheet has "
             f"{largest} panels; at most {MAX_PANELS} (docs/limits.md)"
         )
+    # a crease as wide as the widest panel any design has (a panel spans size_x / m along x,
+    # Miura and TMP alike): every row would fail alike
+    widest = sheet["size_x"] / min(counts["m"])
+    if "W" in by and min(_values(by["W"])) >= widest:
+        raise doc.error(
+            f"[features] W = {_values(by['W'])} m: every crease is at least "
+            f"{min(_values(by['W'])):g} m wide, as wide as the widest panel of any design "
+            f"({widest:.4g} m = size_x / m = {sheet['size_x']:g} / {min(counts['m']):g})"
+        )
     for code in sorted(SHEET_FAMILIES, reverse=True):  # TMP's parity, then Miura's angle
         if code not in pats:
             continue
