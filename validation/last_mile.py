@@ -25,6 +25,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import tomllib
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -126,11 +127,15 @@ def view_in_chromium(report: Path) -> str:
 def summarise(name: str, out: Path, run: dict | None) -> dict:
     """One row of the table from OUT/design.json, the sliced pieces and the browser check."""
     doc = json.loads((out / "design.json").read_text())
-    chosen = doc.get("chosen") or {}
-    rule = chosen.get("rule") or {}
-    feats = chosen.get("features") or {}
-    perf = chosen.get("performance") or {}
-    thick = perf.get("thick", feats.get("thick"))
+    rule = doc.get("rule") or {}
+    feats = doc.get("features") or {}
+    perf = doc.get("performance") or {}
+    thick = perf.get("thick")
+    if thick is not None:
+        technique = TECHNIQUES.get(int(thick), str(thick))
+    else:  # a kind without a thick column (the strip) builds with its file's thick key
+        setting = tomllib.loads((HERE / doc["scenario"]["source"]).read_text())
+        technique = str(setting.get("thick", "centred")) + " (fixed)"
     fab = doc.get("fabrication") or {}
     pieces = pieces_of(out)
     sliced = [slice_piece(p) for p in pieces]
@@ -141,13 +146,20 @@ def summarise(name: str, out: Path, run: dict | None) -> dict:
         "simulations": doc.get("database", {}).get("rows"),
         "answer": doc.get("answer"),
         "headline": doc.get("headline"),
-        "verified_precision": rule.get("verified_precision"),
-        "rule": rule.get("text") or rule.get("rule"),
+        "verified_precision": doc.get("verified_precision"),
+        "verified": [
+            rule.get("verified_meeting"),
+            rule.get("verified_n"),
+            rule.get("verified_failed"),
+        ],
+        "verified_95ci": rule.get("verified_95ci"),
+        "meets_bar": doc.get("rule_meets_bar"),
+        "rule": rule.get("rule"),
         "features": feats,
         "performance": perf,
-        "meets": chosen.get("meets"),
-        "buildable": chosen.get("buildable"),
-        "technique": TECHNIQUES.get(int(thick)) if thick is not None else None,
+        "meets": doc.get("meets_target"),
+        "buildable": doc.get("buildable"),
+        "technique": technique,
         "fabrication": fab,
         "pieces": len(pieces),
         "pieces_sliced": sum(s[0] for s in sliced),
@@ -163,7 +175,13 @@ def table(rows: list[dict]) -> str:
     lines = [head, "|" + "---|" * 8]
     for r in rows:
         vp = r["verified_precision"]
-        vp = "none" if vp is None else f"{vp:.2f}" + (" (meets 0.9)" if vp >= 0.9 else " (< 0.9)")
+        if vp is None:
+            vp = "none"
+        else:
+            meeting, n, failed = r["verified"]
+            low = r["verified_95ci"][0]
+            bar = "meets the bar" if r["meets_bar"] else "below the bar"
+            vp = f"{vp:.2f} ({meeting}/{n}, {failed} failed; 95 % from {low:.2f}; {bar})"
         design = "none" if not r["features"] else (
             ("meets, " if r["meets"] else "misses, ")
             + ("buildable" if r["buildable"] else "not buildable")
