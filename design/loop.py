@@ -955,6 +955,7 @@ def _scenario_summary(sc: Scenario) -> dict:
                 "low": c.low,
                 "high": c.high,
                 "choices": list(c.choices),
+                **({"names": list(c.names)} if c.names else {}),
             }
             for c in sc.features
         ],
@@ -964,6 +965,7 @@ def _scenario_summary(sc: Scenario) -> dict:
                 "unit": c.unit,
                 "display_unit": c.display_unit,
                 "description": c.description,
+                **({"choices": list(c.choices), "names": list(c.names)} if c.names else {}),
             }
             for c in sc.performance
         ],
