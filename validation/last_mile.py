@@ -189,7 +189,12 @@ def table(rows: list[dict]) -> str:
         )  # fmt: skip
         fab = r["fabrication"]
         if fab:
-            where = "fits whole" if fab.get("fits") else "cut to fit"
+            if fab.get("fits"):
+                where = "fits whole"
+            elif fab.get("pieces"):
+                where = "cut to fit"
+            else:
+                where = "not cut: " + str(fab.get("problem") or "no cut fits")
             pieces = f"{fab.get('pieces')} ({fab.get('extent')}, {where})"
         else:
             pieces = "no part"
