@@ -1,4 +1,8 @@
 // Square twist drawn in Rabbit Ear from the segments of Origami Simulator's singlesquaretwist.svg
+// Usage: NODE_PATH=~/.cache/holofold-node/node_modules node square_twist_rabbit_ear.js \
+//   /work/os-examples/assets/Origami/singlesquaretwist.svg square_twist.fold
+// (Rabbit Ear 0.9.32 has no SVG reader: the SVG's M/l segments are parsed here, coloured
+// blue = valley, red = mountain, black = boundary, as Origami Simulator draws them.)
 const ear = require("rabbit-ear");
 const fs = require("fs");
 const svg = fs.readFileSync(process.argv[2], "utf8");
