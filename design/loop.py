@@ -568,8 +568,12 @@ class DesignLoop:
             ask = RefineRequest(self.sc, s.refine, s.seed + 7919 * r, 10**6 * r,
                                 tuple(st.boxes), last and last.miner, len(st.table))  # fmt: skip
             new = how(ask)
+            words = new.words
+            if how is at_random and str(st.mine_target) != str(self.problem.target):
+                # designs may meet the target itself: none did with panels that fold clear
+                words = " at random (none met the target with thick panels that do not overlap yet)"
             of = f"{r}/{s.rounds}" if s.rounds is not None else f"{r}"
-            self.say(f"[refine] round {of}: {s.refine} new designs{new.words}")
+            self.say(f"[refine] round {of}: {s.refine} new designs{words}")
             res = self._simulate(new.designs, self.dbf / f"refine-{r}-{new.key}")
             st.table = pd.concat([st.table, res.assign(origin=f"refine-{r}")], ignore_index=True)
 
@@ -951,6 +955,7 @@ def _scenario_summary(sc: Scenario) -> dict:
                 "low": c.low,
                 "high": c.high,
                 "choices": list(c.choices),
+                **({"names": list(c.names)} if c.names else {}),
             }
             for c in sc.features
         ],
@@ -960,6 +965,7 @@ def _scenario_summary(sc: Scenario) -> dict:
                 "unit": c.unit,
                 "display_unit": c.display_unit,
                 "description": c.description,
+                **({"choices": list(c.choices), "names": list(c.names)} if c.names else {}),
             }
             for c in sc.performance
         ],

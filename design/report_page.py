@@ -246,8 +246,11 @@ def _columns(summary: DesignSummary) -> dict[str, Column]:
             if not isinstance(c, Mapping) or "name" not in c:
                 continue
             unit = str(c.get("unit") or "-")
+            names = tuple(str(n) for n in c.get("names") or ())  # named levels: "1 (offset)"
+            levels = tuple(float(v) for v in c.get("choices") or ()) if names else ()
             try:
-                col = Column(str(c["name"]), unit, display=str(c.get("display_unit") or ""))
+                col = Column(str(c["name"]), unit, display=str(c.get("display_unit") or ""),
+                             choices=levels, names=names)  # fmt: skip
             except ValueError:  # a display unit this holofold does not know: the SI unit
                 col = Column(str(c["name"]), unit)
             out[col.name] = col

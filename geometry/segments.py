@@ -223,6 +223,17 @@ class _Planner:
 
     def plan(self) -> list[np.ndarray] | None:
         rows = [np.asarray(r) for r in _clusters(self.proj[:, 1], self.tol[1])]
+        got = self._plan(rows)
+        if got is None and len(rows) < len(self.cells):
+            # rows whose cells shift little by little (a generalised Miura-ori's zig-zag)
+            # chain into one band: bands of fixed height, each cell by its centre, instead
+            y = self.proj[:, 1]
+            band = np.floor((y - y.min()) / max(2 * self.tol[1], 1e-300)).astype(int)
+            rows = [np.flatnonzero(band == b) for b in np.unique(band)]
+            got = self._plan(rows)
+        return got
+
+    def _plan(self, rows: list[np.ndarray]) -> list[np.ndarray] | None:
         bands, cur = [], np.zeros(0, int)
         for row in rows:
             trial = np.concatenate([cur, row])
@@ -442,7 +453,7 @@ def segment_part(
     if plan is None:
         return Segmentation(
             bed, whole, (), none,
-            f"the part ({whole.summary()}) cannot be cut into pieces that fit the {bed} bed "
+            f"no cut at its panel boundaries gives pieces that fit the {bed} bed "
             f"with room for their joints ({margin:.3g} mm each side)",
         )  # fmt: skip
     piece_of = np.empty(len(cells), int)

@@ -115,6 +115,27 @@ def test_sheet_cut_into_pieces_that_join(tmp_path):
     assert back.bounds[1][:2].max() <= 70.0 + 1e-6  # mm on the bed
 
 
+def test_a_generalised_miura_whose_panel_rows_zig_zag_is_cut():
+    # issue 34 (validation/last_mile, the hyperbolic-paraboloid roof): the chosen 6 x 8
+    # generalised Miura-ori, 373 x 390 mm flat, was "not cut": its panels' centres climb
+    # little by little across each row, so the rows chained into one band as tall as the part
+    from pathlib import Path
+
+    from holofold.geometry import read_pattern
+
+    pattern = read_pattern(Path(__file__).parent / "data" / "hypar-roof-6x8.fold")
+    seg = segment_part(pattern, 2.726e-3, 0.4136e-3, 2.462e-3, DEFAULT_BED)
+    assert not seg.problem, seg.problem
+    assert not seg.whole.fits and 4 <= len(seg.segments) <= 8  # 373 x 390 mm on 250 x 210
+    assert sorted(np.concatenate([s.panels for s in seg.segments])) == list(range(48))
+    for s in seg.segments:
+        m = s.mesh
+        assert m.is_watertight and len(m.split(only_watertight=False)) == 1
+        assert m.bounds[1][0] <= DEFAULT_BED.width + 1e-9
+        assert m.bounds[1][1] <= DEFAULT_BED.depth + 1e-9
+    assert len(seg.joints) >= len(seg.segments) - 1  # every piece joined to the rest
+
+
 def test_no_segmentation_when_nothing_fits():
     seg = segment_part(_miura(), 2e-3, 0.6e-3, 2e-3, Bed.parse("12x12"))
     assert not seg.fits and not seg.segments

@@ -639,6 +639,30 @@ def test_when_no_design_is_buildable_the_rules_are_mined_for_the_target_alone(tm
     assert "No design meets the target: the nearest" not in page
 
 
+def _stiff_ones_overlap(row):
+    """The designs meeting double > 1.8 (a > 0.9) are the ones whose thick panels overlap."""
+    return {"double": 2.0 * row["a"], "mass": row["a"],
+            "overlap": 1e-9 if row["a"] > 0.9 else 0.0, "status": CONVERGED}  # fmt: skip
+
+
+def test_a_random_round_says_the_target_was_met_only_with_overlapping_panels(tmp_path):
+    # issue 34 (the square twist of validation/last_mile): 43 of 350 designs met the target,
+    # all with overlapping panels, and each random round said "none met the target yet"
+    said = []
+    res = run_design(_cheap_scenario(_stiff_ones_overlap), "double > 1.8", tmp_path / "o",
+                     samples=60, pilot=0, refine=20, verify=10, top=1, rounds=1, workers=1,
+                     progress=False, files=False, say=said.append)  # fmt: skip
+    base = res.table[res.table["origin"] == "database"]
+    met = int((base["double"] > 1.8).sum())
+    assert met > 0 and (base.loc[base["double"] > 1.8, "overlap"] > 0).all()
+    assert any(f"no rule to mine: {met} of 60 simulated designs meet the target, 0 of them with"
+               " thick panels that do not overlap" in x for x in said)  # fmt: skip
+    refine = [x for x in said if x.startswith("[refine] round 1")]
+    assert refine == ["[refine] round 1/1: 20 new designs at random (none met the target with "
+                      "thick panels that do not overlap yet)"]  # fmt: skip
+    assert not any("(none met the target yet)" in x for x in said)
+
+
 def _noisy(row):
     """double = 2a plus noise uniform on [-1.35, 1.35] drawn from the design's digits: at most
     about 87 % of the designs of any box (a near 1) have double > 1."""

@@ -243,6 +243,33 @@ def test_page_holds_the_design_table_and_target(folder):
         assert m["m == 12"] == ["12", "holds exactly", "", "met"]
 
 
+def test_named_levels_read_with_their_names_in_the_design_table(folder):
+    # issue 34 (validation/last_mile): the pattern and surface kinds' chosen design read
+    # "thick 1", not which technique its panels use; the loop writes the levels' names into
+    # design.json and the page reads them back
+    from holofold.design.loop import _scenario_summary
+    from holofold.design.scenarios import Scenario
+    from holofold.design.scenarios.pattern_loads import THICK_COLUMN
+
+    sc = Scenario(name="t", description="t", check=lambda row: [], evaluate=lambda row: {},
+                  features=(Column("pattern", "-", "", choices=(1.0, 2.0),
+                                   names=("Miura-ori", "TMP")),
+                            Column("tpanel", "m", "", 1e-3, 2e-3)),
+                  performance=(Column("y", "N/m"), THICK_COLUMN))  # fmt: skip
+    summary = make_summary()
+    summary["scenario"] = {**summary["scenario"], **_scenario_summary(sc)}
+    summary["chosen"] = {**summary["chosen"], "features": {"pattern": 2.0, "tpanel": 1.5e-3},
+                         "performance": {"y": 140.2, "thick": 1.0}}  # fmt: skip
+    page = write_report_page(folder, summary).read_text(encoding="utf-8")
+    rows = {r[0]: r[1] for r in _parse(page).tables["design-table"] if len(r) == 2}
+    assert rows["thick"] == "1 (offset)"
+    assert rows["pattern"] == "2 (TMP)"
+    assert rows["tpanel"] == "1.5 mm" and rows["y"] == "140.2 N/m"
+    # a summary written before (no names) reads as it did
+    page = write_report_page(folder, make_summary()).read_text(encoding="utf-8")
+    assert {r[0]: r[1] for r in _parse(page).tables["design-table"] if len(r) == 2}["m"] == "12"
+
+
 def test_the_answer_comes_first_and_says_how_it_was_found(folder):
     page = _visible(report_page_html(folder, make_summary()))
     sections = re.findall(r'<section id="([a-z]+)"', page)
