@@ -71,6 +71,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "steady_temperature",
             "heat_input_matrix",
             "crease_temperature_matrix",
+            "HeatMatrices",
             "timoshenko_curvature",
             "Bimorph",
             "ThermalState",

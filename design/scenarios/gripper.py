@@ -57,10 +57,9 @@ from holofold.mechanics.status import CONVERGED, Outcome, Status
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.thermal import (
     Bimorph,
+    HeatMatrices,
     ThermalState,
-    crease_temperature_matrix,
     electrothermal_stage,
-    heat_input_matrix,
     initial_thermal_state,
     thermal_model,
 )
@@ -646,8 +645,7 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
         dissipation_deg=mat.dissipation_deg,
         room_temperature=mat.room_temperature,
     )
-    H = heat_input_matrix(s.creases.nodes, s.n_nodes)
-    A = crease_temperature_matrix(s.creases.nodes, s.n_nodes)
+    matrices = HeatMatrices.of(s)
     a, b = n.tips
     state, dist, tmax, unconverged = start, [], [], 0
     closing, status = None, STATUS_NO_CLOSURE
@@ -655,7 +653,7 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
         factor, tol = _ramp(g.kind, step)
         state, results = electrothermal_stage(
             s, thermal, model.bimorph, state, factor * options.q_load * model.heat_length,
-            **options.tolerance(tol, "force"), assembler=asm, heat_matrix=H, temp_matrix=A,
+            **options.tolerance(tol, "force"), assembler=asm, matrices=matrices,
         )  # fmt: skip
         unconverged += sum(int(not r.ok) for r in results)
         x = s.nodes + state.U
