@@ -31,7 +31,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "CurveError",
             "PlanarCurve",
             "builtin_curve",
-            "load_curve",
             "parse_curve_spec",
         ],
         "curve_files": [
@@ -48,6 +47,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "check_curve_size",
             "read_points_csv",
             "read_svg_curve",
+            "load_curve",
         ],
         "error": ["ClosestPointError", "closest_point_error", "index_matched_error", "paper_error"],
         "strip": ["SAMPLINGS", "MAX_M", "StripGeometry", "strip_geometry"],

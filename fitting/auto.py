@@ -22,7 +22,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from holofold.fitting.curves import load_curve
+from holofold.fitting.curve_files import load_curve
 from holofold.fitting.error import closest_point_error, index_matched_error
 from holofold.fitting.strip import (
     check_m,
@@ -88,7 +88,7 @@ def fit_auto(
 
     Parameters
     ----------
-    curve : PlanarCurve or anything :func:`holofold.fitting.curves.load_curve` accepts
+    curve : PlanarCurve or anything :func:`holofold.fitting.curve_files.load_curve` accepts
     tolerance : float
         Allowed closest-point error, metres (> 0); met if error <= tolerance (1 + 1e-9).
     m_range : iterable of int

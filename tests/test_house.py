@@ -41,7 +41,6 @@ LEFT = [
         for m in ("readers", "svg_reader", "dxf_reader", "fold_reader", "opx_reader")
     },  # fmt: skip
     {"holofold.design.scenarios.gripper", "holofold.design.scenarios.gripper_kind"},
-    {"holofold.fitting.curves", "holofold.fitting.curve_files"},
 ]
 
 
