@@ -113,9 +113,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "reader_for",
             "READERS",
             "PatternReader",
-            "PatternWarning",
-            "pattern_from_lines",
         ],
+        "line_drawing": ["PatternWarning", "pattern_from_lines"],
         "printable": [
             "PrintableLayout",
             "printable_layout",

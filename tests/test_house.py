@@ -35,11 +35,7 @@ LEFT = [
             "solvers.selffold",
             "thermal",
         )
-    },  # fmt: skip
-    {
-        "holofold.geometry." + m
-        for m in ("readers", "svg_reader", "dxf_reader", "fold_reader", "opx_reader")
-    },  # fmt: skip
+    },
     {"holofold.design.scenarios.gripper", "holofold.design.scenarios.gripper_kind"},
 ]
 
