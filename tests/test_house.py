@@ -36,7 +36,6 @@ LEFT = [
             "thermal",
         )
     },
-    {"holofold.design.scenarios.gripper", "holofold.design.scenarios.gripper_kind"},
 ]
 
 
