@@ -23,6 +23,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "AutoFit",
             "FitNotFoundError",
             "fit_auto",
+            "ThickCheck",
             "DEFAULT_M_RANGE",
             "PUBLISHED_MAX_WARP",
         ],
