@@ -43,6 +43,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "folding": [
             "fold_pattern",
+            "FoldSettings",
             "FoldResult",
             "fold_targets",
             "crease_classes",

@@ -91,13 +91,8 @@ def test_no_import_circle_but_those_left():
 
 
 #: public functions still over 12 parameters: the forest's hyperparameters (a scikit-learn
-#: estimator's are its __init__'s), generate_database (store.py: other work) and fold_pattern
-#: (it wants a settings record)
-OVER_12 = {
-    "design/rules/miner.py __init__",
-    "design/store.py generate_database",
-    "mechanics/folding.py fold_pattern",
-}
+#: estimator's are its __init__'s) and generate_database (store.py: other work)
+OVER_12 = {"design/rules/miner.py __init__", "design/store.py generate_database"}
 
 
 def test_no_public_function_takes_over_12_parameters_but_those_left():
