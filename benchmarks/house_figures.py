@@ -174,26 +174,33 @@ def _returns(fn) -> list:
 
 
 def wide_tuples(trees: dict) -> list[str]:
-    """Functions returning a bare tuple of 4+ that another module of the library uses."""
-    imported = defaultdict(set)  # name -> modules importing it by name
+    """Functions returning a bare tuple of 4+ that another module of the library uses: a
+    function imported by name from its module or from its layer's face, a method (or a
+    function) called as ``.name`` in another module (by name only: an over-count is possible
+    for common method names)."""
+    imported = defaultdict(set)  # (module imported from, name) -> modules importing it
     attributes = defaultdict(set)  # attribute name -> modules using it
     for module, tree in trees.items():
         for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom):
+            if isinstance(node, ast.ImportFrom) and node.module:
                 for a in node.names:
-                    imported[a.name].add(module)
+                    imported[(node.module, a.name)].add(module)
             elif isinstance(node, ast.Attribute):
                 attributes[node.attr].add(module)
     out = []
     for module, tree in trees.items():
+        face = ".".join(module.split(".")[:2])
         for qual, fn, method, _ in _functions(tree):
             width = max([_tuple_width(fn.returns)] + [_tuple_width(r) for r in _returns(fn)])
             if width < 4:
                 continue
             name = qual.rsplit(".", 1)[-1]
-            users = attributes[name] if method else imported[name] | attributes[name]
-            users = users - {module}
-            if users:
+            users = set(attributes[name])
+            if not method:
+                users |= imported[(module, name)] | imported[(face, name)]
+                if name.startswith("_"):  # a private function: only an import crosses
+                    users = imported[(module, name)]
+            if users - {module}:
                 out.append(f"{module}.{qual} ({width})")
     return sorted(out)
 
