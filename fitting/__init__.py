@@ -23,6 +23,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "AutoFit",
             "FitNotFoundError",
             "fit_auto",
+            "ThickCheck",
             "DEFAULT_M_RANGE",
             "PUBLISHED_MAX_WARP",
         ],
@@ -31,7 +32,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "CurveError",
             "PlanarCurve",
             "builtin_curve",
-            "load_curve",
             "parse_curve_spec",
         ],
         "curve_files": [
@@ -48,6 +48,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "check_curve_size",
             "read_points_csv",
             "read_svg_curve",
+            "load_curve",
         ],
         "error": ["ClosestPointError", "closest_point_error", "index_matched_error", "paper_error"],
         "strip": ["SAMPLINGS", "MAX_M", "StripGeometry", "strip_geometry"],

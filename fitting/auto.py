@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 
-from holofold.fitting.curves import load_curve
+from holofold.fitting.curve_files import load_curve
 from holofold.fitting.error import closest_point_error, index_matched_error
 from holofold.fitting.strip import (
     check_m,
@@ -39,7 +40,14 @@ from holofold.geometry.clearance import printability
 from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
 from holofold.geometry.thick import TECHNIQUES, path_overlap, thick_panels
 
-__all__ = ["AutoFit", "FitNotFoundError", "fit_auto", "DEFAULT_M_RANGE", "PUBLISHED_MAX_WARP"]
+__all__ = [
+    "AutoFit",
+    "FitNotFoundError",
+    "ThickCheck",
+    "fit_auto",
+    "DEFAULT_M_RANGE",
+    "PUBLISHED_MAX_WARP",
+]
 
 #: largest relative quad warp of the 3000 published arch designs (0.0347, rounded up)
 PUBLISHED_MAX_WARP = 0.035
@@ -58,6 +66,32 @@ class FitNotFoundError(ParameterError):
     def __init__(self, message: str, candidates: pd.DataFrame):
         super().__init__(message)
         self.candidates = candidates
+
+
+@dataclass(frozen=True)
+class ThickCheck:
+    """The folded thick panels :func:`fit_auto` builds for every candidate strip: panel
+    thickness t and crease width W (m; both, or neither: no thick panels), the technique
+    (:data:`~holofold.geometry.thick.TECHNIQUES`) and whether a candidate whose panels overlap
+    is refused. Checked by :func:`fit_auto`, with its messages."""
+
+    panel_thickness: float | None = None
+    crease_width: float | None = None
+    require_no_overlap: bool = False
+    thick: str = "centred"
+
+
+def _thick_check(given: ThickCheck | None, options: dict) -> ThickCheck:
+    """The record, or one made of the former keywords (``panel_thickness=``, ...)."""
+    fields = ThickCheck.__dataclass_fields__
+    for k in options:
+        if k not in fields:
+            raise TypeError(f"fit_auto() got an unexpected keyword argument {k!r}")
+    if given is None:
+        return ThickCheck(**options)
+    if options:
+        raise TypeError(f"fit_auto(thick_check=...): give {next(iter(options))} in the record")
+    return given
 
 
 class AutoFit(NamedTuple):
@@ -79,16 +113,14 @@ def fit_auto(
     metric: str = "max",
     prefer: str = "largest-offset",
     max_warp: float | None = PUBLISHED_MAX_WARP,
-    panel_thickness: float | None = None,
-    crease_width: float | None = None,
-    require_no_overlap: bool = False,
-    thick: str = "centred",
+    thick_check: ThickCheck | None = None,
+    **thick_options,
 ) -> AutoFit:
     """Smallest m (and an offset) whose strip's closest-point error meets ``tolerance``.
 
     Parameters
     ----------
-    curve : PlanarCurve or anything :func:`holofold.fitting.curves.load_curve` accepts
+    curve : PlanarCurve or anything :func:`holofold.fitting.curve_files.load_curve` accepts
     tolerance : float
         Allowed closest-point error, metres (> 0); met if error <= tolerance (1 + 1e-9).
     m_range : iterable of int
@@ -107,15 +139,15 @@ def fit_auto(
         Which qualifying offset to take at the smallest m.
     max_warp : float or None
         Largest allowed relative quad warp (diagonal distance / mean diagonal; None: any).
-    panel_thickness, crease_width : float, optional
-        t and W, m: the folded thick panels' ``overlap`` (m^3) and ``clearance`` (m) are
-        reported for the candidates built.
-    require_no_overlap : bool
-        Refuse candidates whose thick panels overlap (needs both of the above).
-    thick : str
-        The thick panels' technique (:data:`~holofold.geometry.thick.TECHNIQUES`): the
+    thick_check : ThickCheck, optional
+        The folded thick panels of every candidate built: with ``panel_thickness`` and
+        ``crease_width`` (t and W, m) their ``overlap`` (m^3) and ``clearance`` (m) are
+        reported; ``require_no_overlap`` refuses candidates whose panels overlap (needs both);
+        ``thick`` is the technique (:data:`~holofold.geometry.thick.TECHNIQUES`): the
         ``overlap`` is that of these panels (:func:`~holofold.geometry.thick.path_overlap` in
         the folded state); ``clearance`` stays that of centred slabs.
+    **thick_options
+        The record's fields by name instead (``panel_thickness=6e-3, crease_width=1e-3``).
 
     Returns
     -------
@@ -129,6 +161,9 @@ def fit_auto(
     FitNotFoundError
         When no candidate qualifies (the message names the best error reached).
     """
+    tc = _thick_check(thick_check, thick_options)
+    panel_thickness, crease_width = tc.panel_thickness, tc.crease_width
+    require_no_overlap, thick = tc.require_no_overlap, tc.thick
     curve = load_curve(curve)
     tol = check_range("tolerance", tolerance, 0.0, None, low_open=True)
     if metric not in ("max", "mean"):

@@ -27,7 +27,12 @@ from pathlib import Path
 
 import numpy as np
 
-from holofold.fitting.curves import CurveError, CurveFormatError, PlanarCurve
+from holofold.fitting.curves import (
+    CurveFormatError,
+    PlanarCurve,
+    parse_curve_spec,
+    svg_path_curve,
+)
 from holofold.geometry.inputs import check_input_file
 from holofold.geometry.units import LENGTH_UNITS, length_factor
 
@@ -45,6 +50,7 @@ __all__ = [
     "check_curve_size",
     "read_points_csv",
     "read_svg_curve",
+    "load_curve",
 ]
 
 #: (smallest, largest) extent of a target curve that is plausible for an origami part, m
@@ -348,7 +354,7 @@ def read_svg_curve(ref, units: str | None = None, *, check_size: bool = True) ->
     # svgelements maps the viewBox to CSS px: back to user units, then to metres
     scale = _user_per_px(svg) * per_user
     name = pid or Path(file).stem
-    curve = _curve_of(SvgPath(el), name, ref, scale)
+    curve = svg_path_curve(SvgPath(el), name, ref, scale)
     params = {**curve.params, "units": label, "metres_per_unit": per_user}
     curve = PlanarCurve(curve.func, name=name, kind="svg", params=params)
     if check_size:
@@ -465,32 +471,29 @@ def _expanded(elements: int, points: int, refs: dict, named: dict, file: str) ->
     return total(elements, points, refs, frozenset())
 
 
-def _curve_of(path, name: str, source: str, scale: float) -> PlanarCurve:
-    """Sample an svgelements Path (one subpath) densely; ``scale`` m per coordinate unit."""
-    from svgelements import Close, Move
+# ---------------------------------------------------------------------- any description
+def load_curve(curve, units: str | None = None, *, check_size: bool = True) -> PlanarCurve:
+    """A :class:`PlanarCurve` from any accepted description.
 
-    segs = [s for s in path if not isinstance(s, Move)]
-    moves = sum(isinstance(s, Move) for s in path)
-    if moves > 1:
-        raise CurveFormatError(
-            f"SVG path {name!r} has {moves} subpaths (M commands); a curve is one line: put "
-            "the one to fit in a <path id=...> of its own and read it with file.svg#id"
-        )
-    if isinstance(segs[-1:] and segs[-1], Close) and segs[-1].length() == 0:
-        segs = segs[:-1]
-    if not segs:
-        raise CurveFormatError(f"SVG path {name!r} has no segments")
-    lengths = np.array([float(s.length()) for s in segs])
-    if not np.isfinite(lengths).all() or lengths.sum() <= 0:
-        raise CurveError(f"SVG path {name!r} has zero or non-finite length")
-    n_seg = np.maximum(2, np.ceil(2048 * lengths / lengths.sum()).astype(int))
-    pts = []
-    for seg, n, ln in zip(segs, n_seg, lengths, strict=True):
-        if ln <= 0:
-            continue
-        ts = np.linspace(0.0, 1.0, n + 1)[(1 if pts else 0) :]
-        pts.append(np.asarray(seg.npoint(ts), float).reshape(-1, 2))
-    xy = np.concatenate(pts) * scale
-    xz = np.column_stack([xy[:, 0], -xy[:, 1]])
-    xz -= xz[0]
-    return PlanarCurve.from_points(xz, name=name, degree=1, source=source)
+    ``curve`` may be a PlanarCurve, a callable, an (N, 2) array, a built-in specification
+    string (``"parabola:span=4,height=1"``), a CSV/TXT file of points or an SVG file
+    (optionally ``file.svg#path-id``). ``units`` is the unit of a file's numbers
+    (CSV default m, SVG default the document's own);
+    ``check_size`` warns about a file's curve of implausible size.
+    """
+    if isinstance(curve, PlanarCurve):
+        return curve
+    if isinstance(curve, (str, Path)):
+        s = str(curve)
+        file = s.partition("#")[0]
+        low = file.lower()
+        if low.endswith(".svg"):
+            return read_svg_curve(s, units, check_size=check_size)
+        if low.endswith((".csv", ".txt", ".dat")) or Path(file).is_file():
+            if not Path(file).is_file():
+                raise CurveFormatError(f"points file {file!r} does not exist")
+            return read_points_csv(file, units or "m", check_size=check_size)
+        return parse_curve_spec(s)
+    if callable(curve):
+        return PlanarCurve.from_function(curve)
+    return PlanarCurve.from_points(curve)

@@ -33,7 +33,6 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -46,7 +45,7 @@ __all__ = [
     "BUILTIN_CURVES",
     "builtin_curve",
     "parse_curve_spec",
-    "load_curve",
+    "svg_path_curve",
 ]
 
 log = logging.getLogger(__name__)
@@ -175,15 +174,13 @@ class PlanarCurve:
         with its units and transforms is read by
         :func:`~holofold.fitting.curve_files.read_svg_curve`.
         """
-        from holofold.fitting.curve_files import _curve_of
-
         try:
             from svgelements import Path as SvgPath
 
             path = SvgPath(d)
         except Exception as exc:
             raise CurveFormatError(f"cannot parse SVG path data {d[:60]!r}: {exc}") from exc
-        curve = _curve_of(path, name, source or "svg path", 1.0)
+        curve = svg_path_curve(path, name, source or "svg path", 1.0)
         return cls(curve.func, name=name, kind="svg", params={"d": d[:200], **curve.params})
 
     def __getstate__(self) -> dict:
@@ -524,31 +521,34 @@ def parse_curve_spec(spec: str) -> PlanarCurve:
     return builtin_curve(name, **params)
 
 
-# ---------------------------------------------------------------------- any description
-def load_curve(curve, units: str | None = None, *, check_size: bool = True) -> PlanarCurve:
-    """A :class:`PlanarCurve` from any accepted description.
+def svg_path_curve(path, name: str, source: str, scale: float) -> PlanarCurve:
+    """The curve of an svgelements ``Path`` (one subpath), sampled densely (every segment,
+    points in proportion to its length) and interpolated linearly in arc length; ``scale`` m
+    per coordinate unit, y down in SVG -> z = -y, the origin at the path's first point."""
+    from svgelements import Close, Move
 
-    ``curve`` may be a PlanarCurve, a callable, an (N, 2) array, a built-in specification
-    string (``"parabola:span=4,height=1"``), a CSV/TXT file of points or an SVG file
-    (optionally ``file.svg#path-id``). ``units`` is the unit of a file's numbers
-    (:mod:`~holofold.fitting.curve_files`: CSV default m, SVG default the document's own);
-    ``check_size`` warns about a file's curve of implausible size.
-    """
-    if isinstance(curve, PlanarCurve):
-        return curve
-    if isinstance(curve, (str, Path)):
-        from holofold.fitting.curve_files import read_points_csv, read_svg_curve
-
-        s = str(curve)
-        file = s.partition("#")[0]
-        low = file.lower()
-        if low.endswith(".svg"):
-            return read_svg_curve(s, units, check_size=check_size)
-        if low.endswith((".csv", ".txt", ".dat")) or Path(file).is_file():
-            if not Path(file).is_file():
-                raise CurveFormatError(f"points file {file!r} does not exist")
-            return read_points_csv(file, units or "m", check_size=check_size)
-        return parse_curve_spec(s)
-    if callable(curve):
-        return PlanarCurve.from_function(curve)
-    return PlanarCurve.from_points(curve)
+    segs = [s for s in path if not isinstance(s, Move)]
+    moves = sum(isinstance(s, Move) for s in path)
+    if moves > 1:
+        raise CurveFormatError(
+            f"SVG path {name!r} has {moves} subpaths (M commands); a curve is one line: put "
+            "the one to fit in a <path id=...> of its own and read it with file.svg#id"
+        )
+    if isinstance(segs[-1:] and segs[-1], Close) and segs[-1].length() == 0:
+        segs = segs[:-1]
+    if not segs:
+        raise CurveFormatError(f"SVG path {name!r} has no segments")
+    lengths = np.array([float(s.length()) for s in segs])
+    if not np.isfinite(lengths).all() or lengths.sum() <= 0:
+        raise CurveError(f"SVG path {name!r} has zero or non-finite length")
+    n_seg = np.maximum(2, np.ceil(2048 * lengths / lengths.sum()).astype(int))
+    pts = []
+    for seg, n, ln in zip(segs, n_seg, lengths, strict=True):
+        if ln <= 0:
+            continue
+        ts = np.linspace(0.0, 1.0, n + 1)[(1 if pts else 0) :]
+        pts.append(np.asarray(seg.npoint(ts), float).reshape(-1, 2))
+    xy = np.concatenate(pts) * scale
+    xz = np.column_stack([xy[:, 0], -xy[:, 1]])
+    xz -= xz[0]
+    return PlanarCurve.from_points(xz, name=name, degree=1, source=source)

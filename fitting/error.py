@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.fitting.curves import PlanarCurve, load_curve
+from holofold.fitting.curve_files import load_curve
+from holofold.fitting.curves import PlanarCurve
 from holofold.fitting.strip import chord_normals
 from holofold.geometry.errors import ParameterError
 
@@ -57,7 +58,7 @@ def paper_error(curve, m, offset, seg: int = SEG):
 
     Parameters
     ----------
-    curve : PlanarCurve or spec accepted by :func:`holofold.fitting.curves.load_curve`
+    curve : PlanarCurve or spec accepted by :func:`holofold.fitting.curve_files.load_curve`
         The target (the paper: ``half-circle:radius=2``).
     m : int or array_like of int
         Number of Miura units (>= 1 here; the strip itself needs >= 2).

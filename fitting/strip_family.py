@@ -13,7 +13,7 @@ __all__ = ["FAMILY"]
 
 
 def _build(v: dict, label):
-    from holofold.fitting.curves import load_curve
+    from holofold.fitting.curve_files import load_curve
     from holofold.fitting.strip_fit import fit_strip
 
     return fit_strip(

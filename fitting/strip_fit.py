@@ -14,7 +14,8 @@ from functools import cached_property
 
 import numpy as np
 
-from holofold.fitting.curves import PlanarCurve, load_curve
+from holofold.fitting.curve_files import load_curve
+from holofold.fitting.curves import PlanarCurve
 from holofold.fitting.error import ClosestPointError, closest_point_error, index_matched_error
 from holofold.fitting.strip import (
     StripGeometry,
@@ -168,7 +169,7 @@ def fit_strip(
 
     Parameters
     ----------
-    curve : PlanarCurve or anything :func:`~holofold.fitting.curves.load_curve` accepts
+    curve : PlanarCurve or anything :func:`~holofold.fitting.curve_files.load_curve` accepts
         Target curve in the x-z plane, metres.
     m : int
         Number of Miura units, >= 2 (2m centre-line segments). The paper uses even m so that

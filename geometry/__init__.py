@@ -61,8 +61,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "PathOverlap",
             "miura_path",
             "thick_panel_mesh",
-            "thick_printable",
         ],
+        "thick_part": ["thick_printable"],
         "facets": ["split_faces", "nonconvex_faces", "SPLIT_MODES"],
         "families": [
             "Parameter",
@@ -113,9 +113,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "reader_for",
             "READERS",
             "PatternReader",
-            "PatternWarning",
-            "pattern_from_lines",
         ],
+        "line_drawing": ["PatternWarning", "pattern_from_lines"],
         "printable": [
             "PrintableLayout",
             "printable_layout",

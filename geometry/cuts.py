@@ -13,9 +13,26 @@ passive crease.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-__all__ = ["separate_cuts"]
+__all__ = ["SeparatedCuts", "separate_cuts"]
+
+
+class SeparatedCuts(NamedTuple):
+    """What :func:`separate_cuts` returns (a tuple, so ``xy, faces, ... = separate_cuts(...)``
+    still unpacks): the new vertices (nv', d), faces, edges (ne', 2), assignment and fold
+    angle (ne',), ``origin`` (nv',) the original vertex of each, and notes (one line per
+    problem)."""
+
+    coords: np.ndarray
+    faces: list
+    edges: np.ndarray
+    assignment: np.ndarray
+    fold_angle: np.ndarray
+    origin: np.ndarray
+    notes: tuple
 
 
 def _find(parent: np.ndarray, i: int) -> int:
@@ -27,7 +44,7 @@ def _find(parent: np.ndarray, i: int) -> int:
     return root
 
 
-def separate_cuts(coords, faces, edges, assignment, fold_angle):
+def separate_cuts(coords, faces, edges, assignment, fold_angle) -> SeparatedCuts:
     """Faces on both sides of every ``C`` edge made to share no edge there.
 
     Parameters
@@ -41,8 +58,9 @@ def separate_cuts(coords, faces, edges, assignment, fold_angle):
 
     Returns
     -------
-    coords, faces, edges, assignment, fold_angle, origin, notes
-        The new arrays (vertices copied where the cuts split them; ``origin`` (nv',) the
+    SeparatedCuts
+        coords, faces, edges, assignment, fold_angle, origin, notes: the new arrays
+        (vertices copied where the cuts split them; ``origin`` (nv',) the
         original vertex of each), edges in order of first use by the faces, and notes (one
         line per problem).
     """
@@ -53,7 +71,7 @@ def separate_cuts(coords, faces, edges, assignment, fold_angle):
     faces = [np.asarray(f, np.int64) for f in faces]
     nv = len(coords)
     if not (asg == "C").any():
-        return coords, faces, edges, asg, ang, np.arange(nv), ()
+        return SeparatedCuts(coords, faces, edges, asg, ang, np.arange(nv), ())
     sizes = np.array([len(f) for f in faces])
     fv = np.concatenate(faces)
     start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
@@ -105,4 +123,6 @@ def separate_cuts(coords, faces, edges, assignment, fold_angle):
             "they cannot open: kept joined (a passive crease)"
         )
         new_asg[ids] = "U"
-    return coords[origin], new_faces, new_edges, new_asg, new_ang, origin, tuple(notes)
+    return SeparatedCuts(
+        coords[origin], new_faces, new_edges, new_asg, new_ang, origin, tuple(notes)
+    )

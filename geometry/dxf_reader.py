@@ -29,6 +29,7 @@ import numpy as np
 
 from holofold.geometry.bounded import check_dxf_pattern
 from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
+from holofold.geometry.line_drawing import pattern_from_lines
 
 __all__ = ["read_dxf_pattern", "dxf_lines", "LAYER_CODES", "ACI_CODES", "MAX_DXF_BYTES"]
 
@@ -214,8 +215,6 @@ def dxf_lines(path, *, curves: str = "keep"):
 def read_dxf_pattern(path, *, tol: float | None = None, unit: float | None = None,
                      split: str = "as-needed", curves: str = "keep"):  # fmt: skip
     """The crease pattern of a DXF file (see the module docstring), metres."""
-    from holofold.geometry.readers import pattern_from_lines
-
     name = Path(path).name
     S, codes, angles, file_unit, notes = dxf_lines(path, curves=curves)
     if unit is not None:

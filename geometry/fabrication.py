@@ -203,8 +203,8 @@ def write_fabrication_set(
         path_overlap,
         thick_panel_mesh,
         thick_panels,
-        thick_printable,
     )
+    from holofold.geometry.thick_part import thick_printable
     from holofold.geometry.units import length_factor
 
     length_factor(units)

@@ -13,11 +13,26 @@ with more than three vertices, as Origami Simulator does; ``"none"`` leaves them
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from holofold.geometry.errors import ParameterError
 
-__all__ = ["split_faces", "nonconvex_faces", "unfannable_faces", "SPLIT_MODES"]
+__all__ = ["SplitFaces", "split_faces", "nonconvex_faces", "unfannable_faces", "SPLIT_MODES"]
+
+
+class SplitFaces(NamedTuple):
+    """What :func:`split_faces` returns (a tuple, so it still unpacks): the new faces (a split
+    face's triangles in its place), the edges (ne', 2) with the added ``J`` edges last, their
+    assignment and fold angle (ne',), and ``n_split``, how many faces were split."""
+
+    faces: list
+    edges: np.ndarray
+    assignment: np.ndarray
+    fold_angle: np.ndarray
+    n_split: int
+
 
 #: which faces :func:`split_faces` triangulates
 SPLIT_MODES = ("as-needed", "all", "none")
@@ -62,7 +77,7 @@ def unfannable_faces(xy, faces, rel_area: float = 1e-3) -> np.ndarray:
     return np.array(bad, np.intp)
 
 
-def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed"):
+def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed") -> SplitFaces:
     """Triangulate faces (see the module docstring).
 
     Parameters
@@ -77,8 +92,9 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
 
     Returns
     -------
-    faces, edges, assignment, fold_angle, n_split
-        The new faces (a split face's triangles in its place), the edges with the added ``J``
+    SplitFaces
+        faces, edges, assignment, fold_angle, n_split: the new faces (a split face's
+        triangles in its place), the edges with the added ``J``
         edges last, and how many faces were split.
     """
     if mode not in SPLIT_MODES:
@@ -89,13 +105,13 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
     asg = np.asarray(assignment)
     ang = np.asarray(fold_angle, float)
     if mode == "none":
-        return faces, edges, asg, ang, 0
+        return SplitFaces(faces, edges, asg, ang, 0)
     if mode == "all":
         todo = {k for k, f in enumerate(faces) if len(f) > 3}
     else:
         todo = set(unfannable_faces(xy, faces).tolist())
     if not todo:
-        return faces, edges, asg, ang, 0
+        return SplitFaces(faces, edges, asg, ang, 0)
     import manifold3d
 
     out: list[np.ndarray] = []
@@ -117,4 +133,4 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
         edges = np.vstack([edges, np.array(added, np.int64)])
         asg = np.concatenate([asg, np.full(len(added), "J", dtype=asg.dtype)])
         ang = np.concatenate([ang, np.zeros(len(added))])
-    return out, edges, asg, ang, len(todo)
+    return SplitFaces(out, edges, asg, ang, len(todo))

@@ -30,6 +30,7 @@ import numpy as np
 
 from holofold.geometry.errors import FormatError
 from holofold.geometry.fold_io import _UNITS, MAX_FOLD_BYTES, _Bad, _parse, load_fold
+from holofold.geometry.line_drawing import PatternWarning, finish_pattern, pattern_from_lines
 from holofold.geometry.pattern import ASSIGNMENTS
 
 __all__ = ["read_fold_pattern", "fold_frames"]
@@ -87,8 +88,6 @@ def _is_cp(fr: dict) -> bool:
 def read_fold_pattern(path, *, frame: int | None = None, unit: float | None = None,
                       split: str = "as-needed"):  # fmt: skip
     """The crease pattern of a FOLD file (see the module docstring), metres."""
-    from holofold.geometry.readers import PatternWarning, finish_pattern
-
     path = Path(path)
     name = path.name
     where = f"FOLD file {name!r}"
@@ -267,8 +266,6 @@ def _scaled(coords, scale: float, where: str):
 
 
 def _from_edges(fr: dict, where: str, name: str, split: str, notes):
-    from holofold.geometry.readers import pattern_from_lines
-
     try:
         X = np.asarray(fr["vertices_coords"], float)[:, :2]
         E = np.asarray(fr["edges_vertices"], np.int64).reshape(-1, 2)

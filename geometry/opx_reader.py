@@ -19,6 +19,7 @@ import numpy as np
 
 from holofold.geometry.bounded import check_token_count
 from holofold.geometry.errors import FormatError, ParameterError
+from holofold.geometry.line_drawing import pattern_from_lines
 
 __all__ = ["read_opx_pattern", "read_cp_pattern", "ORIPA_TYPES", "MAX_ORIPA_BYTES"]
 
@@ -121,8 +122,6 @@ def _finish(name, segs, codes, aux):
 
 
 def _read(lines, path, tol, unit, split):
-    from holofold.geometry.readers import pattern_from_lines
-
     name = Path(path).name
     S, codes, angles, notes = lines(path)
     if unit is not None:

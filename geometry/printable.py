@@ -53,6 +53,7 @@ from holofold.geometry.errors import (
 )
 from holofold.geometry.pattern import CreasePattern
 from holofold.geometry.solid import corner_edges, offset_corners
+from holofold.geometry.thick import panel_solids_of
 
 # trimesh (with scipy.spatial and scipy.optimize) costs 0.5-1 s to import; it loads on first use
 trimesh = lazy_loader.load("trimesh")
@@ -356,8 +357,6 @@ def folded_printable_solid(
     parts = []
     shift = 0.0
     if panels is not None:
-        from holofold.geometry.thick import panel_solids_of
-
         parts = panel_solids_of(pattern, panels)
         shift = panels.side * tc / 2  # the hinge's mid-surface, along the panel normal
     for f, (a, k) in enumerate(zip(starts, sizes, strict=True)):  # the thick panels

@@ -402,7 +402,7 @@ def segment_part(
         How far a joint at a crease runs into the later piece's panel beyond the hinge, m.
     panels : ThickPanels, optional
         Offset or tapered panels (:func:`~holofold.geometry.thick.thick_panels`): the part is
-        :func:`~holofold.geometry.thick.thick_printable`'s, each piece printed the way up it
+        :func:`~holofold.geometry.thick_part.thick_printable`'s, each piece printed the way up it
         prints (hinge face on the bed); default the centred part of ``printable_solid``.
     """
     import manifold3d as m3d
@@ -419,7 +419,7 @@ def segment_part(
     if panels is None or panels.technique == "centred":
         part_m = printable_solid(pattern, panel_thickness, crease_thickness, crease_width)
     else:
-        from holofold.geometry.thick import thick_printable, turned_over
+        from holofold.geometry.thick_part import thick_printable, turned_over
 
         part_m = thick_printable(pattern, panels, crease_thickness, turn=False)
         flip = turned_over(pattern, panels)

@@ -33,6 +33,7 @@ import numpy as np
 
 from holofold.geometry.bounded import check_svg_pattern
 from holofold.geometry.errors import FormatError, ParameterError
+from holofold.geometry.line_drawing import pattern_from_lines
 
 __all__ = ["read_svg_pattern", "svg_lines", "SVG_COLOURS", "CURVE_MODES", "MAX_SVG_BYTES"]
 
@@ -307,8 +308,6 @@ def read_svg_pattern(
     ``split``: which faces to triangulate (:data:`~holofold.geometry.facets.SPLIT_MODES`);
     ``curves``: :data:`CURVE_MODES`.
     """
-    from holofold.geometry.readers import pattern_from_lines
-
     name = Path(path).name
     if unit is not None and not (
         isinstance(unit, int | float) and math.isfinite(unit) and unit > 0

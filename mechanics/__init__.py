@@ -43,6 +43,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "folding": [
             "fold_pattern",
+            "FoldSettings",
             "FoldResult",
             "fold_targets",
             "crease_classes",
@@ -71,6 +72,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "steady_temperature",
             "heat_input_matrix",
             "crease_temperature_matrix",
+            "HeatMatrices",
             "timoshenko_curvature",
             "Bimorph",
             "ThermalState",

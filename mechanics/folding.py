@@ -62,6 +62,7 @@ from holofold.mechanics.structure import Structure
 
 __all__ = [
     "FoldResult",
+    "FoldSettings",
     "fold_pattern",
     "fold_targets",
     "crease_classes",
@@ -290,6 +291,37 @@ def _section(value, n: int, name: str) -> np.ndarray:
     return a
 
 
+@dataclass(frozen=True)
+class FoldSettings:
+    """How :func:`fold_pattern` folds (each field's meaning: its parameters): the model
+    (``"concentrated"`` or ``"compliant"``) and its switches (``profile``), the steps
+    (``max_step_deg``, degrees; ``rel_tol``; ``max_iter``; ``time_limit``, s;
+    ``extrapolate``), and what stops a fold (``check_intersections``, ``contact``). Checked
+    by :func:`fold_pattern`, with its messages."""
+
+    model: str = "concentrated"
+    profile: Profile = PHYSICAL
+    max_step_deg: float = 3.0
+    rel_tol: float = 1e-7
+    max_iter: int = 30
+    time_limit: float | None = None
+    extrapolate: bool = False
+    check_intersections: bool = True
+    contact: object = None
+
+
+def _fold_settings(given: FoldSettings | None, options: dict) -> FoldSettings:
+    """The record, or one made of the former keywords (``max_step_deg=2.0``, ...)."""
+    for k in options:
+        if k not in FoldSettings.__dataclass_fields__:
+            raise TypeError(f"fold_pattern() got an unexpected keyword argument {k!r}")
+    if given is None:
+        return FoldSettings(**options)
+    if options:
+        raise TypeError(f"fold_pattern(settings=...): give {next(iter(options))} in the record")
+    return given
+
+
 def fold_pattern(
     pattern: CreasePattern,
     fraction: float = 1.0,
@@ -299,17 +331,10 @@ def fold_pattern(
     crease_width,
     E: float = 2e9,
     nu: float = 0.3,
-    model: str = "concentrated",
     target=None,
     supports=None,
-    max_step_deg: float = 3.0,
-    rel_tol: float = 1e-7,
-    max_iter: int = 30,
-    profile: Profile = PHYSICAL,
-    time_limit: float | None = None,
-    extrapolate: bool = False,
-    check_intersections: bool = True,
-    contact=None,
+    settings: FoldSettings | None = None,
+    **options,
 ) -> FoldResult:
     """Fold ``pattern`` towards ``fraction`` x its target fold angles (see the module
     docstring).
@@ -326,12 +351,16 @@ def fold_pattern(
         m (facets take the panel thickness).
     E, nu : float
         Young's modulus (Pa) and Poisson's ratio of panels and creases.
-    model : {"concentrated", "compliant"}
-        One rotational spring per crease, or creases of finite width.
     target : (ne,) float, optional
         Full-fold targets, degrees (default ``pattern.fold_angle``; see :func:`fold_targets`).
     supports : node ids, optional
         Fixed nodes of the model (all three directions); default :func:`default_supports`.
+    settings : FoldSettings, optional
+        How it folds: the fields below (default ``FoldSettings()``).
+    **options
+        The fields of ``settings`` by name instead (``max_step_deg=2.0, time_limit=60``).
+    model : {"concentrated", "compliant"}
+        One rotational spring per crease, or creases of finite width.
     max_step_deg : float
         Largest change of any driven rest angle per step, degrees.
     rel_tol : float
@@ -364,6 +393,10 @@ def fold_pattern(
     from holofold.mechanics.leave_flat import flow_to_equilibrium
     from holofold.mechanics.solvers import solve_selffold
 
+    st = _fold_settings(settings, options)
+    model, profile, max_step_deg, rel_tol = st.model, st.profile, st.max_step_deg, st.rel_tol
+    max_iter, time_limit, extrapolate = st.max_iter, st.time_limit, st.extrapolate
+    check_intersections, contact = st.check_intersections, st.contact
     fraction = check_range("fraction", fraction, 0.0, 1.0)
     max_step_deg = check_range("max_step_deg", max_step_deg, 0.0, 90.0, low_open=True)
     rel_tol = check_range("rel_tol", rel_tol, 0.0, 1.0, low_open=True)

@@ -55,6 +55,7 @@ __all__ = [
     "solve_layered",
     "heat_input_matrix",
     "crease_temperature_matrix",
+    "HeatMatrices",
     "timoshenko_curvature",
     "Bimorph",
     "ThermalState",
@@ -559,6 +560,23 @@ def crease_temperature_matrix(crease_nodes, n_nodes: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.tile(_TEMP_WEIGHT, nci), (rows, cn.ravel())), shape=(nci, n_nodes))
 
 
+@dataclass(frozen=True, eq=False)
+class HeatMatrices:
+    """The two crease matrices of a structure's electro-thermal stages, which depend on its
+    crease nodes only (made once, used at every heating step): ``heat`` (nn, nci), W of each
+    crease to nodal heat (:func:`heat_input_matrix`), and ``temperature`` (nci, nn), nodal
+    temperature rises to each crease's (:func:`crease_temperature_matrix`)."""
+
+    heat: sp.csr_matrix
+    temperature: sp.csr_matrix
+
+    @classmethod
+    def of(cls, structure) -> HeatMatrices:
+        """The matrices of ``structure`` (its ``creases.nodes`` and ``n_nodes``)."""
+        cn, nn = structure.creases.nodes, structure.n_nodes
+        return cls(heat_input_matrix(cn, nn), crease_temperature_matrix(cn, nn))
+
+
 def timoshenko_curvature(dT, d_alpha, t1, t2, E1=1.0, E2=1.0):
     """Bimorph curvature (1/m) for a temperature rise ``dT`` (K), Timoshenko (1925).
 
@@ -680,8 +698,7 @@ def electrothermal_stage(
     max_iter: int = 30,
     profile=None,
     assembler=None,
-    heat_matrix: sp.spmatrix | None = None,
-    temp_matrix: sp.spmatrix | None = None,
+    matrices: HeatMatrices | None = None,
 ):
     """Add heat to the creases and fold quasi-statically (docs/electro-thermal.md §5.3).
 
@@ -705,6 +722,11 @@ def electrothermal_stage(
     profile : Profile, optional
         Quirk switches (default: the structure's): ``thermal_reinterpolate_from_stage_start``
         and ``reset_non_crease_rest_angles``.
+    assembler : Assembler, optional
+        The self-folding solves' assembler (default: one made for ``structure``).
+    matrices : HeatMatrices, optional
+        ``structure``'s crease matrices (default: made here; pass them to share them between
+        stages).
 
     Returns
     -------
@@ -714,7 +736,6 @@ def electrothermal_stage(
         The self-folding solve of each thermal step.
     """
     profile = profile or structure.profile
-    nn = structure.n_nodes
     cid = structure.creases.ids
     nci = len(cid)
     Q = np.asarray(crease_heat, float)
@@ -723,9 +744,9 @@ def electrothermal_stage(
     steps = int(steps)
     if steps < 1:
         raise ValueError(f"steps = {steps!r} must be >= 1")
-    cn = structure.creases.nodes
-    H = heat_input_matrix(cn, nn) if heat_matrix is None else heat_matrix
-    A = crease_temperature_matrix(cn, nn) if temp_matrix is None else temp_matrix
+    if matrices is None:
+        matrices = HeatMatrices.of(structure)
+    H, A = matrices.heat, matrices.temperature
     q_stage = _csr_times(H, Q)
     U = state.U.copy()
     T = state.T

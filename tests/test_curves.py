@@ -8,12 +8,16 @@ import numpy as np
 import pytest
 
 from holofold.fitting import CurveSelectionWarning
-from holofold.fitting.curve_files import CurveUnitWarning, read_points_csv, read_svg_curve
+from holofold.fitting.curve_files import (
+    CurveUnitWarning,
+    load_curve,
+    read_points_csv,
+    read_svg_curve,
+)
 from holofold.fitting.curves import (
     CurveError,
     PlanarCurve,
     builtin_curve,
-    load_curve,
     parse_curve_spec,
 )
 from holofold.geometry.errors import FormatError, ParameterError

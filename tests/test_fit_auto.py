@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from holofold.fitting import fit_strip
-from holofold.fitting.auto import PUBLISHED_MAX_WARP, FitNotFoundError, fit_auto
+from holofold.fitting.auto import PUBLISHED_MAX_WARP, FitNotFoundError, ThickCheck, fit_auto
 from holofold.fitting.curves import parse_curve_spec
 from holofold.geometry.errors import ParameterError
 
@@ -107,6 +107,29 @@ def test_no_overlap_of_the_folded_thick_panels():
     assert chosen["offset"] < over["offset"].max() or chosen["m"] > over["m"].min()
     with pytest.raises(ParameterError, match="needs a panel thickness"):
         fit_auto(HALF, 0.1, require_no_overlap=True)
+
+
+def test_the_thick_panels_as_one_record_or_as_keywords():
+    """``thick_check=ThickCheck(...)`` is the former keywords' fit: the same candidates (the
+    same computation) and the same refusals."""
+    import pandas as pd
+
+    kw = dict(m_range=[4, 6], offsets=[0.05, 0.1, 0.2])
+    old = fit_auto(HALF, 0.1, panel_thickness=6e-3, crease_width=1e-3, require_no_overlap=True,
+                   thick="offset", **kw)  # fmt: skip
+    check = ThickCheck(6e-3, 1e-3, require_no_overlap=True, thick="offset")
+    new = fit_auto(HALF, 0.1, thick_check=check, **kw)
+    pd.testing.assert_frame_equal(old.candidates, new.candidates, rtol=1e-12)
+    chosen = new.candidates[new.candidates["chosen"]].iloc[0]
+    assert chosen["overlap"] == 0.0 and new.strip.m == old.strip.m == chosen["m"]
+    with pytest.raises(ParameterError, match="needs both a panel thickness and a crease width"):
+        fit_auto(HALF, 0.1, thick_check=ThickCheck(panel_thickness=6e-3), **kw)
+    with pytest.raises(ParameterError, match="unknown thickness technique 'thin'"):
+        fit_auto(HALF, 0.1, thick_check=ThickCheck(thick="thin"), **kw)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'panel_thicknes'"):
+        fit_auto(HALF, 0.1, panel_thicknes=6e-3)
+    with pytest.raises(TypeError, match="give crease_width in the record"):
+        fit_auto(HALF, 0.1, thick_check=check, crease_width=2e-3)
 
 
 @pytest.mark.slow

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from holofold.geometry import CreasePattern, miura_sheet
-from holofold.mechanics import fold_pattern, fold_targets, model_energy
+from holofold.mechanics import FoldSettings, fold_pattern, fold_targets, model_energy
 
 SECTION = dict(panel_thickness=1e-3, crease_thickness=0.3e-3, crease_width=1e-3)
 
@@ -118,6 +118,25 @@ def test_energy_split_adds_up():
     assert e.total > 0
     assert e.panel_energy.sum() + e.crease_energy.sum() == pytest.approx(e.total, rel=1e-10)
     assert (e.crease_energy[~p.interior] == 0).all()
+
+
+def test_fold_settings_as_one_record_or_as_keywords():
+    """``settings=FoldSettings(...)`` is the former keywords' fold: the same path (the same
+    computation, to 1e-12), and the same refusals."""
+    p = miura_sheet(3, 3, a=0.02, b=0.02, gamma=1.0, ext=0.5)
+    old = fold_pattern(p, 0.5, model="compliant", max_step_deg=5.0, max_iter=20, **SECTION)
+    st = FoldSettings(model="compliant", max_step_deg=5.0, max_iter=20)
+    new = fold_pattern(p, 0.5, settings=st, **SECTION)
+    assert len(new.U) == len(old.U) >= 2 and new.verdict == old.verdict
+    scale = np.abs(old.U[-1]).max()
+    assert scale > 1e-4  # m: it folded
+    np.testing.assert_allclose(new.U[-1], old.U[-1], rtol=0, atol=1e-12 * scale)
+    with pytest.raises(ValueError, match="model = 'thin'; allowed"):
+        fold_pattern(p, 0.5, settings=FoldSettings(model="thin"), **SECTION)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'max_steps_deg'"):
+        fold_pattern(p, 0.5, max_steps_deg=5.0, **SECTION)
+    with pytest.raises(TypeError, match="give max_iter in the record"):
+        fold_pattern(p, 0.5, settings=st, max_iter=5, **SECTION)
 
 
 def test_folded_pattern_keeps_layout_and_assignment():

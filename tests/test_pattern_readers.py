@@ -143,6 +143,24 @@ def test_a_closed_cut_frees_the_piece_inside():
     assert len(np.unique(_components(p))) == 2
 
 
+def test_cuts_and_split_faces_return_named_records():
+    """``separate_cuts`` and ``split_faces`` return named tuples (issue 35: no bare tuples of
+    4+ across modules): the fields are the unpacked values."""
+    segs = SQUARE + [[[0.5, 0], [0.5, 0.5]], [[0.5, 0.5], [0.5, 1]], [[0, 0.5], [1, 0.5]]]
+    a = arrange_lines(segs, ["B"] * 4 + ["C", "V", "M"], [0] * 4 + [0, 90, -90])
+    cut = separate_cuts(a.vertices, a.faces, a.edges, a.assignment, a.fold_angle)
+    assert cut._fields == ("coords", "faces", "edges", "assignment", "fold_angle", "origin",
+                           "notes")  # fmt: skip
+    assert len(cut.coords) == len(a.vertices) + 1 and (cut.assignment == "C").sum() == 2
+    np.testing.assert_allclose(cut.coords, a.vertices[cut.origin], rtol=0, atol=0)  # copies
+    L = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], float)
+    p = g.CreasePattern.from_faces(np.c_[L, np.zeros(6)], [np.arange(6)], flat=L)
+    sp = split_faces(L, p.faces, p.edges, p.assignment, p.fold_angle)
+    assert sp.n_split == 1 and len(sp.faces) == 4 and len(sp.edges) == len(sp.assignment)
+    assert sum(_area(L, f) for f in sp.faces) == pytest.approx(3.0, abs=1e-12)
+    assert (sp.assignment[p.n_edges :] == "J").all() and len(sp.edges) == p.n_edges + 3
+
+
 def test_only_non_convex_faces_are_split_and_areas_kept():
     L = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], float)
     sq = np.array([[2, 0], [3, 0], [3, 1], [2, 1]], float)

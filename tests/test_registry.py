@@ -6,10 +6,12 @@ package's entry point), no holofold file edited."""
 from __future__ import annotations
 
 import dataclasses
+import re
 import sys
 import textwrap
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import holofold.geometry as g
@@ -105,18 +107,42 @@ def _plugin(tmp_path, monkeypatch, module: str, source: str, group: str, entry: 
     monkeypatch.delitem(sys.modules, module, raising=False)
 
 
+SQUARE_READER = """
+    import holofold.geometry as g
+
+    def read(path, unit=None):
+        \"\"\"One square panel of side 1 (x unit, default 1 m).\"\"\"
+        s = unit or 1.0
+        xy = [[0, 0], [s, 0], [s, s], [0, s]]
+        return g.CreasePattern.from_faces([[*p, 0.0] for p in xy], [[0, 1, 2, 3]], flat=xy)
+
+    READER = g.PatternReader(".sq", "one square", read, ("unit",))
+    """
+DOUBLE_KIND = """
+    from holofold.design import Column, Scenario
+    from holofold.mechanics import CONVERGED
+
+    def from_config(doc, name, description):
+        k = doc.sub("double").number("factor", 2.0)
+        return Scenario(name=name, description=description or "x times k",
+                        features=(Column("x", "m", "a length", 0.0, 1.0),),
+                        performance=(Column("y", "m", "k x"),), check=lambda row: [],
+                        evaluate=lambda row: {"y": k * row["x"], "status": CONVERGED},
+                        kind="double")
+    """
+UNIFORM_STRATEGY = """
+    from holofold.design import Proposal, sample_designs
+
+    def uniform(q):
+        \"\"\"Every round at random, whatever the forest says.\"\"\"
+        return Proposal(sample_designs(q.scenario, q.n, seed=q.seed, start=q.start),
+                        f"uniform-{q.n}-{q.seed}", " at random (uniform strategy)")
+    """
+
+
 def test_recipe_a_reader(tmp_path, monkeypatch):
-    _plugin(tmp_path, monkeypatch, "hf_toy_reader", '''
-        import holofold.geometry as g
-
-        def read(path, unit=None):
-            """One square panel of side 1 (x unit, default 1 m)."""
-            s = unit or 1.0
-            xy = [[0, 0], [s, 0], [s, s], [0, s]]
-            return g.CreasePattern.from_faces([[*p, 0.0] for p in xy], [[0, 1, 2, 3]], flat=xy)
-
-        READER = g.PatternReader(".sq", "one square", read, ("unit",))
-        ''', "holofold.readers", ".sq = :READER")  # fmt: skip
+    _plugin(tmp_path, monkeypatch, "hf_toy_reader", SQUARE_READER, "holofold.readers",
+            ".sq = :READER")  # fmt: skip
     (tmp_path / "a.sq").write_text("square")
     pat = g.read_pattern(tmp_path / "a.sq", unit=0.5)
     assert ".sq" in READERS and pat.n_faces == 1 and np.ptp(pat.coords[:, 0]) == 0.5
@@ -148,18 +174,8 @@ def test_recipe_a_pattern_family(tmp_path, monkeypatch):
 
 
 def test_recipe_a_scenario_kind(tmp_path, monkeypatch):
-    _plugin(tmp_path, monkeypatch, "hf_toy_kind", '''
-        from holofold.design import Column, Scenario
-        from holofold.mechanics import CONVERGED
-
-        def from_config(doc, name, description):
-            k = doc.sub("double").number("factor", 2.0)
-            return Scenario(name=name, description=description or "x times k",
-                            features=(Column("x", "m", "a length", 0.0, 1.0),),
-                            performance=(Column("y", "m", "k x"),), check=lambda row: [],
-                            evaluate=lambda row: {"y": k * row["x"], "status": CONVERGED},
-                            kind="double")
-        ''', "holofold.scenario_kinds", "double = ")  # fmt: skip
+    _plugin(tmp_path, monkeypatch, "hf_toy_kind", DOUBLE_KIND, "holofold.scenario_kinds",
+            "double = ")  # fmt: skip
     (tmp_path / "d.toml").write_text('kind = "double"\n[double]\nfactor = 3.0\n')
     assert read_scenario(tmp_path / "d.toml").evaluate({"x": 0.5})["y"] == 1.5
 
@@ -176,13 +192,106 @@ def test_recipe_a_cutter_profile(tmp_path, monkeypatch):
 
 
 def test_recipe_a_refinement_strategy(tmp_path, monkeypatch):
-    _plugin(tmp_path, monkeypatch, "hf_toy_strategy", '''
-        from holofold.design import Proposal, sample_designs
-
-        def uniform(q):
-            """Every round at random, whatever the forest says."""
-            return Proposal(sample_designs(q.scenario, q.n, seed=q.seed, start=q.start),
-                            f"uniform-{q.n}-{q.seed}", " at random (uniform strategy)")
-        ''', "holofold.refine_strategies", "uniform = :uniform")  # fmt: skip
+    _plugin(tmp_path, monkeypatch, "hf_toy_strategy", UNIFORM_STRATEGY,
+            "holofold.refine_strategies", "uniform = :uniform")  # fmt: skip
     assert LoopSettings(strategy="uniform").strategy == "uniform"
     assert STRATEGIES["uniform"].__doc__.startswith("Every round")
+
+
+# ------------------------------------------------ the same recipes through the command line
+# Each plug-in is again one new module in tmp_path (and its entry-point line); the command
+# line sees it because its choices are the registries' names, read when the parser is built.
+_MIURA = ["--m", "2", "--n", "2", "--gamma", "60", "--ext", "0.5", "--size", "0.1"]
+
+
+def _cli(argv: list[str]) -> int:
+    from holofold.cli import main
+
+    return main([str(a) for a in argv])
+
+
+def test_recipe_a_reader_through_the_cli(tmp_path, monkeypatch, capsys):
+    """``holofold pattern file --path a.sq`` reads the plug-in's suffix (FOLD written back)."""
+    _plugin(tmp_path, monkeypatch, "hf_cli_reader", SQUARE_READER, "holofold.readers",
+            ".sq = :READER")  # fmt: skip
+    (tmp_path / "a.sq").write_text("square")
+    out = tmp_path / "out"
+    assert _cli(["pattern", "file", "--path", tmp_path / "a.sq", "--unit", 0.5, "-o", out]) == 0
+    assert "1 panels, extent 0.5 x 0.5 x 0 m" in capsys.readouterr().out
+    back = g.read_pattern(out / "pattern.fold")
+    assert back.n_faces == 1 and np.allclose(np.ptp(back.coords, axis=0), [0.5, 0.5, 0.0])
+
+
+def test_recipe_a_pattern_family_through_the_cli(tmp_path, monkeypatch, capsys):
+    """``holofold pattern my-miura`` is a sub-command of its own, with the family's options,
+    and makes the same sheet as ``holofold pattern miura``."""
+    _plugin(tmp_path, monkeypatch, "hf_cli_family", '''
+        import dataclasses
+        import holofold.geometry as g
+
+        FAMILY = dataclasses.replace(g.get_family("miura"), name="my-miura",
+                                     description="my Miura sheet")
+        ''', "holofold.pattern_families", "my-miura = :FAMILY")  # fmt: skip
+    from holofold.cli import build_parser
+
+    with pytest.raises(SystemExit):
+        build_parser("pattern").parse_args(["pattern", "--help"])
+    assert "my-miura" in capsys.readouterr().out
+    assert _cli(["pattern", "my-miura", *_MIURA, "-o", tmp_path / "mine"]) == 0
+    assert _cli(["pattern", "miura", *_MIURA, "-o", tmp_path / "ref"]) == 0
+    mine, ref = (g.read_pattern(tmp_path / d / "pattern.fold") for d in ("mine", "ref"))
+    assert mine.n_faces == ref.n_faces == 4
+    assert np.allclose(mine.coords, ref.coords, rtol=0, atol=1e-12)
+
+
+def _dash_lengths(svg: str, role: str) -> np.ndarray:
+    """Lengths (mm) of the dashes of the first crease path of ``role`` in an SVG."""
+    path = re.search(rf'<path d="([^"]*)"[^>]*data-role="{role}"', svg).group(1)
+    pts = np.array(re.findall(r"[ML] ([-\d.]+) ([-\d.]+)", path), dtype=float).reshape(-1, 2, 2)
+    return np.linalg.norm(pts[:, 1] - pts[:, 0], axis=1)
+
+
+def test_recipe_a_cutter_profile_through_the_cli(tmp_path, monkeypatch):
+    """``--profile my-laser`` is one of the choices; its 5 mm dashes reach the SVG (each
+    dash at least 5 mm, stretched by less than a gap to fill the crease)."""
+    _plugin(tmp_path, monkeypatch, "hf_cli_profile", '''
+        import dataclasses
+        import holofold.geometry as g
+
+        PROFILE = dataclasses.replace(g.PROFILES["laser"], name="my-laser", dash=5.0)
+        ''', "holofold.cutter_profiles", "my-laser = :PROFILE")  # fmt: skip
+    for name in ("my-laser", "laser"):
+        assert _cli(["pattern", "miura", *_MIURA, "--profile", name, "-o", tmp_path / name]) == 0
+    mine = (tmp_path / "my-laser" / "pattern.svg").read_text()
+    ref = (tmp_path / "laser" / "pattern.svg").read_text()
+    assert "my-laser profile" in mine
+    gap = g.get_profile("my-laser").gap
+    dashes = _dash_lengths(mine, "mountain")
+    assert ((dashes >= 5.0 - 1e-3) & (dashes < 5.0 + gap)).all()
+    assert len(dashes) < len(_dash_lengths(ref, "mountain"))
+    with pytest.raises(SystemExit):  # a profile nobody registered is no choice
+        _cli(["pattern", "miura", *_MIURA, "--profile", "your-laser", "-o", tmp_path / "x"])
+
+
+def test_recipe_a_scenario_kind_and_a_strategy_through_the_cli(tmp_path, monkeypatch, capsys):
+    """``holofold design d.toml --strategy uniform``: a scenario kind and a refinement
+    strategy, each one plug-in module, run the whole loop from the command line."""
+    _plugin(tmp_path, monkeypatch, "hf_cli_kind", DOUBLE_KIND, "holofold.scenario_kinds",
+            "double = ")  # fmt: skip
+    _plugin(tmp_path, monkeypatch, "hf_cli_strategy", UNIFORM_STRATEGY,
+            "holofold.refine_strategies", "uniform = :uniform")  # fmt: skip
+    (tmp_path / "d.toml").write_text('kind = "double"\n[double]\nfactor = 3.0\n')
+    out = tmp_path / "out"
+    loop = ["-n", 60, "--refine", 20, "--verify", 10, "--rounds", 1, "--pilot", 0,
+            "--all-rounds", "--workers", 1, "--no-progress"]  # fmt: skip
+    status = _cli(["design", tmp_path / "d.toml", "--target", "y > 2.0", *loop,
+                   "--strategy", "uniform", "-o", out])  # fmt: skip
+    said = capsys.readouterr().out
+    assert status == 0 and "round 1/1: 20 new designs at random (uniform strategy)" in said
+    table = pd.read_parquet(out / "designs.parquet")
+    assert (table["origin"] == "refine-1").sum() == 20
+    assert np.allclose(table["y"], 3.0 * table["x"], rtol=1e-12)  # the kind's factor, read
+    assert _cli(["design", tmp_path / "d.toml", "--target", "y > 2.0", "--strategy", "nearby",
+                 "-o", tmp_path / "no"]) == 2  # fmt: skip
+    assert "strategy = 'nearby' must be one of" in capsys.readouterr().err
+    assert not (tmp_path / "no").exists()

@@ -42,6 +42,14 @@ def test_estimate_predicts_precision_on_fresh_rows_where_training_precision_does
     assert np.mean(train - fresh) > 0.05  # the optimism the estimate removes
 
 
+def test_posterior_is_a_named_record():
+    post = posterior(np.array([8.0, 3.0]), np.array([10.0, 3.0]), 0.5, 4.0)
+    assert post._fields == ("mean", "lo", "hi", "lcb")
+    np.testing.assert_allclose(post.mean, [(8 + 2) / (10 + 4), (3 + 2) / (3 + 4)], rtol=1e-12)
+    assert (post.lo < post.lcb).all() and (post.lcb < post.mean).all()
+    assert (post.mean < post.hi).all()
+
+
 def test_posterior_and_rule_estimates_with_held_out_rows():
     mean, lo, hi, lcb = posterior(np.array([8.0]), np.array([10.0]), 0.5, 4.0)
     assert mean[0] == pytest.approx((8 + 2) / (10 + 4))

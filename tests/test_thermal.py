@@ -10,6 +10,7 @@ from holofold.mechanics.hinges import build_compliant
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.thermal import (
     Bimorph,
+    HeatMatrices,
     ThermalModel,
     chain_conductance,
     conduction_matrix,
@@ -218,6 +219,31 @@ def test_electrothermal_stage_folds_toward_plus_z():
     np.testing.assert_allclose(new.crease_angle - np.pi, bim.fold_increment(dT), rtol=1e-12)
     assert np.all(new.crease_angle > np.pi)
     np.testing.assert_allclose(new.q.sum(), Q.sum(), rtol=1e-12)
+
+
+def test_a_stage_given_its_heat_matrices_folds_the_same():
+    """``matrices=HeatMatrices.of(s)`` (made once, shared by the gripper's heating steps) is
+    what the stage makes itself: the same matrices, the same state to 1e-12."""
+    pat, s = _gripper_structure()
+    sup = np.zeros((s.n_nodes, 3), bool)
+    sup[:4] = True
+    s = s.with_supports(sup)
+    mats = HeatMatrices.of(s)
+    cn = s.creases.nodes
+    assert abs(mats.heat - heat_input_matrix(cn, s.n_nodes)).max() == 0
+    assert abs(mats.temperature - crease_temperature_matrix(cn, s.n_nodes)).max() == 0
+    assert mats.heat.shape == (s.n_nodes, len(s.creases.ids)) == mats.temperature.T.shape
+    model = thermal_model(s, panel_conductivity=0.3, crease_conductivity=0.3, air_thickness=4.6e-3)
+    nci = len(s.creases.ids)
+    bim = Bimorph(np.full(nci, 50e-6), 0.2e-6, 1.0e-6, 2e9, 2e9, np.full(nci, 150e-6))
+    Q = np.full(nci, 0.1 * 3.1e-3 * 5)
+    state = initial_thermal_state(s)
+    a, _ = electrothermal_stage(s, model, bim, state, Q, tol=5e-7)
+    b, _ = electrothermal_stage(s, model, bim, state, Q, tol=5e-7, matrices=mats)
+    for name in ("U", "T", "q", "crease_angle", "spring_rest"):
+        x, y = getattr(a, name), getattr(b, name)
+        np.testing.assert_allclose(y, x, rtol=1e-12, atol=1e-12 * np.abs(x).max(), err_msg=name)
+    assert np.abs(a.U).max() > 1e-6  # it did fold
 
 
 def test_structure_without_triangles_gives_empty_model():

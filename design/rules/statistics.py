@@ -3,6 +3,8 @@ estimate of a rule's precision on new designs."""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from holofold.design.rules.boxes import boxes_contain
@@ -13,6 +15,7 @@ __all__ = [
     "wilson_lower",
     "fbeta",
     "fit_prior",
+    "Posterior",
     "posterior",
     "box_counts",
     "finder_matrix",
@@ -72,7 +75,18 @@ def fit_prior(strength, tp: np.ndarray, n: np.ndarray, base_rate: float) -> tupl
     return mu, float(np.clip(mu * (1 - mu) / tau2 - 1, 0.0, MAX_PRIOR))
 
 
-def posterior(tp, n, mu: float, k: float):
+class Posterior(NamedTuple):
+    """What :func:`posterior` returns (a tuple, so it still unpacks): the posterior mean of
+    precision, its 95 % interval (``lo``, ``hi``) and one-sided 95 % lower bound ``lcb``, each
+    shaped as the counts."""
+
+    mean: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    lcb: np.ndarray
+
+
+def posterior(tp, n, mu: float, k: float) -> Posterior:
     """Posterior mean, 95 % interval and one-sided 95 % lower bound of precision.
 
     Prior Beta(k mu, k (1 - mu)) on ``tp`` of ``n`` rows; the interval and bound are quantiles
@@ -88,7 +102,7 @@ def posterior(tp, n, mu: float, k: float):
     lo = betaincinv(a + 0.5, b + 0.5, 0.025)
     hi = betaincinv(a + 0.5, b + 0.5, 0.975)
     lcb = betaincinv(a + 0.5, b + 0.5, 0.05)
-    return mean, lo, hi, lcb
+    return Posterior(mean, lo, hi, lcb)
 
 
 def box_counts(pair_box, pair_row, pair_bag, y_pos, m: int, n: int) -> dict:

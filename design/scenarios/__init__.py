@@ -24,6 +24,7 @@ from holofold.design.scenarios.kinds import (
     register_kind,
     scenario_kinds,
 )
+from holofold.design.scenarios.paper import SCENARIO_NAMES, get_scenario
 
 __all__ = [
     "Column",
@@ -44,27 +45,3 @@ __all__ = [
     "KINDS",
     "scenario_kinds",
 ]
-
-#: command-line name -> module (its ``SCENARIO``) or ``module:ATTRIBUTE``
-_MODULES = {
-    "single-miura": "holofold.design.scenarios.single_miura",
-    "canopy": "holofold.design.scenarios.canopy",
-    "arch": "holofold.design.scenarios.arch",
-    "gripper": "holofold.design.scenarios.gripper",
-    "gripper-converged": "holofold.design.scenarios.gripper:SCENARIO_CONVERGED",
-}
-SCENARIO_NAMES = tuple(_MODULES)
-
-
-def get_scenario(name: str) -> Scenario:
-    """The :class:`Scenario` called ``name`` (one of :data:`SCENARIO_NAMES`)."""
-    import importlib
-
-    key = str(name).strip().lower().replace("_", "-")
-    if key not in _MODULES:
-        raise ValueError(
-            f"unknown scenario {name!r}; allowed: {', '.join(SCENARIO_NAMES)} "
-            "or a scenario file (.toml)"
-        )
-    module, _, attr = _MODULES[key].partition(":")
-    return getattr(importlib.import_module(module), attr or "SCENARIO")

@@ -21,6 +21,7 @@ from pathlib import Path
 from holofold.design.scenarios.base import Scenario
 from holofold.design.scenarios.config import ScenarioFileError, Section
 from holofold.design.scenarios.kinds import get_kind, kind_names
+from holofold.design.scenarios.paper import get_scenario
 from holofold.geometry.inputs import check_input_file
 
 __all__ = [
@@ -113,6 +114,4 @@ def load_scenario(spec: Scenario | str | os.PathLike) -> Scenario:
     s = os.fspath(spec)
     if s.lower().endswith(".toml"):
         return read_scenario(s)
-    from holofold.design.scenarios import get_scenario
-
     return get_scenario(s)

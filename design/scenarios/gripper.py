@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from functools import partial
+from functools import lru_cache, partial
 
 import numpy as np
 
@@ -57,10 +57,9 @@ from holofold.mechanics.status import CONVERGED, Outcome, Status
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.thermal import (
     Bimorph,
+    HeatMatrices,
     ThermalState,
-    crease_temperature_matrix,
     electrothermal_stage,
-    heat_input_matrix,
     initial_thermal_state,
     thermal_model,
 )
@@ -646,8 +645,7 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
         dissipation_deg=mat.dissipation_deg,
         room_temperature=mat.room_temperature,
     )
-    H = heat_input_matrix(s.creases.nodes, s.n_nodes)
-    A = crease_temperature_matrix(s.creases.nodes, s.n_nodes)
+    matrices = HeatMatrices.of(s)
     a, b = n.tips
     state, dist, tmax, unconverged = start, [], [], 0
     closing, status = None, STATUS_NO_CLOSURE
@@ -655,7 +653,7 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
         factor, tol = _ramp(g.kind, step)
         state, results = electrothermal_stage(
             s, thermal, model.bimorph, state, factor * options.q_load * model.heat_length,
-            **options.tolerance(tol, "force"), assembler=asm, heat_matrix=H, temp_matrix=A,
+            **options.tolerance(tol, "force"), assembler=asm, matrices=matrices,
         )  # fmt: skip
         unconverged += sum(int(not r.ok) for r in results)
         x = s.nodes + state.U
@@ -844,20 +842,100 @@ def write_gripper_files(row, folder, units: str = "mm", cutter=None):
     )  # fmt: skip
 
 
+# ------------------------------------------------------ the closed state: files and view
+@lru_cache(maxsize=8)
+def _closed(options: GripperOptions, items: tuple):
+    row = dict(items)
+    result = simulate(row, replace(options, keep_history=True))
+    model = gripper_model(row, options.profile, options.material)
+    return result, model
+
+
+def closed_gripper(options: GripperOptions, row):
+    """(GripperResult with its history, GripperModel) of one design: the shape and the
+    temperatures at the closing heating step (or at the step cap if it never closes)."""
+    return _closed(options, tuple(sorted((k, float(v)) for k, v in dict(row).items())))
+
+
+def _closed_mesh(options: GripperOptions, row):
+    import trimesh
+
+    res, _ = closed_gripper(options, row)
+    return trimesh.Trimesh(res.nodes + res.displacement, res.triangles, process=False), res
+
+
+def write_closed_gripper_files(
+    options: GripperOptions, row, folder, units: str = "mm", cutter=None
+):
+    """The flat gripper's fabrication set (:func:`write_gripper_files`) and its closed (heated)
+    state: ``closed.stl`` (key ``closed``: the mid-surface at the closing heating step, in
+    ``units``) and ``closed_temperature.ply`` (``closed_temperature``: the same, each vertex
+    coloured by its temperature, blue at room temperature to red at Tmax)."""
+    from pathlib import Path
+
+    from holofold.geometry import export
+
+    fab = write_gripper_files(row, folder, units=units, cutter=cutter)
+    mesh, res = _closed_mesh(options, row)
+    T = np.asarray(res.temperature, float)
+    s = (T - T.min()) / max(float(np.ptp(T)), 1e-12)
+    colours = np.column_stack(
+        [
+            255 * np.minimum(1, 2 * s),
+            40 + 200 * (1 - np.abs(2 * s - 1)),
+            255 * np.maximum(0, 1 - 2 * s),
+            np.full(len(s), 255),
+        ]
+    )
+    hot = mesh.copy()
+    hot.visual.vertex_colors = colours.astype(np.uint8)
+    state = "closed" if res.closing_step is not None else "at the step cap (not closed)"
+    stl = export(mesh, Path(folder) / "closed.stl", units=units)
+    ply = export(hot, Path(folder) / "closed_temperature.ply", units=units)
+    fab = fab.plus("closed", stl, f"STL of the gripper {state} by heating ({units})")
+    return fab.plus(
+        "closed_temperature", ply, f"PLY of the gripper {state}, coloured by temperature ({units})"
+    )
+
+
+def gripper_view(options: GripperOptions, row):
+    """From flat (room temperature) to closed by heating, coloured by temperature, with the
+    held base nodes (:class:`~holofold.design.view.DesignView`)."""
+    from holofold.design.view import DesignView
+
+    res, model = closed_gripper(options, row)
+    room = options.material.room_temperature
+    held = np.unique(np.concatenate([np.asarray(n, int) for n, _ in model.nodes.hold_heating]))
+    closed = res.closing_step is not None
+    last = (f"closed at heating step {res.closing_step}" if closed
+            else f"not closed after {len(res.tip_distance)} heating steps")  # fmt: skip
+    T = np.asarray(res.temperature, float)
+    facts = [("state", last),
+             ("room temperature", f"{room:.4g} degC"),
+             ("hottest point when closed", f"{T.max():.4g} degC (Tmax)"),
+             ("tip distance", f"{1e3 * res.tip_distance[-1]:.3g} mm (closure below "
+                              f"{1e3 * options.closure:.3g} mm)")]  # fmt: skip
+    if closed and np.isfinite(res.finalQ):
+        facts.append(("heating power at closure", f"{res.finalQ:.4g} W (finalQ)"))
+    return DesignView(
+        frames=np.stack([res.nodes, res.nodes + res.displacement]),
+        labels=("flat, at room temperature", last),
+        faces=[list(t) for t in res.triangles], supports=held,
+        scalar=np.stack([np.full(len(T), room), T]), scalar_name="temperature",
+        scalar_unit="degC", facts=tuple(facts),
+    )  # fmt: skip
+
+
 def _closed_files(converged: bool, row, folder, units: str = "mm", cutter=None):
     """The built-in gripper's files with its closed (heated) state, as its scenario file's
-    (:func:`holofold.design.scenarios.gripper_kind.write_closed_gripper_files`)."""
-    from holofold.design.scenarios.gripper_kind import write_closed_gripper_files
-
+    (:func:`write_closed_gripper_files`)."""
     options = GripperOptions(converged=converged)
     return write_closed_gripper_files(options, row, folder, units=units, cutter=cutter)
 
 
 def _closed_view(converged: bool, row):
     """The built-in gripper's 3D view, flat to closed by heating
-    (:func:`holofold.design.scenarios.gripper_kind.gripper_view`)."""
-    from holofold.design.scenarios.gripper_kind import gripper_view
-
+    (:func:`gripper_view`)."""
     return gripper_view(GripperOptions(converged=converged), row)
 
 

@@ -14,8 +14,7 @@ heating rate), ``Tmax`` (°C), ``stiff`` (N/m), as in the paper.
 
 from __future__ import annotations
 
-from dataclasses import replace
-from functools import lru_cache, partial
+from functools import partial
 
 import numpy as np
 
@@ -31,10 +30,12 @@ from holofold.design.scenarios.gripper import (
     GripperMaterial,
     GripperOptions,
     check,
-    gripper_model,
+    closed_gripper,
     gripper_row_timeout,
     gripper_shape,
+    gripper_view,
     simulate,
+    write_closed_gripper_files,
     write_gripper_files,
 )
 from holofold.design.scenarios.plausible import (
@@ -82,8 +83,6 @@ def gripper_mass(options: GripperOptions, row) -> float:
     """density x (panel area x tpanel + active-crease length x W x (t1 + t2 - tpanel)), kg:
     the flat film of panel thickness, with the bimorph (t1 + t2) instead of the panel over a
     strip of width W along every active crease (the compliant creases the model represents)."""
-    import numpy as np
-
     from holofold.geometry.gripper import gripper_pattern
 
     g = gripper_pattern(int(round(row["Pattern"])), row["L1"], row["L2"], row["rate"])
@@ -96,89 +95,6 @@ def gripper_mass(options: GripperOptions, row) -> float:
     length = float(np.linalg.norm(X[e[:, 1]] - X[e[:, 0]], axis=1).sum())
     tp, t1, t2, W = (float(row[k]) for k in ("tpanel", "t1", "t2", "W"))
     return float(options.material.density * (area * tp + length * W * (t1 + t2 - tp)))
-
-
-@lru_cache(maxsize=8)
-def _closed(options: GripperOptions, items: tuple):
-    row = dict(items)
-    result = simulate(row, replace(options, keep_history=True))
-    model = gripper_model(row, options.profile, options.material)
-    return result, model
-
-
-def closed_gripper(options: GripperOptions, row):
-    """(GripperResult with its history, GripperModel) of one design: the shape and the
-    temperatures at the closing heating step (or at the step cap if it never closes)."""
-    return _closed(options, tuple(sorted((k, float(v)) for k, v in dict(row).items())))
-
-
-def _closed_mesh(options: GripperOptions, row):
-    import trimesh
-
-    res, _ = closed_gripper(options, row)
-    return trimesh.Trimesh(res.nodes + res.displacement, res.triangles, process=False), res
-
-
-def write_closed_gripper_files(
-    options: GripperOptions, row, folder, units: str = "mm", cutter=None
-):
-    """The flat gripper's fabrication set (:func:`write_gripper_files`) and its closed (heated)
-    state: ``closed.stl`` (key ``closed``: the mid-surface at the closing heating step, in
-    ``units``) and ``closed_temperature.ply`` (``closed_temperature``: the same, each vertex
-    coloured by its temperature, blue at room temperature to red at Tmax)."""
-    from pathlib import Path
-
-    from holofold.geometry import export
-
-    fab = write_gripper_files(row, folder, units=units, cutter=cutter)
-    mesh, res = _closed_mesh(options, row)
-    T = np.asarray(res.temperature, float)
-    s = (T - T.min()) / max(float(np.ptp(T)), 1e-12)
-    colours = np.column_stack(
-        [
-            255 * np.minimum(1, 2 * s),
-            40 + 200 * (1 - np.abs(2 * s - 1)),
-            255 * np.maximum(0, 1 - 2 * s),
-            np.full(len(s), 255),
-        ]
-    )
-    hot = mesh.copy()
-    hot.visual.vertex_colors = colours.astype(np.uint8)
-    state = "closed" if res.closing_step is not None else "at the step cap (not closed)"
-    stl = export(mesh, Path(folder) / "closed.stl", units=units)
-    ply = export(hot, Path(folder) / "closed_temperature.ply", units=units)
-    fab = fab.plus("closed", stl, f"STL of the gripper {state} by heating ({units})")
-    return fab.plus(
-        "closed_temperature", ply, f"PLY of the gripper {state}, coloured by temperature ({units})"
-    )
-
-
-def gripper_view(options: GripperOptions, row):
-    """From flat (room temperature) to closed by heating, coloured by temperature, with the
-    held base nodes (:class:`~holofold.design.view.DesignView`)."""
-    from holofold.design.view import DesignView
-
-    res, model = closed_gripper(options, row)
-    room = options.material.room_temperature
-    held = np.unique(np.concatenate([np.asarray(n, int) for n, _ in model.nodes.hold_heating]))
-    closed = res.closing_step is not None
-    last = (f"closed at heating step {res.closing_step}" if closed
-            else f"not closed after {len(res.tip_distance)} heating steps")  # fmt: skip
-    T = np.asarray(res.temperature, float)
-    facts = [("state", last),
-             ("room temperature", f"{room:.4g} degC"),
-             ("hottest point when closed", f"{T.max():.4g} degC (Tmax)"),
-             ("tip distance", f"{1e3 * res.tip_distance[-1]:.3g} mm (closure below "
-                              f"{1e3 * options.closure:.3g} mm)")]  # fmt: skip
-    if closed and np.isfinite(res.finalQ):
-        facts.append(("heating power at closure", f"{res.finalQ:.4g} W (finalQ)"))
-    return DesignView(
-        frames=np.stack([res.nodes, res.nodes + res.displacement]),
-        labels=("flat, at room temperature", last),
-        faces=[list(t) for t in res.triangles], supports=held,
-        scalar=np.stack([np.full(len(T), room), T]), scalar_name="temperature",
-        scalar_unit="degC", facts=tuple(facts),
-    )  # fmt: skip
 
 
 def gripper_scenario(
