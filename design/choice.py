@@ -277,7 +277,8 @@ def _headline(
         return (
             f"The design with {by} among the simulated designs inside {r.label}, the best "
             f"{bar} (verified precision {_pct(r.precision)}, 95 % "
-            f"interval {_pct(lo)} to {_pct(hi)}, n = {r.verified.simulated}); "
+            f"interval {_pct(lo)} to {_pct(hi)}, n = {r.verified.tried}"
+            f"{f', {r.verified.failed} failed' if r.verified.failed else ''}); "
             f"{n_good} of {n_ok} simulated designs {meeting[5:]}.{overlap}"
         )
     if kind == "designs":

@@ -202,7 +202,9 @@ def _verified(rule) -> str:
     if p is None:
         return "not verified"
     lo, hi = (_percent(c) for c in rule.interval)
-    return f"{p} (95\u00a0% interval {lo} to {hi}, n\u00a0=\u00a0{rule.verified.simulated})"
+    v = rule.verified
+    failed = f", {v.failed} failed" if v.failed else ""
+    return f"{p} (95\u00a0% interval {lo} to {hi}, n\u00a0=\u00a0{v.tried}{failed})"
 
 
 def _seconds(t) -> str:

@@ -46,7 +46,12 @@ def _count(d: Mapping, key: str, where: str) -> int:
 
 @dataclass(frozen=True)
 class Counts:
-    """Fresh designs simulated inside a rule: successful, failed, and meeting the target."""
+    """Fresh designs simulated inside a rule: successful, failed, and meeting the target.
+
+    The precision is the fraction of *all* of them that meet the target: a design whose
+    simulation failed (a self-overlapping strip, a gripper that never closes, a row past its
+    time limit) is a design a user of the rule could pick that does not meet it.
+    """
 
     simulated: int
     failed: int
@@ -61,12 +66,17 @@ class Counts:
             raise ValueError(f"{self.meeting} designs meeting the target of {self.simulated}")
 
     @property
+    def tried(self) -> int:
+        """Every fresh design: simulated successfully or failed."""
+        return self.simulated + self.failed
+
+    @property
     def precision(self) -> float | None:
-        return self.meeting / self.simulated if self.simulated else None
+        return self.meeting / self.tried if self.tried else None
 
     @property
     def interval(self) -> tuple[float, float] | None:
-        return wilson(self.meeting, self.simulated) if self.simulated else None
+        return wilson(self.meeting, self.tried) if self.tried else None
 
 
 @dataclass(frozen=True)

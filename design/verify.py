@@ -107,7 +107,8 @@ class Verification:
     """Fresh designs inside a rule and how many meet the target.
 
     ``designs`` holds the simulated rows with ``meets_target``; ``precision`` is the fraction
-    of successfully simulated rows meeting the target, ``interval`` its 95 % Wilson interval.
+    of every fresh design meeting the target, a failed simulation counted as not meeting it
+    (it is a design inside the rule that does not work), ``interval`` its 95 % Wilson interval.
     """
 
     designs: pd.DataFrame
@@ -129,12 +130,13 @@ class Verification:
 
     @property
     def precision(self) -> float:
-        return self.n_meeting / self.n_ok if self.n_ok else float("nan")
+        n = self.n_ok + self.n_failed
+        return self.n_meeting / n if n else float("nan")
 
     @property
     def interval(self) -> tuple[float, float]:
         """95 % Wilson interval (exact at p = 0 and p = 1; NaN when nothing simulated)."""
-        return wilson(self.n_meeting, self.n_ok)
+        return wilson(self.n_meeting, self.n_ok + self.n_failed)
 
     @property
     def counts(self) -> Counts:
@@ -143,7 +145,7 @@ class Verification:
     def summary(self) -> dict:
         """JSON-ready counts, precision and interval (None where no design simulated)."""
         lo, hi = self.interval
-        finite = self.n_ok > 0
+        finite = self.n_ok + self.n_failed > 0
         return {
             "simulated": self.n_ok,
             "failed": self.n_failed,
@@ -154,12 +156,13 @@ class Verification:
 
     def describe(self) -> str:
         """One line: how many fresh designs meet the target, with the interval."""
-        if not self.n_ok:
-            return f"no fresh design simulated successfully ({self.n_failed} failed)"
+        if not self.n_ok + self.n_failed:
+            return "no fresh design simulated"
         lo, hi = self.interval
+        failed = f"; {self.n_failed} failed, counted as not meeting it" if self.n_failed else ""
         return (
-            f"fresh designs meeting the target: {self.n_meeting}/{self.n_ok} = "
-            f"{self.precision:.3f} (95 % CI {lo:.3f}-{hi:.3f}; {self.n_failed} failed)"
+            f"fresh designs meeting the target: {self.n_meeting}/{self.n_ok + self.n_failed} = "
+            f"{self.precision:.3f} (95 % CI {lo:.3f}-{hi:.3f}{failed})"
         )
 
 
@@ -187,7 +190,8 @@ def verify_rule(
     scheduler address or ``"local"``), ``on_invalid`` and ``row_timeout`` are passed to
     :func:`holofold.design.store.build_database`: with ``on_invalid="skip"`` fresh designs the
     scenario's check refuses (a box reaching past a validity limit) are failed rows, as are
-    rows past their time limit; failed rows count in ``n_failed``, not in the precision.
+    rows past their time limit; failed rows count in ``n_failed`` and as designs that do not
+    meet the target in the precision.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)

@@ -148,3 +148,24 @@ def test_holofold_verify_is_the_loops_resumable_verification(tmp_path, capsys):
                           6, folder=tmp_path / "w")[0]  # fmt: skip
     csv = pd.read_csv(out / "verify_rule1.csv")
     assert np.allclose(csv["tcrease"], direct.designs["tcrease"])
+
+
+def test_a_failed_fresh_design_counts_as_one_that_misses_the_target():
+    # the parabolic arch of validation/last_mile: 26 of 28 simulated designs met the target and
+    # 22 were self-overlapping strips; the rule's precision is 26 / 50, not 26 / 28
+    from holofold.design.rounds import Counts
+    from holofold.design.targets import parse_target
+    from holofold.design.verify import Verification
+
+    c = Counts(simulated=28, failed=22, meeting=26)
+    assert c.tried == 50 and c.precision == pytest.approx(0.52)
+    lo, hi = c.interval
+    assert lo < 0.52 < hi < 0.7
+    res = pd.DataFrame({
+        "k": [1.0, 2.0, 3.0, np.nan],
+        "status": ["converged", "converged", "converged", "failed: the strip overlaps itself"],
+    })  # fmt: skip
+    v = Verification.of(res, parse_target("k > 1.5", ["k"]))
+    assert (v.n_ok, v.n_failed, v.n_meeting) == (3, 1, 2)
+    assert v.precision == 0.5 and v.summary()["precision"] == 0.5
+    assert "2/4 = 0.500" in v.describe() and "1 failed, counted as not meeting it" in v.describe()
