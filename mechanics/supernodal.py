@@ -51,7 +51,8 @@ RELAX_ZEROS = 0.1
 
 @cache
 def _addresses() -> np.ndarray:
-    """Addresses of LAPACK ``dpotrf`` and BLAS ``dtrsm``, ``dsyrk`` (scipy's)."""
+    """Addresses of LAPACK ``dpotrf`` and BLAS ``dtrsm``, ``dsyrk``, ``dtrsv``, ``dgemv``
+    (scipy's)."""
     from numba.extending import get_cython_function_address as addr
 
     return np.array(
@@ -59,6 +60,8 @@ def _addresses() -> np.ndarray:
             addr("scipy.linalg.cython_lapack", "dpotrf"),
             addr("scipy.linalg.cython_blas", "dtrsm"),
             addr("scipy.linalg.cython_blas", "dsyrk"),
+            addr("scipy.linalg.cython_blas", "dtrsv"),
+            addr("scipy.linalg.cython_blas", "dgemv"),
         ],
         np.int64,
     )
@@ -148,10 +151,6 @@ def _supernodes(parent, count, relax):
     start[ns] = n
     # relaxed amalgamation of a chain child -> parent (the child the last column before
     # the parent's first): merged if contiguous and the added zeros are few
-    snode = np.empty(n, np.int64)
-    for s in range(ns):
-        for j in range(start[s], start[s + 1]):
-            snode[j] = s
     cols = np.empty(ns, np.int64)  # columns of each (merged) supernode
     rows = np.empty(ns, np.int64)  # rows of its first column
     zeros = np.zeros(ns, np.int64)  # explicit zeros it holds
@@ -159,7 +158,6 @@ def _supernodes(parent, count, relax):
     for s in range(ns):
         cols[s] = start[s + 1] - start[s]
         rows[s] = count[start[s]]
-    head = np.arange(ns)  # merged supernode s belongs to: its last surviving member
     for s in range(ns - 1):
         last = start[s + 1] - 1
         p = parent[last]
@@ -371,36 +369,52 @@ def _factor(data, slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, s
 
 
 @njit(**OPTS)
-def _solve(lx, sup, rows, rptr, lptr, y):
-    """Solve L L' x = y in place (y (n, k), in the factor's order)."""
+def _solve(lx, sup, rows, rptr, lptr, addrs, y):
+    """Solve L L' x = y in place (y (k, n): k right-hand sides in the factor's order), each
+    supernode by BLAS ``dtrsv`` and ``dgemv`` on its gathered rows."""
     ns = sup.shape[0] - 1
-    k = y.shape[1]
-    for s in range(ns):
-        f = sup[s]
-        nc = sup[s + 1] - f
-        m = rptr[s + 1] - rptr[s]
-        L = lx[lptr[s] : lptr[s] + m * nc]
-        R = rows[rptr[s] : rptr[s + 1]]
-        for j in range(nc):
-            d = L[j * m + j]
-            for r in range(k):
-                v = y[f + j, r] / d
-                y[f + j, r] = v
-                for a in range(j + 1, m):
-                    y[R[a], r] -= L[j * m + a] * v
-    for s in range(ns - 1, -1, -1):
-        f = sup[s]
-        nc = sup[s + 1] - f
-        m = rptr[s + 1] - rptr[s]
-        L = lx[lptr[s] : lptr[s] + m * nc]
-        R = rows[rptr[s] : rptr[s + 1]]
-        for j in range(nc - 1, -1, -1):
-            d = L[j * m + j]
-            for r in range(k):
-                acc = y[f + j, r]
-                for a in range(j + 1, m):
-                    acc -= L[j * m + a] * y[R[a], r]
-                y[f + j, r] = acc / d
+    lo = np.array([ord("L")], np.uint8)
+    tr = np.array([ord("T")], np.uint8)
+    no = np.array([ord("N")], np.uint8)
+    one = np.array([1.0])
+    mone = np.array([-1.0])
+    inc = np.ones(1, np.int32)
+    n_ = np.zeros(1, np.int32)
+    m_ = np.zeros(1, np.int32)
+    ld = np.zeros(1, np.int32)
+    w = np.empty(max(int(np.max(np.diff(rptr))), 1) if ns else 1)
+    for r in range(y.shape[0]):
+        x = y[r]
+        for s in range(ns):
+            m = rptr[s + 1] - rptr[s]
+            nc = sup[s + 1] - sup[s]
+            R = rows[rptr[s] : rptr[s + 1]]
+            L = lx[lptr[s] : lptr[s] + m * nc]
+            for a in range(m):
+                w[a] = x[R[a]]
+            n_[0] = nc
+            ld[0] = m
+            _fcall(addrs[3], (lo, no, no, n_, L, ld, w, inc))
+            if m > nc:
+                m_[0] = m - nc
+                _fcall(addrs[4], (no, m_, n_, mone, L[nc:], ld, w, inc, one, w[nc:], inc))
+            for a in range(m):
+                x[R[a]] = w[a]
+        for s in range(ns - 1, -1, -1):
+            m = rptr[s + 1] - rptr[s]
+            nc = sup[s + 1] - sup[s]
+            R = rows[rptr[s] : rptr[s + 1]]
+            L = lx[lptr[s] : lptr[s] + m * nc]
+            for a in range(m):
+                w[a] = x[R[a]]
+            n_[0] = nc
+            ld[0] = m
+            if m > nc:
+                m_[0] = m - nc
+                _fcall(addrs[4], (tr, m_, n_, mone, L[nc:], ld, w[nc:], inc, one, w, inc))
+            _fcall(addrs[3], (lo, tr, no, n_, L, ld, w, inc))
+            for a in range(nc):
+                x[R[a]] = w[a]
 
 
 # ------------------------------------------------------------------------ orderings
@@ -526,7 +540,7 @@ class SupernodalCholesky:
 
 
 class SupernodalFactor:
-    """A numeric factor: :meth:`solve`."""
+    """A numeric factor: :meth:`solve` (also by calling it, as a linear solver's ``solve``)."""
 
     def __init__(self, analysis: _Analysis, lx: np.ndarray):
         self._a = analysis
@@ -537,10 +551,12 @@ class SupernodalFactor:
         finite."""
         a = self._a
         b = np.asarray(rhs, dtype=float)
-        y = np.array(b.reshape(a.n, -1)[a.order], order="C")
-        _solve(self._lx, a.sup, a.rows, a.rptr, a.lptr, y)
-        x = np.empty_like(y)
-        x[a.order] = y
+        y = np.array(b.reshape(a.n, -1)[a.order].T, order="C")
+        _solve(self._lx, a.sup, a.rows, a.rptr, a.lptr, _addresses(), y)
+        x = np.empty((a.n, y.shape[0]))
+        x[a.order] = y.T
         if not np.all(np.isfinite(x)):
             raise SingularSystemError("non-finite solution of the linear system")
         return x.reshape(b.shape)
+
+    __call__ = solve
