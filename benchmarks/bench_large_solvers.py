@@ -11,6 +11,10 @@ definite), every path factorises the same free-free tangent and solves one right
                      analysis once per pattern: AMD, and from 10,000 DOFs METIS's nested
                      dissection where pymetis is installed, CHOLMOD keeping the cheaper)
     ... AMD only     the same with CHOLMOD's AMD alone, as where pymetis is missing (aarch64)
+    supernodal       holofold's own multifrontal Cholesky (mechanics.supernodal: numba, scipy's
+                     BLAS/LAPACK; MMD ordering, and from 10,000 DOFs METIS's where pymetis is
+                     installed, keeping the cheaper): the "cholesky" path without cvxopt
+    ... MMD only     the same with MMD alone: what a plain ``pip install holofold`` runs
 
 Rounds interleave the paths (each round times every path once, in a rotating order) so that a
 machine whose speed drifts with other jobs slows them alike. Times are the CPU time of this
@@ -23,7 +27,8 @@ memory while the path is set up afresh and factorises and solves once (the facto
 workspace and the path's cached ordering; /proc/self/clear_refs resets the peak first).
 ``setup`` is the path's one-time CPU cost per topology (ordering, symbolic analysis, band
 layout). ``ratio`` is the path's min over the best min at that size; ``*`` marks the path the
-assembler takes (``mechanics.linear.solver_path``), ``+`` the one it takes without cvxopt.
+assembler takes (``mechanics.linear.solver_path``), ``+`` the one a plain install takes (no
+cvxopt, no pymetis).
 
     python benchmarks/bench_large_solvers.py [--rounds 5] [--sizes 12x4 100x100] [--out F.md]
 """
@@ -52,12 +57,19 @@ from holofold.geometry.miura import miura_sheet  # noqa: E402
 from holofold.mechanics import sparse_cholesky  # noqa: E402
 from holofold.mechanics.assembly import Assembler  # noqa: E402
 from holofold.mechanics.hinges import build_concentrated  # noqa: E402
-from holofold.mechanics.linear import BANDED_MAX_WORK, CHOLESKY_MIN_WORK, solver_path  # noqa: E402
+from holofold.mechanics.linear import (  # noqa: E402
+    CHOLESKY_MIN_WORK,
+    cholesky_backend,
+    solver_path,
+)
+from holofold.mechanics.supernodal import SupernodalCholesky  # noqa: E402
 
 SIZES = ["12x4", "24x8", "36x12", "48x16", "72x24", "100x30", "120x40", "100x50", "150x50",
          "100x75", "100x100"]  # fmt: skip
 AMD = "sparse Cholesky, AMD order only"
-PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD]
+OWN = "supernodal (holofold)"
+MMD = "supernodal, MMD order only"
+PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD, OWN, MMD]
 _LIBC = ctypes.CDLL("libc.so.6")
 
 
@@ -80,15 +92,16 @@ def band_work(K: sp.csr_matrix) -> tuple[np.ndarray, int, float]:
 
 
 def fallback_path(nf: int, work: float) -> str:
-    """The path the assembler takes without cvxopt (mechanics.linear's thresholds)."""
+    """The path a plain install takes (no cvxopt, no pymetis; mechanics.linear's thresholds)."""
     if nf <= 200:
         return "dense LU"
-    return "banded Cholesky" if work <= max(CHOLESKY_MIN_WORK, BANDED_MAX_WORK) else "SuperLU"
+    return "banded Cholesky" if work <= CHOLESKY_MIN_WORK else MMD
 
 
 def assembler_path(asm: Assembler) -> str:
     """The path the assembler takes here (mechanics.linear.solver_path)."""
-    return {"dense": "dense LU", "banded": "banded Cholesky", "cholesky": "sparse Cholesky",
+    own = "sparse Cholesky" if cholesky_backend() == "cholmod" else OWN
+    return {"dense": "dense LU", "banded": "banded Cholesky", "cholesky": own,
             "superlu": "SuperLU"}[solver_path(asm.reduction)]  # fmt: skip
 
 
@@ -179,6 +192,24 @@ def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
             return make_cholesky("amd")
 
         makers[AMD] = make_amd
+
+    def make_own(ordering=None):
+        chol = SupernodalCholesky(K.indptr, K.indices, ordering=ordering)
+
+        def own():
+            f = chol.factor(K.data)
+            if f is None:
+                raise np.linalg.LinAlgError("not positive definite")
+            return f.solve(b)
+
+        return own
+
+    makers[OWN] = make_own
+
+    def make_mmd():  # MMD alone: the ordering of a plain install (no pymetis)
+        return make_own("mmd")
+
+    makers[MMD] = make_mmd
     return makers
 
 

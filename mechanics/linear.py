@@ -5,8 +5,8 @@ LAPACK LU up to :data:`DENSE_MAX_DOF` free DOFs, then a banded Cholesky (LAPACK 
 on the cached reverse Cuthill-McKee band while its work ``nf (bw + 1)^2`` stays under
 :data:`CHOLESKY_MIN_WORK`, and a supernodal sparse Cholesky above it (:func:`cholesky_backend`:
 CHOLMOD where ``holofold[cholmod]`` is installed, else holofold's own multifrontal one,
-:mod:`~holofold.mechanics.supernodal`). Without either (the numpy kernel path,
-``HOLOFOLD_KERNELS=numpy``, and no cvxopt) the band serves up to :data:`BANDED_MAX_WORK` and
+:mod:`~holofold.mechanics.supernodal`, on the compiled kernel path). Without either (no cvxopt
+and the numpy kernel path) the band serves up to :data:`BANDED_MAX_WORK` and
 SuperLU (LU with a cached minimum-degree ordering) beyond; SuperLU also takes every banded or
 sparse-Cholesky tangent that is not positive definite. Each ``*_solver`` returns
 ``solve(rhs)`` for ``rhs`` (nf,) (or (nf, k)) that raises :class:`SingularSystemError` for a
@@ -89,19 +89,14 @@ def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:
 def cholesky_backend() -> str | None:
     """The supernodal sparse Cholesky of the ``"cholesky"`` path: ``"cholmod"`` where cvxopt
     imports (``holofold[cholmod]``), else ``"supernodal"`` (holofold's own, numba and scipy's
-    BLAS) unless the numpy kernel path is asked for (``HOLOFOLD_KERNELS=numpy``: never
-    compile), else None (the band and SuperLU serve)."""
+    BLAS) where the compiled kernels run (it is compiled with them, into their cache), else
+    None: on the numpy kernel path (``HOLOFOLD_KERNELS=numpy``, or ``auto`` while the kernels
+    compile) the band and SuperLU serve."""
     from holofold.mechanics import kernels, sparse_cholesky
 
     if sparse_cholesky.available():
         return "cholmod"
-    if kernels.requested() == "numpy":
-        return None
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return None
-    return "supernodal"
+    return "supernodal" if kernels.active().compiled else None
 
 
 def storage_of(path: str) -> str | None:

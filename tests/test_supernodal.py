@@ -80,6 +80,7 @@ def test_indefinite_tangent_is_refused_and_the_assembler_falls_back_to_lu(
     assert np.linalg.eigvalsh(K.toarray())[0] < 0.0
     assert SupernodalCholesky(K.indptr, K.indices).factor(K.data) is None
     monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
+    monkeypatch.setenv("HOLOFOLD_KERNELS", "compiled")
     s = _sheet(36, 12)
     asm = Assembler(s)
     assert asm.solver == "cholesky" and linear.cholesky_backend() == "supernodal"
@@ -144,7 +145,7 @@ def test_metis_ordering_where_pymetis_is_installed():
 
 def test_solver_path_choice(monkeypatch):
     """Above CHOLESKY_MIN_WORK: CHOLMOD where cvxopt is installed, else holofold's own
-    supernodal Cholesky; with the numpy kernel path and no cvxopt the band up to
+    supernodal Cholesky on the compiled kernel path; on the numpy one without cvxopt the band up to
     BANDED_MAX_WORK and SuperLU beyond; small models stay dense or banded whatever is
     installed."""
     red = Assembler(_sheet(36, 12)).reduction
@@ -152,6 +153,7 @@ def test_solver_path_choice(monkeypatch):
     assert linear.CHOLESKY_MIN_WORK < work <= linear.BANDED_MAX_WORK
     small = Assembler(_sheet(12, 4)).reduction
     monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
+    monkeypatch.setenv("HOLOFOLD_KERNELS", "compiled")
     assert linear.cholesky_backend() == "supernodal"
     assert linear.solver_path(red) == "cholesky"
     assert linear.solver_path(small) == "banded"
@@ -170,6 +172,7 @@ def test_batch_newton_step_on_the_supernodal_path(monkeypatch):
     """BatchAssembler.newton_step of two samples on the supernodal path (one indefinite: LU)
     gives each sample's own Assembler increment to 1e-9 relative."""
     monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
+    monkeypatch.setenv("HOLOFOLD_KERNELS", "compiled")
     s = _sheet(36, 12)
     batch = BatchAssembler([s, s])
     rng = np.random.default_rng(6)
