@@ -33,8 +33,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
+from numba.core import config
 
-from holofold.mechanics._compiled import _fcall
+from holofold.mechanics import kernels
 from holofold.mechanics._jit import OPTS
 from holofold.mechanics.status import SingularSystemError
 
@@ -47,6 +48,23 @@ METIS_MIN_DOF = 10_000
 #: most this fraction of the merged supernode's entries (relaxed amalgamation: fewer, larger
 #: fronts do more of their work in BLAS-3).
 RELAX_ZEROS = 0.1
+
+
+#: the compiled kernels' call of a Fortran routine by address (imported through
+#: :mod:`~holofold.mechanics.kernels`, which sets their cache folder)
+_fcall = kernels.kernel_path("compiled").module._fcall
+
+
+def _jit(fn):
+    """``njit`` with the compiled kernels' options, cached in their folder (numba reads the
+    cache folder when a function is decorated): compiled by their background compile
+    (``mechanics._warmup``) and keyed on this file's source with them."""
+    before = config.CACHE_DIR
+    config.CACHE_DIR = str(kernels.cache_folder())
+    try:
+        return njit(**OPTS)(fn)
+    finally:
+        config.CACHE_DIR = before
 
 
 @cache
@@ -68,7 +86,7 @@ def _addresses() -> np.ndarray:
 
 
 # ------------------------------------------------------------------------ symbolic analysis
-@njit(**OPTS)
+@_jit
 def _etree(n, rp, ci):
     """Elimination tree (parent, -1 at roots) of the symmetric matrix whose strictly lower
     triangle is the CSR (rp, ci) (row i: columns < i)."""
@@ -86,7 +104,7 @@ def _etree(n, rp, ci):
     return parent
 
 
-@njit(**OPTS)
+@_jit
 def _postorder(parent):
     """A postorder of the forest ``parent`` (children in increasing order)."""
     n = parent.shape[0]
@@ -119,7 +137,7 @@ def _postorder(parent):
     return post
 
 
-@njit(**OPTS)
+@_jit
 def _colcounts(n, rp, ci, parent):
     """Nonzeros of each column of L (diagonal included): row subtrees of the strictly lower CSR."""
     count = np.ones(n, np.int64)
@@ -135,7 +153,7 @@ def _colcounts(n, rp, ci, parent):
     return count
 
 
-@njit(**OPTS)
+@_jit
 def _supernodes(parent, count, relax):
     """Supernode of each column: runs of columns j-1 -> j (parent) with nested structure, then
     children merged into their parents while the explicit zeros stay within ``relax``."""
@@ -186,7 +204,7 @@ def _supernodes(parent, count, relax):
     return sup
 
 
-@njit(**OPTS)
+@_jit
 def _structure(n, sup, parent, cp, ri):
     """Row structure of each supernode (its columns first, then the rows below in increasing
     order), the supernodes' parents, and the position of each child's update rows in its
@@ -261,7 +279,7 @@ def _structure(n, sup, parent, cp, ri):
     return snode, sparent, rows, rptr, rel, chead, cnext
 
 
-@njit(**OPTS)
+@_jit
 def _entry_positions(n, sup, snode, rows, rptr, cp, ri):
     """Front position (column-major, ld = the supernode's row count) of each lower-triangle
     entry in CSC order."""
@@ -278,7 +296,7 @@ def _entry_positions(n, sup, snode, rows, rptr, cp, ri):
     return pos
 
 
-@njit(**OPTS)
+@_jit
 def _stack_size(sup, rptr, sparent, chead, cnext):
     """Largest total of update blocks alive at once on the multifrontal stack (postorder)."""
     ns = sup.shape[0] - 1
@@ -299,7 +317,7 @@ def _stack_size(sup, rptr, sparent, chead, cnext):
 
 
 # ------------------------------------------------------------------------ numeric factor
-@njit(**OPTS)
+@_jit
 def _factor(data, slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, stack_n,
             max_front, addrs, lx):  # fmt: skip
     """Multifrontal numeric factorisation into ``lx`` (each supernode's m x nc block,
@@ -368,7 +386,7 @@ def _factor(data, slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, s
     return 0
 
 
-@njit(**OPTS)
+@_jit
 def _solve(lx, sup, rows, rptr, lptr, addrs, y):
     """Solve L L' x = y in place (y (k, n): k right-hand sides in the factor's order), each
     supernode by BLAS ``dtrsv`` and ``dgemv`` on its gathered rows."""
