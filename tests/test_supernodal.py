@@ -187,3 +187,24 @@ def test_batch_newton_step_on_the_supernodal_path(monkeypatch):
     assert not errors
     for k in range(2):
         assert np.abs(dU[k] - want[k]).max() <= 1e-9 * np.abs(want[k]).max()
+
+
+@pytest.mark.parametrize("relax", [0.0, 0.1, 1.0])
+def test_random_patterns_and_amalgamation(relax, monkeypatch):
+    """Random symmetric patterns (1 to 300 rows, sparse to dense-ish), MMD or a random order,
+    no, the default or heavy amalgamation of supernodes: dense LAPACK's solution to 1e-12."""
+    from holofold.mechanics import supernodal
+
+    monkeypatch.setattr(supernodal, "RELAX_ZEROS", relax)
+    rng = np.random.default_rng(11)
+    for _ in range(8):
+        n = int(rng.integers(1, 300))
+        A = sp.random(n, n, density=float(rng.uniform(0.003, 0.1)), random_state=rng)
+        A = A + A.T
+        K = (A + sp.diags(np.asarray(abs(A).sum(axis=1)).ravel() + 0.5)).tocsr()
+        K.sort_indices()
+        b = rng.standard_normal((n, 2))
+        ref = np.linalg.solve(K.toarray(), b)
+        for ordering in ("mmd", rng.permutation(n)):
+            x = SupernodalCholesky(K.indptr, K.indices, ordering=ordering).factor(K.data)
+            assert np.abs(x.solve(b) - ref).max() <= 1e-12 * np.abs(ref).max()
