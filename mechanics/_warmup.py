@@ -74,8 +74,8 @@ def _thermal() -> None:
 
 
 def _supernodal() -> None:
-    """holofold's own sparse Cholesky (the "cholesky" path without cvxopt), on a 2-D grid
-    Laplacian: every function of its analysis, factorisation and solves."""
+    """holofold's own sparse Cholesky (the "cholesky" path without cvxopt) and LDL^T, on a 2-D
+    grid Laplacian: every function of its analysis, factorisations and solves."""
     import scipy.sparse as sp
 
     from holofold.mechanics.supernodal import SupernodalCholesky
@@ -85,9 +85,14 @@ def _supernodal() -> None:
     S = sp.diags([-np.ones(n - 1)] * 2, [-1, 1])
     K = (sp.kron(sp.identity(n), T) + sp.kron(S, sp.identity(n))).tocsr()
     K.sort_indices()
-    factor = SupernodalCholesky(K.indptr, K.indices).factor(K.data)
+    chol = SupernodalCholesky(K.indptr, K.indices)
+    factor = chol.factor(K.data)
     factor.solve(np.ones(n * n))
     factor.solve(np.ones((n * n, 2)))
+    # indefinite (diagonal +-5, dominant): the LDL^T factor and its solve
+    rows = np.repeat(np.arange(n * n), np.diff(K.indptr))
+    signed = np.where(rows == K.indices, np.where(rows % 2, 5.0, -5.0), K.data)
+    chol.factor_ldl(signed).solve(np.ones(n * n))
 
 
 def run_warmup() -> None:

@@ -16,7 +16,11 @@ supernode's row structure and the positions of its children's update rows in it.
 :meth:`SupernodalCholesky.factor` then assembles and factorises every front in postorder
 (``dpotrf`` of the pivot block, ``dtrsm`` of the rows below, ``dsyrk`` of the update matrix
 passed to the parent on a stack) and returns a :class:`SupernodalFactor` (``solve(rhs)``), or
-None when the matrix is not positive definite. Factors are independent arrays.
+None when the matrix is not positive definite. For symmetric indefinite matrices (issue 37,
+item 2) :meth:`SupernodalCholesky.factor_ldl` factorises each pivot block by LAPACK's
+Bunch-Kaufman ``dsytrf`` (pivoting within the block only) and eliminates the rows below it
+(``dsytrs``, ``dgemm``), checked by one solve; None (use LU) where a pivot block is singular or
+the check fails. Factors are independent arrays.
 
 Typical use::
 
@@ -69,8 +73,8 @@ def _jit(fn):
 
 @cache
 def _addresses() -> np.ndarray:
-    """Addresses of LAPACK ``dpotrf`` and BLAS ``dtrsm``, ``dsyrk``, ``dtrsv``, ``dgemv``
-    (scipy's)."""
+    """Addresses of scipy's ``dpotrf``, ``dtrsm``, ``dsyrk``, ``dtrsv``, ``dgemv``, ``dsytrf``,
+    ``dsytrs``, ``dgemm``."""
     from numba.extending import get_cython_function_address as addr
 
     return np.array(
@@ -80,6 +84,9 @@ def _addresses() -> np.ndarray:
             addr("scipy.linalg.cython_blas", "dsyrk"),
             addr("scipy.linalg.cython_blas", "dtrsv"),
             addr("scipy.linalg.cython_blas", "dgemv"),
+            addr("scipy.linalg.cython_lapack", "dsytrf"),
+            addr("scipy.linalg.cython_lapack", "dsytrs"),
+            addr("scipy.linalg.cython_blas", "dgemm"),
         ],
         np.int64,
     )
@@ -319,11 +326,20 @@ def _stack_size(sup, rptr, sparent, chead, cnext):
 # ------------------------------------------------------------------------ numeric factor
 @_jit
 def _factor(data, slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, stack_n,
-            max_front, addrs, lx):  # fmt: skip
+            max_front, addrs, lx, ldl, ipiv):  # fmt: skip
     """Multifrontal numeric factorisation into ``lx`` (each supernode's m x nc block,
-    column-major); 0, or 1 + the column where the matrix is not positive definite."""
+    column-major); 0, or 1 + the column where the matrix is not positive definite (``ldl``:
+    where a pivot block is singular). ``ldl``: each pivot block by LAPACK's Bunch-Kaufman
+    ``dsytrf`` (pivots in ``ipiv``, interchanges within the block only) and the rows below
+    kept as they are (block elimination), for symmetric indefinite matrices."""
     ns = sup.shape[0] - 1
     F = np.empty(max_front)
+    X = np.empty(max_front)
+    nb = 1
+    for s in range(ns):
+        nb = max(nb, sup[s + 1] - sup[s])
+    work = np.empty(64 * nb)
+    lwork = np.array([64 * nb], np.int32)
     stk = np.empty(max(stack_n, 1))
     off = np.zeros(ns, np.int64)
     top = 0
@@ -365,6 +381,26 @@ def _factor(data, slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, s
         top = lowest
         ld[0] = m
         n_[0] = nc
+        if ldl:
+            piv = ipiv[f : f + nc]
+            _fcall(addrs[5], (lo, n_, fr, ld, piv, work, lwork, info))
+            if info[0] != 0:
+                return 1 + f + info[0] - 1
+            lx[lptr[s] : lptr[s] + m * nc] = fr[: m * nc]
+            if sparent[s] != -1 and mu > 0:
+                for a in range(mu):  # X = F21' (nc x mu), then X = F11^-1 F21'
+                    for j in range(nc):
+                        X[a * nc + j] = fr[j * m + nc + a]
+                m_[0] = mu
+                _fcall(addrs[6], (lo, n_, m_, fr, ld, piv, X, n_, info))
+                blk = stk[top : top + mu * mu]
+                for b in range(mu):
+                    src = (nc + b) * m + nc
+                    blk[b * mu : (b + 1) * mu] = fr[src : src + mu]
+                _fcall(addrs[7], (no, no, m_, m_, n_, mone, fr[nc:], ld, X, n_, one, blk, m_))
+                off[s] = top
+                top += mu * mu
+            continue
         _fcall(addrs[0], (lo, n_, fr, ld, info))
         if info[0] != 0:
             return 1 + f + info[0] - 1
@@ -435,6 +471,85 @@ def _solve(lx, sup, rows, rptr, lptr, addrs, y):
                 x[R[a]] = w[a]
 
 
+@_jit
+def _solve_ldl(lx, ipiv, sup, rows, rptr, lptr, addrs, y):
+    """Solve K x = y in place from the block-elimination factor of ``_factor(ldl=True)``
+    (y (k, n) in the factor's order): forward z_p = A^-1 b_p, b_q -= B z_p; backward
+    x_p = z_p - A^-1 B' x_q, per supernode (A its pivot block, B the rows below)."""
+    ns = sup.shape[0] - 1
+    lo = np.array([ord("L")], np.uint8)
+    tr = np.array([ord("T")], np.uint8)
+    no = np.array([ord("N")], np.uint8)
+    one = np.array([1.0])
+    zero = np.array([0.0])
+    mone = np.array([-1.0])
+    inc = np.ones(1, np.int32)
+    n_ = np.zeros(1, np.int32)
+    m_ = np.zeros(1, np.int32)
+    ld = np.zeros(1, np.int32)
+    info = np.zeros(1, np.int32)
+    mmax = 1
+    for s in range(ns):
+        mmax = max(mmax, rptr[s + 1] - rptr[s])
+    w = np.empty(mmax)
+    t = np.empty(mmax)
+    for r in range(y.shape[0]):
+        x = y[r]
+        for s in range(ns):
+            f = sup[s]
+            m = rptr[s + 1] - rptr[s]
+            nc = sup[s + 1] - f
+            R = rows[rptr[s] : rptr[s + 1]]
+            L = lx[lptr[s] : lptr[s] + m * nc]
+            for a in range(m):
+                w[a] = x[R[a]]
+            n_[0] = nc
+            ld[0] = m
+            _fcall(addrs[6], (lo, n_, inc, L, ld, ipiv[f : f + nc], w, n_, info))
+            if m > nc:
+                m_[0] = m - nc
+                _fcall(addrs[4], (no, m_, n_, mone, L[nc:], ld, w, inc, one, w[nc:], inc))
+            for a in range(m):
+                x[R[a]] = w[a]
+        for s in range(ns - 1, -1, -1):
+            f = sup[s]
+            m = rptr[s + 1] - rptr[s]
+            nc = sup[s + 1] - f
+            if m == nc:
+                continue
+            R = rows[rptr[s] : rptr[s + 1]]
+            L = lx[lptr[s] : lptr[s] + m * nc]
+            for a in range(m):
+                w[a] = x[R[a]]
+            n_[0] = nc
+            ld[0] = m
+            m_[0] = m - nc
+            _fcall(addrs[4], (tr, m_, n_, one, L[nc:], ld, w[nc:], inc, zero, t, inc))
+            _fcall(addrs[6], (lo, n_, inc, L, ld, ipiv[f : f + nc], t, n_, info))
+            for j in range(nc):
+                x[f + j] = w[j] - t[j]
+
+
+@_jit
+def _matvec(cp, ri, slots, data, x, out):
+    """out = K x in the factor's order, K from its lower triangle (CSC cp, ri; values
+    ``data[slots]``)."""
+    out[:] = 0.0
+    for j in range(cp.shape[0] - 1):
+        for p in range(cp[j], cp[j + 1]):
+            i = ri[p]
+            v = data[slots[p]]
+            out[i] += v * x[j]
+            if i != j:
+                out[j] += v * x[i]
+
+
+#: the largest relative residual ||K x - b|| / (||K|| ||x|| + ||b||) (inf-norms) of the check
+#: solve that an LDL^T factor may give; above it :meth:`SupernodalCholesky.factor_ldl` refuses
+#: (restricted pivoting met a bad pivot block) and the caller takes LU
+LDL_CHECK = 1e-12
+
+
 # ------------------------------------------------------------------------ orderings
 def mmd_order(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """Multiple minimum degree order of the symmetric pattern (rows, cols) (scipy's SuperLU
@@ -499,6 +614,7 @@ class _Analysis:
         self.max_front = int((m * m).max()) if m.size else 0
         self.stack = int(_stack_size(sup, rptr, sparent, chead, cnext))
         self.flops = float((count.astype(float) ** 2).sum())
+        self.ri = ri
 
 
 class SupernodalCholesky:
@@ -552,17 +668,52 @@ class SupernodalCholesky:
         code = _factor(
             np.ascontiguousarray(data, dtype=float), a.slots, a.cp, a.pos, a.sup, a.rel,
             a.rptr, a.lptr, a.sparent, a.chead, a.cnext, a.stack, a.max_front, _addresses(),
-            lx,
+            lx, False, np.zeros(1, np.int32),
         )  # fmt: skip
         return None if code else SupernodalFactor(a, lx)
+
+    def factor_ldl(self, data) -> SupernodalFactor | None:
+        """An LDL^T factor of the symmetric (indefinite) matrix with pattern values ``data``:
+        Bunch-Kaufman pivoting within each supernode's pivot block (no delayed pivots), checked
+        by one solve (relative residual at most :data:`LDL_CHECK`); None if a pivot block is
+        singular or the check fails (then use LU)."""
+        a = self._a
+        data = np.ascontiguousarray(data, dtype=float)
+        lx = np.empty(int(a.lptr[-1]))
+        ipiv = np.zeros(a.n, np.int32)
+        code = _factor(
+            data, a.slots, a.cp, a.pos, a.sup, a.rel, a.rptr, a.lptr, a.sparent, a.chead,
+            a.cnext, a.stack, a.max_front, _addresses(), lx, True, ipiv,
+        )  # fmt: skip
+        if code:
+            return None
+        x = np.sin(np.arange(1.0, a.n + 1.0))  # a check solve, in the factor's order
+        b = np.empty(a.n)
+        _matvec(a.cp, a.ri, a.slots, data, x, b)
+        y = b.copy().reshape(1, -1)
+        _solve_ldl(lx, ipiv, a.sup, a.rows, a.rptr, a.lptr, _addresses(), y)
+        r = np.empty(a.n)
+        _matvec(a.cp, a.ri, a.slots, data, y[0], r)
+        row_sums = np.zeros(a.n)
+        _matvec(a.cp, a.ri, a.slots, np.abs(data), np.ones(a.n), row_sums)
+        scale = row_sums.max() * np.abs(y).max() + np.abs(b).max()
+        if not np.abs(r - b).max() <= LDL_CHECK * scale:
+            return None
+        return SupernodalFactor(a, lx, ipiv)
 
 
 class SupernodalFactor:
     """A numeric factor: :meth:`solve` (also by calling it, as a linear solver's ``solve``)."""
 
-    def __init__(self, analysis: _Analysis, lx: np.ndarray):
+    def __init__(self, analysis: _Analysis, lx: np.ndarray, ipiv: np.ndarray | None = None):
         self._a = analysis
         self._lx = lx
+        self._ipiv = ipiv  # LDL^T pivots, None for a Cholesky factor
+
+    @property
+    def ldl(self) -> bool:
+        """True for an LDL^T factor (:meth:`SupernodalCholesky.factor_ldl`)."""
+        return self._ipiv is not None
 
     def solve(self, rhs) -> np.ndarray:
         """x with K x = rhs, for rhs (n,) or (n, k); :class:`SingularSystemError` if x is not
@@ -570,7 +721,10 @@ class SupernodalFactor:
         a = self._a
         b = np.asarray(rhs, dtype=float)
         y = np.array(b.reshape(a.n, -1)[a.order].T, order="C")
-        _solve(self._lx, a.sup, a.rows, a.rptr, a.lptr, _addresses(), y)
+        if self._ipiv is None:
+            _solve(self._lx, a.sup, a.rows, a.rptr, a.lptr, _addresses(), y)
+        else:
+            _solve_ldl(self._lx, self._ipiv, a.sup, a.rows, a.rptr, a.lptr, _addresses(), y)
         x = np.empty((a.n, y.shape[0]))
         x[a.order] = y.T
         if not np.all(np.isfinite(x)):

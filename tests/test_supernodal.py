@@ -71,25 +71,32 @@ def test_spd_sheet_tangent_matches_the_dense_solve(sheet_tangents):
     assert _backward_error(K, ref, B) < 1e-12
 
 
-def test_indefinite_tangent_is_refused_and_the_assembler_falls_back_to_lu(
-    sheet_tangents, monkeypatch
-):
-    """An indefinite tangent has no Cholesky factor: factor() gives None, and the assembler on
-    the supernodal path solves it by SuperLU instead (relative residual below 1e-12)."""
+def test_indefinite_tangent_gets_the_ldl_factor(sheet_tangents, monkeypatch):
+    """An indefinite tangent has no Cholesky factor (factor() gives None) but an LDL^T one:
+    relative residual below 1e-12 and dense LAPACK's solution to 1e-7; the assembler on the
+    supernodal path takes it (and the Cholesky factor where the tangent is definite)."""
     K = sheet_tangents[1]
     assert np.linalg.eigvalsh(K.toarray())[0] < 0.0
-    assert SupernodalCholesky(K.indptr, K.indices).factor(K.data) is None
+    chol = SupernodalCholesky(K.indptr, K.indices)
+    assert chol.factor(K.data) is None
+    f = chol.factor_ldl(K.data)
+    assert f.ldl
+    B = np.random.default_rng(2).standard_normal((K.shape[0], 2))
+    X = f.solve(B)
+    assert _backward_error(K, X, B) < 1e-12
+    ref = np.linalg.solve(K.toarray(), B)
+    assert np.abs(X - ref).max() / np.abs(ref).max() < 1e-7
     monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
     monkeypatch.setenv("HOLOFOLD_KERNELS", "compiled")
     s = _sheet(36, 12)
     asm = Assembler(s)
     assert asm.solver == "cholesky" and linear.cholesky_backend() == "supernodal"
     rng = np.random.default_rng(5)
-    for scale in (0.0, 1e-4):  # positive definite (supernodal), indefinite (SuperLU)
+    for scale in (0.0, 1e-4):  # positive definite (Cholesky), indefinite (LDL^T)
         U = scale * rng.standard_normal((s.n_nodes, 3))
         U[s.supports] = 0.0
         _, _, solve = asm.evaluate_factorized(U)
-        assert isinstance(solve, SupernodalFactor) == (scale == 0.0)
+        assert isinstance(solve, SupernodalFactor) and solve.ldl == (scale != 0.0)
         K = asm.evaluate_reduced(U, dense=False)[2]
         b = rng.standard_normal((K.shape[0], 2))
         assert _backward_error(K, solve(b), b) < 1e-12
@@ -169,7 +176,7 @@ def test_solver_path_choice(monkeypatch):
 
 
 def test_batch_newton_step_on_the_supernodal_path(monkeypatch):
-    """BatchAssembler.newton_step of two samples on the supernodal path (one indefinite: LU)
+    """BatchAssembler.newton_step of two samples on the supernodal path (one indefinite: LDL^T)
     gives each sample's own Assembler increment to 1e-9 relative."""
     monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
     monkeypatch.setenv("HOLOFOLD_KERNELS", "compiled")
@@ -208,3 +215,25 @@ def test_random_patterns_and_amalgamation(relax, monkeypatch):
         for ordering in ("mmd", rng.permutation(n)):
             x = SupernodalCholesky(K.indptr, K.indices, ordering=ordering).factor(K.data)
             assert np.abs(x.solve(b) - ref).max() <= 1e-12 * np.abs(ref).max()
+
+
+def test_ldl_on_random_indefinite_patterns_and_a_singular_pivot():
+    """Random symmetric indefinite (diagonally dominant, mixed signs) patterns: LDL^T solves
+    as dense LAPACK to 1e-12; a matrix with a zero row and column is refused (None: LU)."""
+    rng = np.random.default_rng(12)
+    for _ in range(8):
+        n = int(rng.integers(1, 300))
+        A = sp.random(n, n, density=float(rng.uniform(0.003, 0.1)), random_state=rng)
+        A = A + A.T
+        d = (np.asarray(abs(A).sum(axis=1)).ravel() + 0.5) * np.where(rng.random(n) < 0.4, -1, 1)
+        K = (A + sp.diags(d)).tocsr()
+        K.sort_indices()
+        b = rng.standard_normal((n, 2))
+        ref = np.linalg.solve(K.toarray(), b)
+        f = SupernodalCholesky(K.indptr, K.indices).factor_ldl(K.data)
+        assert np.abs(f.solve(b) - ref).max() <= 1e-12 * np.abs(ref).max()
+    pattern = sp.csr_matrix(np.ones((3, 3)))
+    values = np.array([[2.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -3.0]])
+    chol = SupernodalCholesky(pattern.indptr, pattern.indices)
+    assert chol.factor_ldl(values.ravel()) is None
+    assert chol.factor(values.ravel()) is None
