@@ -15,6 +15,9 @@ definite), every path factorises the same free-free tangent and solves one right
                      BLAS/LAPACK; MMD ordering, and from 10,000 DOFs METIS's where pymetis is
                      installed, keeping the cheaper): the "cholesky" path without cvxopt
     ... MMD only     the same with MMD alone: what a plain ``pip install holofold`` runs
+    sparse LDL^T     with ``--indefinite`` (the tangent at a random 0.1 mm displacement, not
+                     definite: the Cholesky paths drop out): SupernodalCholesky.factor_ldl,
+                     what the "cholesky" path takes where the Cholesky fails
 
 Rounds interleave the paths (each round times every path once, in a rotating order) so that a
 machine whose speed drifts with other jobs slows them alike. Times are the CPU time of this
@@ -31,6 +34,7 @@ assembler takes (``mechanics.linear.solver_path``), ``+`` the one a plain instal
 cvxopt, no pymetis).
 
     python benchmarks/bench_large_solvers.py [--rounds 5] [--sizes 12x4 100x100] [--out F.md]
+        [--indefinite]
 """
 
 from __future__ import annotations
@@ -69,7 +73,8 @@ SIZES = ["12x4", "24x8", "36x12", "48x16", "72x24", "100x30", "120x40", "100x50"
 AMD = "sparse Cholesky, AMD order only"
 OWN = "supernodal (holofold)"
 MMD = "supernodal, MMD order only"
-PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD, OWN, MMD]
+LDL = "sparse LDL^T (holofold)"
+PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD, OWN, MMD, LDL]
 _LIBC = ctypes.CDLL("libc.so.6")
 
 
@@ -210,6 +215,24 @@ def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
         return make_own("mmd")
 
     makers[MMD] = make_mmd
+
+    def make_ldl():  # holofold's sparse LDL^T: the indefinite tangent's path without LU
+        chol = SupernodalCholesky(K.indptr, K.indices)
+
+        def ldl():
+            f = chol.factor_ldl(K.data)
+            if f is None:
+                raise np.linalg.LinAlgError("LDL^T refused")
+            return f.solve(b)
+
+        return ldl
+
+    makers[LDL] = make_ldl
+    if args.indefinite:  # the Cholesky paths cannot factorise it
+        for p in ("banded Cholesky", "sparse Cholesky", AMD, OWN, MMD):
+            makers.pop(p, None)
+    else:
+        makers.pop(LDL)
     return makers
 
 
@@ -249,6 +272,9 @@ def measure(size: str, args) -> list[dict]:
     s = model(m, n)
     asm = Assembler(s)
     U = np.zeros((s.n_nodes, 3))
+    if args.indefinite:  # displaced at random by 0.1 mm: compressed bars, indefinite
+        U = 1e-4 * np.random.default_rng(1).standard_normal((s.n_nodes, 3))
+        U[s.supports] = 0.0
     _, _, K = asm.evaluate_reduced(U, dense=False)
     K = K.tocsr()
     K.sort_indices()
@@ -281,6 +307,9 @@ def measure(size: str, args) -> list[dict]:
     t_asm = min(asm_cpu)
     chosen = assembler_path(asm)
     without = fallback_path(K.shape[0], work)
+    if args.indefinite:  # where the Cholesky fails: LDL^T after the sparse one, LU after the band
+        to = {"sparse Cholesky": LDL, OWN: LDL, MMD: LDL, "banded Cholesky": "SuperLU"}
+        chosen, without = to.get(chosen, chosen), to.get(without, without)
     rows = []
     for p in PATHS:
         if p not in calls:
@@ -320,6 +349,10 @@ def main(argv=None) -> None:
     ap.add_argument("--band-limit", type=float, default=1e11, help="skip the band above this")
     ap.add_argument("--band-slow", type=float, default=2e10, help="band work timed twice only")
     ap.add_argument("--out", help="also write the table (markdown) to this file")
+    ap.add_argument(
+        "--indefinite", action="store_true",
+        help="the tangent at a random 0.1 mm displacement (indefinite): LU and LDL^T paths",
+    )  # fmt: skip
     args = ap.parse_args(argv)
     rows = []
     with threadpool_limits(1):
