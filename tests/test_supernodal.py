@@ -237,3 +237,22 @@ def test_ldl_on_random_indefinite_patterns_and_a_singular_pivot():
     chol = SupernodalCholesky(pattern.indptr, pattern.indices)
     assert chol.factor_ldl(values.ravel()) is None
     assert chol.factor(values.ravel()) is None
+
+
+def test_canopy_design_on_the_plain_install_matches_the_band_and_superlu(monkeypatch):
+    """One canopy design of 36 x 12 panels (the "cholesky" path) on holofold's own sparse
+    Cholesky, as a plain install runs it, gives the outputs of the numpy/scipy fallback (band,
+    SuperLU) to 1e-9 (converged outputs)."""
+    from holofold.design import get_scenario
+
+    monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
+    monkeypatch.setenv("HOLOFOLD_KERNELS", "compiled")
+    sc = get_scenario("canopy")
+    row = sc.complete(dict(pattern=2, m=36, n=12, tcrease=7e-4, tpanel=3e-3, W=2e-3))
+    assert linear.cholesky_backend() == "supernodal"
+    own = sc.evaluate(row)
+    monkeypatch.setattr(linear, "cholesky_backend", lambda: None)
+    ref = sc.evaluate(row)
+    assert str(own["status"]) == str(ref["status"]) == "converged"
+    for name in sc.performance_names:
+        assert own[name] == pytest.approx(ref[name], rel=1e-9), name
