@@ -43,7 +43,15 @@ from holofold.mechanics import kernels
 from holofold.mechanics._jit import OPTS
 from holofold.mechanics.status import SingularSystemError
 
-__all__ = ["SupernodalCholesky", "SupernodalFactor", "METIS_MIN_DOF", "RELAX_ZEROS"]
+__all__ = [
+    "SupernodalCholesky",
+    "SupernodalFactor",
+    "mmd_order",
+    "metis_order",
+    "METIS_MIN_DOF",
+    "RELAX_ZEROS",
+    "LDL_CHECK",
+]
 
 #: Patterns of at least this many rows also try METIS's nested dissection (where pymetis is
 #: installed) and keep the ordering with fewer flops.
