@@ -11,6 +11,13 @@ definite), every path factorises the same free-free tangent and solves one right
                      analysis once per pattern: AMD, and from 10,000 DOFs METIS's nested
                      dissection where pymetis is installed, CHOLMOD keeping the cheaper)
     ... AMD only     the same with CHOLMOD's AMD alone, as where pymetis is missing (aarch64)
+    supernodal       holofold's own multifrontal Cholesky (mechanics.supernodal: numba, scipy's
+                     BLAS/LAPACK; MMD ordering, and from 10,000 DOFs METIS's where pymetis is
+                     installed, keeping the cheaper): the "cholesky" path without cvxopt
+    ... MMD only     the same with MMD alone: what a plain ``pip install holofold`` runs
+    sparse LDL^T     with ``--indefinite`` (the tangent at a random 0.1 mm displacement, not
+                     definite: the Cholesky paths drop out): SupernodalCholesky.factor_ldl,
+                     what the "cholesky" path takes where the Cholesky fails
 
 Rounds interleave the paths (each round times every path once, in a rotating order) so that a
 machine whose speed drifts with other jobs slows them alike. Times are the CPU time of this
@@ -23,9 +30,11 @@ memory while the path is set up afresh and factorises and solves once (the facto
 workspace and the path's cached ordering; /proc/self/clear_refs resets the peak first).
 ``setup`` is the path's one-time CPU cost per topology (ordering, symbolic analysis, band
 layout). ``ratio`` is the path's min over the best min at that size; ``*`` marks the path the
-assembler takes (``mechanics.linear.solver_path``), ``+`` the one it takes without cvxopt.
+assembler takes (``mechanics.linear.solver_path``), ``+`` the one a plain install takes (no
+cvxopt, no pymetis).
 
     python benchmarks/bench_large_solvers.py [--rounds 5] [--sizes 12x4 100x100] [--out F.md]
+        [--indefinite]
 """
 
 from __future__ import annotations
@@ -52,12 +61,20 @@ from holofold.geometry.miura import miura_sheet  # noqa: E402
 from holofold.mechanics import sparse_cholesky  # noqa: E402
 from holofold.mechanics.assembly import Assembler  # noqa: E402
 from holofold.mechanics.hinges import build_concentrated  # noqa: E402
-from holofold.mechanics.linear import BANDED_MAX_WORK, CHOLESKY_MIN_WORK, solver_path  # noqa: E402
+from holofold.mechanics.linear import (  # noqa: E402
+    CHOLESKY_MIN_WORK,
+    cholesky_backend,
+    solver_path,
+)
+from holofold.mechanics.supernodal import SupernodalCholesky  # noqa: E402
 
 SIZES = ["12x4", "24x8", "36x12", "48x16", "72x24", "100x30", "120x40", "100x50", "150x50",
          "100x75", "100x100"]  # fmt: skip
 AMD = "sparse Cholesky, AMD order only"
-PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD]
+OWN = "supernodal (holofold)"
+MMD = "supernodal, MMD order only"
+LDL = "sparse LDL^T (holofold)"
+PATHS = ["dense LU", "banded Cholesky", "SuperLU", "sparse Cholesky", AMD, OWN, MMD, LDL]
 _LIBC = ctypes.CDLL("libc.so.6")
 
 
@@ -80,15 +97,16 @@ def band_work(K: sp.csr_matrix) -> tuple[np.ndarray, int, float]:
 
 
 def fallback_path(nf: int, work: float) -> str:
-    """The path the assembler takes without cvxopt (mechanics.linear's thresholds)."""
+    """The path a plain install takes (no cvxopt, no pymetis; mechanics.linear's thresholds)."""
     if nf <= 200:
         return "dense LU"
-    return "banded Cholesky" if work <= max(CHOLESKY_MIN_WORK, BANDED_MAX_WORK) else "SuperLU"
+    return "banded Cholesky" if work <= CHOLESKY_MIN_WORK else MMD
 
 
 def assembler_path(asm: Assembler) -> str:
     """The path the assembler takes here (mechanics.linear.solver_path)."""
-    return {"dense": "dense LU", "banded": "banded Cholesky", "cholesky": "sparse Cholesky",
+    own = "sparse Cholesky" if cholesky_backend() == "cholmod" else OWN
+    return {"dense": "dense LU", "banded": "banded Cholesky", "cholesky": own,
             "superlu": "SuperLU"}[solver_path(asm.reduction)]  # fmt: skip
 
 
@@ -179,6 +197,42 @@ def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
             return make_cholesky("amd")
 
         makers[AMD] = make_amd
+
+    def make_own(ordering=None):
+        chol = SupernodalCholesky(K.indptr, K.indices, ordering=ordering)
+
+        def own():
+            f = chol.factor(K.data)
+            if f is None:
+                raise np.linalg.LinAlgError("not positive definite")
+            return f.solve(b)
+
+        return own
+
+    makers[OWN] = make_own
+
+    def make_mmd():  # MMD alone: the ordering of a plain install (no pymetis)
+        return make_own("mmd")
+
+    makers[MMD] = make_mmd
+
+    def make_ldl():  # holofold's sparse LDL^T: the indefinite tangent's path without LU
+        chol = SupernodalCholesky(K.indptr, K.indices)
+
+        def ldl():
+            f = chol.factor_ldl(K.data)
+            if f is None:
+                raise np.linalg.LinAlgError("LDL^T refused")
+            return f.solve(b)
+
+        return ldl
+
+    makers[LDL] = make_ldl
+    if args.indefinite:  # the Cholesky paths cannot factorise it
+        for p in ("banded Cholesky", "sparse Cholesky", AMD, OWN, MMD):
+            makers.pop(p, None)
+    else:
+        makers.pop(LDL)
     return makers
 
 
@@ -218,6 +272,9 @@ def measure(size: str, args) -> list[dict]:
     s = model(m, n)
     asm = Assembler(s)
     U = np.zeros((s.n_nodes, 3))
+    if args.indefinite:  # displaced at random by 0.1 mm: compressed bars, indefinite
+        U = 1e-4 * np.random.default_rng(1).standard_normal((s.n_nodes, 3))
+        U[s.supports] = 0.0
     _, _, K = asm.evaluate_reduced(U, dense=False)
     K = K.tocsr()
     K.sort_indices()
@@ -250,6 +307,9 @@ def measure(size: str, args) -> list[dict]:
     t_asm = min(asm_cpu)
     chosen = assembler_path(asm)
     without = fallback_path(K.shape[0], work)
+    if args.indefinite:  # where the Cholesky fails: LDL^T after the sparse one, LU after the band
+        to = {"sparse Cholesky": LDL, OWN: LDL, MMD: LDL, "banded Cholesky": "SuperLU"}
+        chosen, without = to.get(chosen, chosen), to.get(without, without)
     rows = []
     for p in PATHS:
         if p not in calls:
@@ -289,6 +349,10 @@ def main(argv=None) -> None:
     ap.add_argument("--band-limit", type=float, default=1e11, help="skip the band above this")
     ap.add_argument("--band-slow", type=float, default=2e10, help="band work timed twice only")
     ap.add_argument("--out", help="also write the table (markdown) to this file")
+    ap.add_argument(
+        "--indefinite", action="store_true",
+        help="the tangent at a random 0.1 mm displacement (indefinite): LU and LDL^T paths",
+    )  # fmt: skip
     args = ap.parse_args(argv)
     rows = []
     with threadpool_limits(1):

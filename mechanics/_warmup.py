@@ -73,10 +73,34 @@ def _thermal() -> None:
     steady_temperature(model, s.nodes, q)
 
 
+def _supernodal() -> None:
+    """holofold's own sparse Cholesky (the "cholesky" path without cvxopt) and LDL^T, on a 2-D
+    grid Laplacian: every function of its analysis, factorisations and solves."""
+    import scipy.sparse as sp
+
+    from holofold.mechanics.supernodal import SupernodalCholesky
+
+    n = 12
+    T = sp.diags([-np.ones(n - 1), 4.0 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    S = sp.diags([-np.ones(n - 1)] * 2, [-1, 1])
+    K = (sp.kron(sp.identity(n), T) + sp.kron(S, sp.identity(n))).tocsr()
+    K.sort_indices()
+    chol = SupernodalCholesky(K.indptr, K.indices)
+    factor = chol.factor(K.data)
+    factor.solve(np.ones(n * n))
+    factor.solve(np.ones((n * n, 2)))
+    # indefinite (diagonal +-5, dominant): the LDL^T factor and its solve
+    rows = np.repeat(np.arange(n * n), np.diff(K.indptr))
+    signed = np.where(rows == K.indices, np.where(rows % 2, 5.0, -5.0), K.data)
+    chol.factor_ldl(signed).solve(np.ones(n * n))
+
+
 def run_warmup() -> None:
     """Evaluate, factorise and step small dense (2 x 2 Miura), banded (6 x 6) and compliant
-    models, one design and batches, and the gripper's small thermal model."""
+    models, one design and batches, the gripper's small thermal model and holofold's own
+    sparse Cholesky."""
     for m, n in ((2, 2), (6, 6)):
         _exercise([_sheet(m, n), _sheet(m, n)])
     _exercise([_sheet(2, 2, compliant=True)] * 2)
     _thermal()
+    _supernodal()

@@ -61,7 +61,7 @@ __all__ = [
 KERNEL_PATHS = ("numpy", "compiled")
 ENV = "HOLOFOLD_KERNELS"
 #: the modules the compiled kernels are built from (their sources key the cache)
-COMPILED_SOURCES = ("_jit.py", "_compiled.py", "_spring_loop.py")
+COMPILED_SOURCES = ("_jit.py", "_compiled.py", "_spring_loop.py", "supernodal.py")
 #: how often (s) a process on the numpy path looks whether the compiled kernels are ready
 POLL_SECONDS = 2.0
 

@@ -3,10 +3,15 @@
 :func:`solver_path` picks, per reduction, the fastest path for a symmetric tangent: dense
 LAPACK LU up to :data:`DENSE_MAX_DOF` free DOFs, then a banded Cholesky (LAPACK ``dpbtrf``)
 on the cached reverse Cuthill-McKee band while its work ``nf (bw + 1)^2`` stays under
-:data:`BANDED_MAX_WORK`, and SuperLU (LU with a cached minimum-degree ordering) beyond, and
-for every banded tangent that is not positive definite. Each ``*_solver`` returns
-``solve(rhs)`` for ``rhs`` (nf,) (or (nf, k)) that raises :class:`SingularSystemError` for a
-singular matrix or a non-finite solution.
+:data:`CHOLESKY_MIN_WORK`, and a supernodal sparse Cholesky above it (:func:`cholesky_backend`:
+CHOLMOD where ``holofold[cholmod]`` is installed, else holofold's own multifrontal one,
+:mod:`~holofold.mechanics.supernodal`, on the compiled kernel path). Without either (no cvxopt
+and the numpy kernel path) the band serves up to :data:`BANDED_MAX_WORK` and
+SuperLU (LU with a cached minimum-degree ordering) beyond. A tangent on the sparse-Cholesky
+path that is not positive definite gets holofold's sparse LDL^T where the compiled kernels run
+(:func:`cholesky_solver`), else SuperLU, as does a banded tangent that is not positive
+definite. Each ``*_solver`` returns ``solve(rhs)`` for ``rhs`` (nf,) (or (nf, k)) that
+raises :class:`SingularSystemError` for a singular matrix or a non-finite solution.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ __all__ = [
     "BANDED_MAX_WORK",
     "CHOLESKY_MIN_WORK",
     "SOLVER_PATHS",
+    "cholesky_backend",
     "solver_path",
     "storage_of",
     "dense_solver",
@@ -42,11 +48,13 @@ __all__ = [
 DENSE_MAX_DOF = 200
 #: Sparse systems whose reverse Cuthill-McKee band costs at most this many flops
 #: (n * (bandwidth + 1)^2) use the banded Cholesky; above it the supernodal sparse Cholesky
-#: where cvxopt is installed. Measured on Miura sheets (CPU time): a whole solve_newton_batch
-#: per sample, band (its compiled whole-solve kernel) / sparse Cholesky, 6.0 / 7.5 ms at 24 x 8
-#: (work 1.2e7), 12.7 / 13.9 at 30 x 10 (3.0e7), 37.5 / 34.1 at 36 x 12 (6.1e7), 57.8 / 50.0
-#: at 48 x 16; the factorisation + solve alone (benchmarks/bench_large_solvers.py) 3.3 / 2.4
-#: ms at 36 x 12, 32 / 14 at 72 x 24, 505 / 56 at 120 x 40, 3334 / 167 at 100 x 100.
+#: (:func:`cholesky_backend`; holofold's own multifrontal one is as fast as CHOLMOD from
+#: 36 x 12 to 72 x 24 cells, benchmarks/large_solvers.md). Measured on Miura sheets (CPU
+#: time): a whole solve_newton_batch per sample, band (its compiled whole-solve kernel) /
+#: sparse Cholesky, 6.0 / 7.5 ms at 24 x 8 (work 1.2e7), 12.7 / 13.9 at 30 x 10 (3.0e7),
+#: 37.5 / 34.1 at 36 x 12 (6.1e7), 57.8 / 50.0 at 48 x 16; the factorisation + solve alone
+#: (benchmarks/bench_large_solvers.py) 3.3 / 2.4 ms at 36 x 12, 32 / 14 at 72 x 24, 505 / 56
+#: at 120 x 40, 3334 / 167 at 100 x 100.
 CHOLESKY_MIN_WORK = 4e7
 #: Without the sparse Cholesky: band work up to which the banded Cholesky beats SuperLU
 #: (bench_large_solvers, band / SuperLU, two runs at load 13-20: 195-505 / 282-314 ms at
@@ -74,11 +82,22 @@ def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:
     work = nf * (red.band.bandwidth + 1) ** 2
     if work <= CHOLESKY_MIN_WORK:
         return "banded"
-    from holofold.mechanics import sparse_cholesky
-
-    if sparse_cholesky.available():
+    if cholesky_backend() is not None:
         return "cholesky"
     return "banded" if work <= BANDED_MAX_WORK else "superlu"
+
+
+def cholesky_backend() -> str | None:
+    """The supernodal sparse Cholesky of the ``"cholesky"`` path: ``"cholmod"`` where cvxopt
+    imports (``holofold[cholmod]``), else ``"supernodal"`` (holofold's own, numba and scipy's
+    BLAS) where the compiled kernels run (it is compiled with them, into their cache), else
+    None: on the numpy kernel path (``HOLOFOLD_KERNELS=numpy``, or ``auto`` while the kernels
+    compile) the band and SuperLU serve."""
+    from holofold.mechanics import kernels, sparse_cholesky
+
+    if sparse_cholesky.available():
+        return "cholmod"
+    return "supernodal" if kernels.active().compiled else None
 
 
 def storage_of(path: str) -> str | None:
@@ -203,18 +222,36 @@ def lu_solver(data: np.ndarray, red: ReducedPattern):
     return solve
 
 
-def _cholesky_analysis(red: ReducedPattern):
-    """The reduction's :class:`~holofold.mechanics.sparse_cholesky.SparseCholesky` (AMD
-    ordering and symbolic analysis of the free-free pattern), reading the ``"csr_upper"``
-    storage (each upper-triangle entry of the reduced CSR at its compact position)."""
-    from holofold.mechanics.sparse_cholesky import SparseCholesky
+def _cholesky_analysis(red: ReducedPattern, backend: str):
+    """The reduction's :class:`~holofold.mechanics.sparse_cholesky.SparseCholesky` (CHOLMOD)
+    or :class:`~holofold.mechanics.supernodal.SupernodalCholesky` (ordering and symbolic
+    analysis of the free-free pattern), reading the ``"csr_upper"`` storage (each
+    upper-triangle entry of the reduced CSR at its compact position)."""
+    if backend == "cholmod":
+        from holofold.mechanics.sparse_cholesky import SparseCholesky as Analysis
+    else:
+        from holofold.mechanics.supernodal import SupernodalCholesky as Analysis
 
     compact = np.cumsum(red.rows <= red.cols) - 1  # lower entries: never read
-    return SparseCholesky(red.indptr, red.indices, data_slots=np.maximum(compact, 0))
+    return Analysis(red.indptr, red.indices, data_slots=np.maximum(compact, 0))
 
 
-def cholesky_solver(data: np.ndarray, red: ReducedPattern):
-    """``solve(rhs)`` by the supernodal sparse Cholesky of the free-free block from its upper
-    triangle ``data`` (the ``"csr_upper"`` storage; the reduction's cached analysis), or None
-    if the block is not positive definite."""
-    return red.symbolic("cholesky", _cholesky_analysis).factor(data)
+def cholesky_solver(data: np.ndarray, red: ReducedPattern, backend: str | None = None):
+    """``solve(rhs)`` by the supernodal sparse Cholesky (``backend``, default
+    :func:`cholesky_backend`) of the free-free block from its upper triangle ``data`` (the
+    ``"csr_upper"`` storage; the reduction's cached analysis). A block that is not positive
+    definite gets holofold's sparse LDL^T where the compiled kernels run
+    (:meth:`~holofold.mechanics.supernodal.SupernodalCholesky.factor_ldl`: 1.6-10x faster
+    than SuperLU on indefinite Miura tangents of 36 x 12 to 120 x 40 cells); None where that
+    is refused or not available (then LU)."""
+    backend = backend or cholesky_backend() or "supernodal"
+    analysis = red.symbolic(f"cholesky:{backend}", lambda r: _cholesky_analysis(r, backend))
+    solve = analysis.factor(data)
+    if solve is not None:
+        return solve
+    from holofold.mechanics import kernels
+
+    if backend != "supernodal" and not kernels.active().compiled:
+        return None
+    own = red.symbolic("cholesky:supernodal", lambda r: _cholesky_analysis(r, "supernodal"))
+    return own.factor_ldl(data)

@@ -246,8 +246,8 @@ def canopy_sheet():
 
 
 def test_solver_path_takes_the_sparse_cholesky_by_band_work(canopy_sheet, monkeypatch):
-    """Above CHOLESKY_MIN_WORK the assembler takes the sparse Cholesky; without cvxopt the
-    band up to BANDED_MAX_WORK; small models stay on the band."""
+    """Above CHOLESKY_MIN_WORK the assembler takes the sparse Cholesky; without cvxopt (and
+    on the numpy kernel path) the band up to BANDED_MAX_WORK; small models stay on the band."""
     from holofold.mechanics import linear
 
     red = Assembler(canopy_sheet).reduction
@@ -256,6 +256,7 @@ def test_solver_path_takes_the_sparse_cholesky_by_band_work(canopy_sheet, monkey
     assert linear.solver_path(red) == "cholesky"
     assert Assembler(_sheet(12, 4)).solver == "banded"
     monkeypatch.setattr(sparse_cholesky, "_AVAILABLE", False)
+    monkeypatch.setenv("HOLOFOLD_KERNELS", "numpy")  # else holofold's own sparse Cholesky
     assert linear.solver_path(red) == "banded"
     monkeypatch.setattr(linear, "BANDED_MAX_WORK", work / 2)
     assert linear.solver_path(red) == "superlu"
