@@ -569,6 +569,10 @@ class DesignLoop:
                                 tuple(st.boxes), last and last.miner, len(st.table))  # fmt: skip
             new = how(ask)
             words = new.words
+            if last is not None and st.around == r - 1:  # no rule: the box of the hits
+                words = words.replace("inside the best rule", "around the designs meeting it")
+                words = words.replace("inside and around the rules", "around the designs "
+                                      "meeting the target")  # fmt: skip
             if how is at_random and str(st.mine_target) != str(self.problem.target):
                 # designs may meet the target itself: none did with panels that fold clear
                 words = " at random (none met the target with thick panels that do not overlap yet)"
@@ -644,6 +648,7 @@ class DesignLoop:
         ok = mined.table  # the rows mined: failed ones already left out
         if hits and self.more(r):  # a rare target: refine around the designs that meet it
             self.state.boxes = [_box_of(mined.table.loc[mined.meets], self.roles)]
+            self.state.around = r  # the boxes are theirs, not rules
             note = f"no rule yet ({self._met(ok, hits)}); the next round samples around them"
         else:
             note = f"no rule reaches the miner's precision ({self._met(ok, hits)})"

@@ -693,3 +693,32 @@ def test_a_search_that_stops_improving_ends_early_with_the_best_design(tmp_path)
                       rounds=len(s["rounds"]) + 1, workers=1, progress=False,
                       files=False)  # fmt: skip
     assert len(more.summary["rounds"]) > len(s["rounds"])
+
+
+def test_a_round_after_one_without_a_rule_says_it_samples_around_the_hits(tmp_path, monkeypatch):
+    # issue 34 (validation/last_mile): a round after one whose miner found no rule announced
+    # "half inside the best rule" although the box was that of the designs meeting the target
+    import holofold.design.loop as loop
+    from holofold.design import Column, Scenario
+
+    cheap = Scenario(
+        name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
+        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
+        performance=(Column("double", "m"),),
+    )  # fmt: skip
+    real, calls = loop.mined_rules, []
+
+    def none_first(*a, **k):
+        calls.append(1)
+        return [] if len(calls) == 1 else real(*a, **k)
+
+    monkeypatch.setattr(loop, "mined_rules", none_first)
+    said = []
+    run_design(cheap, "double > 1.6", tmp_path / "o", samples=100, rounds=2, refine=40,
+               verify=10, top=1, workers=1, progress=False, files=False,
+               say=said.append)  # fmt: skip
+    assert any("no rule yet" in x and "the next round samples around them" in x for x in said)
+    first = [x for x in said if x.startswith("[refine] round 1")]
+    assert first == ["[refine] round 1/2: 40 new designs, half where the forest votes for the "
+                     "target, half around the designs meeting it"]  # fmt: skip
+    assert not any("inside the best rule" in x for x in said if x.startswith("[refine] round 1"))
