@@ -91,7 +91,7 @@ def test_user_strip_from_a_csv_in_mm(tmp_path):
     _catenary_csv(tmp_path)
     sc = read_scenario(_user_file(tmp_path, CATENARY))
     assert sc.performance_names == [
-        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance"
+        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance", "thick"
     ]  # fmt: skip
     assert sc.categorical == ("m",)
     cols = {c.name: c for c in sc.features}
@@ -281,9 +281,9 @@ def test_evaluate_command_takes_a_scenario_file(tmp_path, capsys):
     import pandas as pd
 
     res = pd.read_csv(out)
-    assert list(res.columns[-10:]) == [
-        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance", "status",
-        "state", "reason",
+    assert list(res.columns[-11:]) == [
+        "Vstiff", "Vsnap", "error", "closest_error", "mass", "overlap", "clearance", "thick",
+        "status", "state", "reason",
     ]  # fmt: skip
     direct = read_scenario(p).evaluate(ROW)
     assert math.isclose(res["Vstiff"][0], direct["Vstiff"], rel_tol=1e-12)

@@ -43,6 +43,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
+from holofold.design.buildability import THICK_CHOICES
 from holofold.design.scenarios.base import Column, Scenario, integer, positive
 from holofold.design.scenarios.config import (
     Section,
@@ -68,7 +69,6 @@ from holofold.fitting import (
     strip_geometry,
 )
 from holofold.geometry import LENGTH_UNITS, non_simple_faces
-from holofold.geometry import TECHNIQUES as THICK_TECHNIQUES
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
@@ -175,8 +175,11 @@ class StripSetting:
         :func:`~holofold.fitting.fit_strip` refuses and nobody can build) as a failed row
         instead of simulating it. None of the 3000 published arch rows overlaps.
     thick : str
-        Thickness accommodation of the fabrication files' solids ("centred", "offset",
-        "tapered"; :func:`~holofold.geometry.thick_panels`); the simulation is the same.
+        Thickness accommodation of the panels ("centred", "offset", "tapered";
+        :func:`~holofold.geometry.thick_panels`), or "auto": the first of them whose panels do
+        not overlap in the strip's shape (:func:`strip_thickness`; a scenario file's default).
+        It sets the ``overlap``, ``clearance`` and ``thick`` columns and the fabrication
+        files' solids; the simulation is the same.
     curve_label : str
         How the curve was given (for reports).
     """
@@ -228,6 +231,10 @@ def strip_columns(setting: StripSetting, extras: bool = True) -> tuple[Column, .
                            display="mm^3"))  # fmt: skip
         cols.append(Column("clearance", "m", "smallest gap between panels sharing no vertex",
                            display="mm"))  # fmt: skip
+        cols.append(Column("thick", "-", "thickness technique of the panels: 0 centred, "
+                           "1 offset, 2 tapered (with thick = 'auto' the first whose panels do "
+                           "not overlap in the strip's shape)", choices=(0.0, 1.0, 2.0),
+                           names=("centred", "offset", "tapered")))  # fmt: skip
     return tuple(cols)
 
 
@@ -383,8 +390,7 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
             }
             continue
         if "overlap" in columns:
-            pattern = CreasePattern.from_faces(g.nodes, list(g.faces))
-            printable[i] = _printability(pattern, float(row["tpanel"]), float(row["W"]))
+            printable[i] = strip_thickness(setting, row, g)
         models.append((i, s, g, err))
     if not models:
         return outs
@@ -423,8 +429,8 @@ def evaluate_strip_batch(setting: StripSetting, columns: Sequence[str], rows) ->
         if "mass" in columns:
             out["mass"] = _mass(setting, g, rows[i])
         if i in printable:
-            out["overlap"] = printable[i].overlap
-            out["clearance"] = min(printable[i].clearance, _NO_NEIGHBOUR)
+            got = printable[i]
+            out["overlap"], out["clearance"], out["thick"] = got.overlap, got.clearance, got.code
         out = {c: out[c] for c in columns}
         out["status"] = Status.gather(cases, worst=Outcome.NOT_CONVERGED)
         outs[i] = out
@@ -487,6 +493,35 @@ def strip_view(setting: StripSetting, row):
     )  # fmt: skip
 
 
+def strip_thickness(setting: StripSetting, row, geometry=None):
+    """The design's thick panels in the strip's shape
+    (:class:`~holofold.design.buildability.ThicknessChoice`): centred panels, or with
+    ``setting.thick`` another technique or "auto" (the first of centred, offset and tapered
+    whose panels do not overlap: :func:`~holofold.design.buildability.choose_thickness` on the
+    strip's flat development and shape). ``geometry``: the design's strip, if built. A strip is
+    not folded from flat in the model, so only its final shape is checked."""
+    from holofold.design.buildability import ThicknessChoice, choose_thickness
+
+    tp, w = float(row["tpanel"]), float(row["W"])
+    fit = None
+    if geometry is None:
+        fit = _fit(setting, row)
+        geometry = fit.geometry
+    p = _printability(CreasePattern.from_faces(geometry.nodes, list(geometry.faces)), tp, w)
+    centred = ThicknessChoice("centred", float(p.overlap),
+                              float(min(p.clearance, _NO_NEIGHBOUR)), ("centred",))  # fmt: skip
+    clear = centred.overlap <= 1e-12 and not centred.clearance < 0
+    if setting.thick == "centred" or (setting.thick == "auto" and clear):
+        return centred
+    flat = (fit or _fit(setting, row)).flat_pattern
+    if flat is None:  # no valid development: nothing but centred panels to judge
+        return centred
+    got = choose_thickness(flat, tp, w, thick=setting.thick, no_neighbour=_NO_NEIGHBOUR)
+    if got.technique == "centred":  # none folds clear: centred, as measured on the strip
+        return ThicknessChoice("centred", centred.overlap, centred.clearance, got.tried)
+    return got
+
+
 def strip_part(setting: StripSetting, row):
     """The printable part: the strip's flat development, printed with panels of ``tpanel``
     joined by hinge strips of ``tcrease`` and width ``W``
@@ -496,9 +531,11 @@ def strip_part(setting: StripSetting, row):
     fit = _fit(setting, row)
     if fit.flat is None:
         return None
+    got = strip_thickness(setting, row)
     return PrintablePart(
-        fit.flat_pattern, float(row["tpanel"]), float(row["tcrease"]), float(row["W"])
-    )
+        fit.flat_pattern, float(row["tpanel"]), float(row["tcrease"]), float(row["W"]),
+        thick=got.technique,
+    )  # fmt: skip
 
 
 def write_strip_files(setting: StripSetting, row, folder, units: str = "mm", cutter=None):
@@ -517,7 +554,7 @@ def write_strip_files(setting: StripSetting, row, folder, units: str = "mm", cut
         crease_thickness=float(row["tcrease"]),
         units=units,
         cutter=cutter,
-        thick=setting.thick,
+        thick=strip_thickness(setting, row).technique,
     )
 
 
@@ -651,7 +688,7 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
         max_iter=max_iter,
         sampling=sampling,
         curve_label=label,
-        thick=doc.choice("thick", THICK_TECHNIQUES, "centred"),
+        thick=doc.choice("thick", THICK_CHOICES, "auto"),
     )
     features = read_features(doc.sub("features"), STRIP_FEATURES, kind="strip")
     for c in features:
