@@ -89,6 +89,16 @@ def _layer(loops: list[np.ndarray], z0: float, z1: float):
     return m3d.Manifold(m3d.Mesh64(vert_properties=np.ascontiguousarray(verts), tri_verts=tris))
 
 
+def _edges_not_in_two(mesh) -> int:
+    """How many edges of ``mesh`` are not in exactly two triangles once its vertices are merged
+    as an STL reader merges them (trimesh's merge tolerance)."""
+    import trimesh
+
+    merged = trimesh.Trimesh(mesh.vertices, mesh.faces, process=True)
+    _, count = np.unique(np.sort(merged.edges, axis=1), axis=0, return_counts=True)
+    return int(np.sum(count != 2))
+
+
 def turned_over(layout: CreasePattern, panels: ThickPanels) -> bool:
     """Whether :func:`thick_printable` turns the part over (180 degrees about x) to print it
     hinge face down: the material lies below the flat layout's reference face."""
@@ -120,12 +130,19 @@ def thick_printable(
     # where a panel's corner edge runs along the layer's (the sheet's border), the union keeps
     # triangles of no area whose corners coincide; merged as an STL reader merges them they
     # leave edges of four triangles: collapse them (surfaces move by less than SIMPLIFY of the
-    # part's size; the roof's and a Miura sheet's volumes did not change to 1e-12)
+    # part's size; the volumes of the roof's and two Miura sheets' parts did not change at all)
     box = np.asarray(whole.bounding_box())
     whole = whole.simplify(SIMPLIFY * float(np.max(box[3:] - box[:3])))
     if turn and panels.side * sgn < 0:  # the material lies below the reference face: turn over
         whole = whole.rotate((180.0, 0.0, 0.0))
     lo = whole.bounding_box()[2]
-    out = _one_body(whole.translate((0.0, 0.0, -lo)), f"printable part ({panels.technique} panels)")
+    name = f"printable part ({panels.technique} panels)"
+    out = _one_body(whole.translate((0.0, 0.0, -lo)), name)
+    bad = _edges_not_in_two(out)
+    if bad:
+        raise DegenerateGeometryError(
+            f"the {name} of this pattern is no closed 2-manifold once its vertices are merged "
+            f"(as an STL reader merges them): {bad} edges are not in exactly two triangles"
+        )
     out.metadata["layout"] = lay
     return out

@@ -104,3 +104,18 @@ def test_roof_offset_part_is_cut_into_pieces_that_fit_the_bed(roof):
         assert m.bounds[0][2] == pytest.approx(0.0, abs=1e-9)
         _assert_closed_2_manifold(m, m.volume)
     assert len(seg.joints) >= len(seg.segments) - 1
+
+
+def test_two_boxes_touching_along_an_edge_are_refused_as_no_2_manifold():
+    """The check thick_printable makes: merged as an STL reader merges them, two boxes that
+    touch along an edge give that edge four triangles."""
+    from holofold.geometry.thick_part import _edges_not_in_two
+
+    a = trimesh.creation.box(extents=(1, 1, 1))
+    b = trimesh.creation.box(extents=(1, 1, 1))
+    b.apply_translation((1, 1, 0))
+    faces = np.vstack([a.faces, b.faces + len(a.vertices)])
+    both = trimesh.Trimesh(np.vstack([a.vertices, b.vertices]), faces, process=False)
+    assert _edges_not_in_two(a) == 0
+    assert both.is_watertight  # unmerged: each box closed on its own
+    assert _edges_not_in_two(both) == 1
