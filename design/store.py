@@ -195,7 +195,7 @@ def _build_locked(
         }
         write_json(meta_path, info)
     n_chunks = (len(designs) + chunk_size - 1) // chunk_size
-    done = scan_chunks(folder, designs, chunk_size)
+    done = scan_chunks(folder, designs, chunk_size, needs=scenario.performance_names)
     _redo_stale(scenario, designs, done, chunk_size, workers, scheduler, on_invalid, timeout,
                 retry_failed)  # fmt: skip
     RowCheckpoint.discard_done(chunks, done)
@@ -425,7 +425,7 @@ def _stored_layout(meta_path: Path, chunks: Path, n_rows: int) -> int | None:
 
 
 def scan_chunks(
-    folder, designs: pd.DataFrame, chunk_size: int, *, move: bool = True
+    folder, designs: pd.DataFrame, chunk_size: int, *, move: bool = True, needs=()
 ) -> dict[int, Path]:
     """The sound chunks of a database folder: chunk index -> path.
 
@@ -434,7 +434,9 @@ def scan_chunks(
     chunk file (truncated, empty, altered, a duplicate or outside the layout) is moved to
     ``chunks/damaged/`` with a warning. A chunk of an older holofold (no checksum in its
     name) that holds the right rows is renamed with its checksum. ``move=False`` (a
-    read-only folder): nothing is moved or renamed; damaged chunks are left out.
+    read-only folder): nothing is moved or renamed; damaged chunks are left out. ``needs``:
+    output columns a sound chunk must hold (the scenario's performance columns: a chunk an
+    older holofold wrote without a column the scenario now has is simulated again).
     """
     chunks = Path(folder) / "chunks"
     n = len(designs)
@@ -456,7 +458,9 @@ def scan_chunks(
         elif m[2] is not None and _digest(data) != m[2]:
             why = "checksum mismatch: truncated or altered"
         else:
-            why = _content_problem(data, designs.iloc[k * chunk_size : (k + 1) * chunk_size])
+            why = _content_problem(
+                data, designs.iloc[k * chunk_size : (k + 1) * chunk_size], needs=needs
+            )
         if why:
             if move:
                 move_damaged(p, why)
@@ -469,12 +473,21 @@ def scan_chunks(
     return good
 
 
-def _content_problem(data: bytes, part: pd.DataFrame, outcome: bool = True) -> str | None:
-    """Why a chunk's bytes do not hold exactly the design rows ``part`` (None if they do)."""
+def _content_problem(
+    data: bytes, part: pd.DataFrame, outcome: bool = True, needs=()
+) -> str | None:
+    """Why a chunk's bytes do not hold exactly the design rows ``part`` and the output
+    columns ``needs`` (None if they do)."""
     try:
         res = pd.read_parquet(io.BytesIO(data))
     except Exception as exc:  # noqa: BLE001 - pyarrow raises several types
         return f"unreadable: {type(exc).__name__}"
+    lacking = [c for c in needs if c not in res.columns]
+    if lacking:
+        return (
+            f"written without the column(s) {', '.join(lacking)} that the scenario now has "
+            "(an older holofold)"
+        )
     if len(res) != len(part):
         return f"{len(res)} rows instead of {len(part)}"
     cols = [c for c in part.columns if c in res.columns]
