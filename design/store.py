@@ -473,9 +473,7 @@ def scan_chunks(
     return good
 
 
-def _content_problem(
-    data: bytes, part: pd.DataFrame, outcome: bool = True, needs=()
-) -> str | None:
+def _content_problem(data: bytes, part: pd.DataFrame, outcome: bool = True, needs=()) -> str | None:
     """Why a chunk's bytes do not hold exactly the design rows ``part`` and the output
     columns ``needs`` (None if they do)."""
     try:
