@@ -337,8 +337,10 @@ def part_fit(
     (``segment_NN.stl`` placed on the bed, ``assembly.svg``)."""
     import trimesh
 
-    from holofold.geometry import bed_fit, segment_part, write_segments
+    from holofold.geometry import bed_fit, clear_segments, segment_part, write_segments
     from holofold.geometry.units import length_factor
+
+    clear_segments(Path(path).parent / "segments")  # pieces of an earlier run: not this part's
 
     mesh = trimesh.load_mesh(str(path), force="mesh")
     mesh.apply_scale(length_factor(units))  # metres

@@ -86,7 +86,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "GRIPPER_NAMES",
         ],
         "bed": ["Bed", "DEFAULT_BED", "BedFit", "bed_fit", "place_on_bed", "print_time_text"],
-        "segments": ["Segment", "Segmentation", "segment_part", "assembly_sheet", "write_segments"],
+        "segments": [
+            "Segment",
+            "Segmentation",
+            "segment_part",
+            "assembly_sheet",
+            "write_segments",
+            "clear_segments",
+        ],
         "clearance": ["Printability", "printability", "panel_overlap", "panel_clearance"],
         "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],
         "miura": [

@@ -38,7 +38,14 @@ from holofold.geometry.bed import (
 from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError, check_range
 from holofold.geometry.pattern import CreasePattern
 
-__all__ = ["Segment", "Segmentation", "segment_part", "assembly_sheet", "write_segments"]
+__all__ = [
+    "Segment",
+    "Segmentation",
+    "segment_part",
+    "assembly_sheet",
+    "write_segments",
+    "clear_segments",
+]
 
 _MM = 1000.0
 
@@ -623,9 +630,26 @@ def _area(p: np.ndarray) -> float:
     return 0.5 * float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum())
 
 
+def clear_segments(folder) -> None:
+    """Remove the pieces (``segment_NN.stl``) and ``assembly.svg`` an earlier run wrote into
+    ``folder``, and the folder if that leaves it empty (a rerun must not leave pieces of
+    another design beside the new ones)."""
+    from pathlib import Path
+
+    out = Path(folder)
+    if not out.is_dir() or out.is_symlink():
+        return
+    for p in [*out.glob("segment_*.stl"), out / "assembly.svg"]:
+        if p.is_file() and not p.is_symlink():
+            p.unlink()
+    if not any(out.iterdir()):
+        out.rmdir()
+
+
 def write_segments(seg: Segmentation, folder, units: str = "mm") -> list:
     """Write ``segment_NN.stl`` (each piece placed on the bed, in ``units``) and, for more
-    than one piece, ``assembly.svg`` into ``folder`` (created if needed); returns the paths."""
+    than one piece, ``assembly.svg`` into ``folder`` (created if needed; the pieces an earlier
+    run left there are removed first); returns the paths."""
     from pathlib import Path
 
     from holofold.geometry.export import export
@@ -633,6 +657,7 @@ def write_segments(seg: Segmentation, folder, units: str = "mm") -> list:
 
     if not seg.segments:
         raise ValueError(seg.problem or "no pieces to write")
+    clear_segments(folder)
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     written = [export(s.mesh, out / f"segment_{s.index:02d}.stl", units=units)

@@ -57,6 +57,14 @@ def test_a_strip_too_long_for_the_bed_is_printed_in_pieces(tmp_path):
         lo, hi = trimesh.load_mesh(p).bounds
         assert lo[2] == pytest.approx(0, abs=1e-6) and hi[0] <= 600 + 1e-6 and hi[1] <= 500 + 1e-6
     assert f"into {got.pieces} pieces" in got.advice and "assembly.svg" in got.advice
+    # a rerun on the same folder leaves no piece of the earlier run (validation/last_mile's arch
+    # kept segment_14 and 15 of a 15-piece design beside the 13 pieces of the next one)
+    seg = tmp_path / "files" / "segments"
+    (seg / "segment_99.stl").write_bytes(pieces[0].read_bytes())
+    again = part_fit(fab["printable"].path, small, root=tmp_path, part=part)
+    assert sorted(seg.glob("segment_*.stl")) == pieces and again.pieces == got.pieces
+    whole = part_fit(fab["printable"].path, Bed(8.0, 8.0), root=tmp_path, part=part)
+    assert whole.fits and whole.pieces == 1 and not seg.exists()  # no pieces left to print
 
 
 def test_a_film_is_cut_not_printed(tmp_path):
