@@ -182,7 +182,7 @@ def table(rows: list[dict]) -> str:
             meeting, n, failed = r["verified"]
             low = r["verified_95ci"][0]
             bar = "meets the bar" if r["meets_bar"] else "below the bar"
-            vp = f"{vp:.2f} ({meeting}/{n}, {failed} failed; 95 % from {low:.2f}; {bar})"
+            vp = f"{vp:.2f} ({meeting}/{n + failed}, {failed} failed; 95 % from {low:.2f}; {bar})"
         design = "none" if not r["features"] else (
             f"{r['answer']}: " + ("meets, " if r["meets"] else "misses, ")
             + ("buildable" if r["buildable"] else "not buildable")
