@@ -26,6 +26,8 @@ LEFT = [
             "_warmup",
             "assembly",
             "kernels",
+            "linear",  # joined with the plain install's supernodal Cholesky (merge of h37):
+            "supernodal",  # linear asks kernels whether the compiled path is active
             "newton_step",
             "solvers",
             "solvers._common",
