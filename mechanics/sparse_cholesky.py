@@ -82,9 +82,11 @@ def available() -> bool:
 METIS_MIN_DOF = 10_000
 
 
-def _nested_dissection(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray | None:
-    """METIS's nested-dissection order of the symmetric pattern with lower-triangle entries
-    (rows, cols), or None where pymetis is not installed."""
+def nested_dissection(rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray | None:
+    """METIS's nested-dissection order of the symmetric pattern with entries (rows, cols) of
+    one triangle (either: the graph is made symmetric), or None where pymetis is not
+    installed. Both sparse Cholesky paths order with it (CHOLMOD's, and
+    :mod:`~holofold.mechanics.supernodal`)."""
     try:
         import pymetis
     except ImportError:
@@ -189,7 +191,7 @@ class SparseCholesky:
             raise ValueError(f"ordering must be 'amd' or a permutation, got {ordering!r}")
         if ordering is None or isinstance(ordering, str):
             auto = ordering is None and n >= METIS_MIN_DOF
-            nd = _nested_dissection(r_low, c_low, n) if auto else None
+            nd = nested_dissection(r_low, c_low, n) if auto else None
             if nd is None:
                 p = amd.order(self._A)  # AMD of the pattern (lower triangle + mirror)
             else:  # CHOLMOD keeps the better of METIS's and its own AMD

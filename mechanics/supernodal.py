@@ -41,6 +41,7 @@ from numba.core import config
 
 from holofold.mechanics import kernels
 from holofold.mechanics._jit import OPTS
+from holofold.mechanics.sparse_cholesky import nested_dissection
 from holofold.mechanics.status import SingularSystemError
 
 __all__ = [
@@ -573,19 +574,9 @@ def mmd_order(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
 
 
 def metis_order(n: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray | None:
-    """METIS's nested-dissection order of the pattern, or None where pymetis is missing."""
-    try:
-        import pymetis
-    except ImportError:
-        return None
-    off = rows != cols
-    r, c = rows[off], cols[off]
-    G = sp.csr_matrix(
-        (np.ones(2 * r.size, np.int8), (np.concatenate([r, c]), np.concatenate([c, r]))),
-        shape=(n, n),
-    )
-    order, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr, G.indices))
-    return np.array(order).astype(np.int64)
+    """METIS's nested-dissection order of the pattern, or None where pymetis is missing
+    (:func:`~holofold.mechanics.sparse_cholesky.nested_dissection`)."""
+    return nested_dissection(rows, cols, n)
 
 
 class _Analysis:

@@ -179,7 +179,7 @@ def test_nested_dissection_candidate(monkeypatch):
     ref = spla.spsolve(K.tocsc(), b)
     monkeypatch.setattr(sparse_cholesky, "METIS_MIN_DOF", 100)
     metis = SparseCholesky(K.indptr, K.indices)
-    if sparse_cholesky._nested_dissection(np.array([1]), np.array([0]), 2) is None:
+    if sparse_cholesky.nested_dissection(np.array([1]), np.array([0]), 2) is None:
         assert metis._nmethods == 1  # no pymetis: AMD as given
     else:
         assert metis._nmethods == 0  # METIS's order and CHOLMOD's AMD compared
