@@ -160,6 +160,12 @@ def build_database(
         return load_database(folder, _write=True)
 
 
+#: what :func:`generate_database` passes on to :func:`build_database` (how the rows run)
+_RUN_OPTIONS = frozenset(
+    ("chunk_size", "workers", "progress", "scheduler", "row_timeout", "retry_failed", "checkpoint")
+)
+
+
 def _build_locked(
     scenario, designs, folder, checked, chunk_size, workers, progress, meta, scheduler,
     on_invalid, timeout, retry_failed=False, every=CHECKPOINT_SECONDS,
@@ -590,21 +596,17 @@ def generate_database(
     seed: int = 0,
     method: str = "random",
     ranges: dict | None = None,
-    chunk_size: int = 100,
-    workers: int = 1,
-    progress: bool | None = None,
-    scheduler: str | None = None,
     csv: bool = False,
     on_invalid: str = "skip",
-    row_timeout: float | str | None = None,
-    retry_failed: bool = False,
-    checkpoint: float = CHECKPOINT_SECONDS,
+    **run,
 ) -> pd.DataFrame:
     """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
 
     ``seed``, ``method`` and ``ranges`` go to :func:`holofold.design.sampling.sample_designs`
-    and are recorded in ``meta.json``; the rest to :func:`build_database`. ``csv`` also
-    writes ``database.csv``. Returns the database.
+    and are recorded in ``meta.json``; ``run`` (``chunk_size``, ``workers``, ``progress``,
+    ``scheduler``, ``row_timeout``, ``retry_failed``, ``checkpoint``) to
+    :func:`build_database`, whose defaults and meanings they keep. ``csv`` also writes
+    ``database.csv``. Returns the database.
 
     Sampled designs lie inside the features' ranges, but a scenario's check can still refuse
     some (an odd arch ``m`` from ``ranges``, a gripper whose ``W`` is not below ``L2/2``: 49
@@ -612,18 +614,17 @@ def generate_database(
     their reason, ``on_invalid="fail"`` refuses the database before anything is simulated.
     Designs refused while simulating (a self-overlapping strip) are failed rows either way.
     """
+    unknown = sorted(set(run) - _RUN_OPTIONS)
+    if unknown:  # before any work, as Python itself would for a named parameter
+        raise TypeError(f"generate_database() got an unexpected keyword argument {unknown[0]!r}")
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     if int(n) < 1:
         raise ValueError(f"n = {n} designs must be >= 1")
     designs = sample_designs(scenario, int(n), seed=seed, method=method, ranges=ranges)
     recorded = {k: list(v) for k, v in (ranges or {}).items()}
-    db = build_database(
-        scenario, designs, folder, chunk_size=chunk_size, workers=workers, progress=progress,
-        meta={"seed": seed, "method": method, "ranges": recorded}, scheduler=scheduler,
-        on_invalid=on_invalid, row_timeout=row_timeout, retry_failed=retry_failed,
-        checkpoint=checkpoint,
-    )  # fmt: skip
+    meta = {"seed": seed, "method": method, "ranges": recorded}
+    db = build_database(scenario, designs, folder, meta=meta, on_invalid=on_invalid, **run)
     if csv:
         write_table(db, Path(folder) / "database.csv")
     return db

@@ -104,3 +104,14 @@ def test_a_huge_sample_is_refused_before_any_work(scen):
         sample_designs(scen, 10**9)  # refused before drawing: 10**9 rows would not fit
     with pytest.raises(ValueError, match="whole number"):
         sample_designs(scen, 2.5)
+
+
+def test_generate_database_passes_exactly_build_databases_run_options_on(tmp_path):
+    import inspect
+
+    own = {"scenario", "designs", "folder", "meta", "on_invalid"}
+    build = set(inspect.signature(store.build_database).parameters) - own
+    assert build == store._RUN_OPTIONS
+    with pytest.raises(TypeError, match="'chunksize'"):
+        store.generate_database("single-miura", 4, tmp_path / "db", chunksize=2)
+    assert not (tmp_path / "db").exists()  # refused before any work
