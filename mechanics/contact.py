@@ -94,6 +94,7 @@ class PanelContact:
         self.kappa = float(kappa)
         self.barrier = ipc.BarrierPotential(self.dhat, self.kappa)
         self.n_dof = self.X0.size
+        self._panel_of_node = _panel_of_node(structure)
         self.last_active = 0
         self.newton_steps = 0
         X = self.X0
@@ -157,6 +158,23 @@ class PanelContact:
     def active(self, U) -> int:
         """Number of pairs closer than ``dmin + dhat``."""
         return len(self._collisions(self._pos(U)))
+
+    def touching(self, U) -> tuple[int, tuple[int, int]]:
+        """``(pairs, (panel, panel))``: the number of primitive pairs closer than ``dmin +
+        dhat`` at ``U`` and two panels of the closest one (``(-1, -1)`` when none; a primitive
+        is placed in the panel of its first vertex)."""
+        X = self._pos(U)
+        c = self._collisions(X)
+        if not len(c):
+            return 0, (-1, -1)
+        E, F = self.mesh.edges, self.mesh.faces
+        best, ids = math.inf, None
+        for i in range(len(c)):
+            d = c[i].compute_distance(c[i].dof(X, E, F))
+            if d < best:
+                best, ids = d, c[i].vertex_ids(E, F)
+        a, b = (int(self._panel_of_node[ids[0]]), int(self._panel_of_node[ids[2]]))
+        return len(c), (min(a, b), max(a, b))
 
     def free_step(self, U0, U1) -> float:
         """Largest fraction in [0, 1] of the straight path ``U0 -> U1`` on which no two
@@ -228,6 +246,19 @@ class PanelContact:
                 return None
             U = cand
         return None
+
+
+def _panel_of_node(structure) -> np.ndarray:
+    """(nn,) int: a panel holding each node (-1 for none), from ``structure.tri_panel``."""
+    out = np.full(len(structure.nodes), -1, np.intp)
+    panel = getattr(structure, "tri_panel", None)
+    if panel is None:
+        return out
+    tri, panel = np.asarray(structure.triangles), np.asarray(panel)
+    keep = panel >= 0
+    for col in range(3)[::-1]:  # the first triangle's panel wins: assigned last
+        out[tri[keep, col][::-1]] = panel[keep][::-1]
+    return out
 
 
 def contact_model(contact, structure, asm=None, thickness=None):

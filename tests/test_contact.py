@@ -46,6 +46,17 @@ def test_barrier_gradient_and_hessian_match_finite_differences():
     assert np.abs(H - Hf).max() <= 1e-6 * np.abs(H).max()
 
 
+def test_touching_counts_the_pairs_and_names_the_two_panels():
+    s = _Two()  # 1.5 mm apart: closer than dmin + dhat = 2 mm, not touching
+    s.tri_panel = np.array([0, 0, 1, 1])
+    pc = PanelContact(s, kappa=1e3)
+    n, where = pc.touching(np.zeros_like(s.nodes))
+    assert n == pc.active(np.zeros_like(s.nodes)) > 0 and where == (0, 1)
+    far = np.zeros_like(s.nodes)
+    far[4:, 2] = 2e-3  # 3.5 mm apart
+    assert pc.touching(far) == (0, (-1, -1))
+
+
 def test_parallel_panels_pushed_together_stop_at_a_gap():
     s = _Two()
     pc = PanelContact(s, kappa=1e3)
