@@ -37,7 +37,12 @@ from holofold.fitting.strip import (
 )
 from holofold.fitting.strip_fit import StripFit, fit_strip
 from holofold.geometry.clearance import printability
-from holofold.geometry.errors import DegenerateGeometryError, ParameterError, check_range
+from holofold.geometry.errors import (
+    DegenerateGeometryError,
+    ParameterError,
+    check_range,
+    record_or_keywords,
+)
 from holofold.geometry.thick import TECHNIQUES, path_overlap, thick_panels
 
 __all__ = [
@@ -79,19 +84,6 @@ class ThickCheck:
     crease_width: float | None = None
     require_no_overlap: bool = False
     thick: str = "centred"
-
-
-def _thick_check(given: ThickCheck | None, options: dict) -> ThickCheck:
-    """The record, or one made of the former keywords (``panel_thickness=``, ...)."""
-    fields = ThickCheck.__dataclass_fields__
-    for k in options:
-        if k not in fields:
-            raise TypeError(f"fit_auto() got an unexpected keyword argument {k!r}")
-    if given is None:
-        return ThickCheck(**options)
-    if options:
-        raise TypeError(f"fit_auto(thick_check=...): give {next(iter(options))} in the record")
-    return given
 
 
 class AutoFit(NamedTuple):
@@ -161,7 +153,7 @@ def fit_auto(
     FitNotFoundError
         When no candidate qualifies (the message names the best error reached).
     """
-    tc = _thick_check(thick_check, thick_options)
+    tc = record_or_keywords(ThickCheck, thick_check, thick_options, "fit_auto", "thick_check")
     panel_thickness, crease_width = tc.panel_thickness, tc.crease_width
     require_no_overlap, thick = tc.require_no_overlap, tc.thick
     curve = load_curve(curve)

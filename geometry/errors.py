@@ -14,6 +14,7 @@ __all__ = [
     "ParameterError",
     "EnvironmentFault",
     "check_range",
+    "record_or_keywords",
 ]
 
 
@@ -69,3 +70,17 @@ def check_range(
     if bad:
         raise ParameterError(f"{name} = {value!r} is outside the allowed range {rng}")
     return v
+
+
+def record_or_keywords(cls, given, keywords: dict, caller: str, param: str):
+    """A settings record given whole (parameter ``param`` of function ``caller``), or made of
+    its fields given as keywords, never both: ``given`` itself, or ``cls(**keywords)``. An
+    unknown name raises ``TypeError`` as Python does for a function's parameter."""
+    for name in keywords:
+        if name not in cls.__dataclass_fields__:
+            raise TypeError(f"{caller}() got an unexpected keyword argument {name!r}")
+    if given is None:
+        return cls(**keywords)
+    if keywords:
+        raise TypeError(f"{caller}({param}=...): give {next(iter(keywords))} in the record")
+    return given
