@@ -17,7 +17,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from holofold.geometry.arrangement import arrange_lines
+from holofold.geometry.cuts import separate_cuts
 from holofold.geometry.errors import FormatError, ParameterError
+from holofold.geometry.facets import SPLIT_MODES, split_faces
 from holofold.geometry.pattern import MAX_PANELS, CreasePattern
 
 __all__ = [
@@ -36,8 +39,6 @@ class PatternWarning(UserWarning):
 
 
 def _check_split(split: str) -> str:
-    from holofold.geometry.facets import SPLIT_MODES
-
     if split not in SPLIT_MODES:
         raise ParameterError(f"split = {split!r}; allowed: {', '.join(SPLIT_MODES)}")
     return split
@@ -66,9 +67,6 @@ def finish_pattern(
 ) -> CreasePattern:  # fmt: skip
     """A :class:`CreasePattern` from a flat layout (metres) and its faces: cuts separated,
     faces split as the model needs (``split``), each repair warned about in one line."""
-    from holofold.geometry.cuts import separate_cuts
-    from holofold.geometry.facets import split_faces
-
     split = _check_split(split)
     notes = list(notes)
     xy = np.asarray(xy, float)
@@ -114,8 +112,6 @@ def pattern_from_lines(
     """The crease pattern of drawn lines (drawing units; ``unit`` metres per drawing unit;
     ``tol`` the merge distance in drawing units, default 2e-3 of the drawing's larger side),
     placed with the lower-left corner of its extent at the origin."""
-    from holofold.geometry.arrangement import arrange_lines
-
     if not (np.isfinite(unit) and unit > 0):
         raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
     if tol is not None and not (np.isfinite(tol) and tol > 0):
