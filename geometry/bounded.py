@@ -18,6 +18,7 @@ from __future__ import annotations
 import io
 import os
 import re
+import stat
 from pathlib import Path
 
 from holofold.geometry.errors import FormatError
@@ -139,6 +140,11 @@ def read_source(source, limit: int = MAX_PATTERN_BYTES, what: str = "file") -> b
         except OSError as exc:
             raise FormatError(f"cannot read {what} {name!r}: {exc.strerror}") from None
     elif callable(getattr(source, "read", None)):
+        size = _stream_size(source)  # an open file: refused before any of it is read
+        if size is not None and size > limit:
+            raise FormatError(
+                f"{what} {name!r} is {size:,} bytes; at most {limit:,} are read (docs/limits.md)"
+            )
         try:
             data = source.read(limit + 1)
         except OSError as exc:
@@ -158,6 +164,15 @@ def read_source(source, limit: int = MAX_PATTERN_BYTES, what: str = "file") -> b
             f"{what} {name!r} is {size} bytes; at most {limit:,} are read (docs/limits.md)"
         )
     return data
+
+
+def _stream_size(stream) -> int | None:
+    """The bytes left in an open regular file from where it stands, None for other streams."""
+    try:
+        st = os.fstat(stream.fileno())
+        return st.st_size - stream.tell() if stat.S_ISREG(st.st_mode) else None
+    except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+        return None
 
 
 def _open(source):

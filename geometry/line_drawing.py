@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -182,18 +182,18 @@ class LineDrawing:
     name: str = "<lines>"
     kind: str = "lines"
     notes: tuple[str, ...] = ()
-    curves: tuple = field(default=())
+    curves: tuple = ()
     unit_note: str = ""
 
     def __post_init__(self):
-        S = np.asarray(self.segments, float)
+        S = np.array(self.segments, float)  # copies: the caller's arrays stay writeable
         if S.size == 0:
             S = S.reshape(0, 2, 2)
         if S.ndim != 3 or S.shape[1:] != (2, 2):
             raise ParameterError(f"segments: expected an (n, 2, 2) array, got shape {S.shape}")
         n = len(S)
-        asg = np.asarray(self.assignment, dtype="<U1")
-        ang = np.asarray(self.fold_angle, float)
+        asg = np.array(self.assignment, dtype="<U1")
+        ang = np.array(self.fold_angle, float)
         if asg.shape != (n,) or ang.shape != (n,):
             raise ParameterError(
                 f"assignment {asg.shape} and fold_angle {ang.shape}: one entry per segment ({n})"

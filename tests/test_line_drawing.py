@@ -138,6 +138,10 @@ def test_the_bounded_checks_run_on_the_bytes_before_a_parser(monkeypatch):
     with pytest.raises(FormatError, match=r"^SVG file '<file>' is over 100 bytes; at most 100"):
         svg_drawing(stream)
     assert stream.tell() == 101
+    with open(BIRD, "rb") as fh:  # an open file: its size is known, nothing of it is read
+        with pytest.raises(FormatError, match=r"'birdBase.svg' is [0-9,]+ bytes; at most 100 "):
+            svg_drawing(fh)
+        assert fh.tell() == 0
     with pytest.raises(FormatError, match=r"'birdBase.svg' is [0-9,]+ bytes; at most 100 are"):
         svg_drawing(BIRD)
     with pytest.raises(FormatError, match="open it in binary mode"):
