@@ -17,7 +17,7 @@ planar arrangement (:func:`~holofold.geometry.arrangement.arrange_lines`), cuts 
 (:func:`~holofold.geometry.cuts.separate_cuts`), faces split where the model needs it
 (:func:`~holofold.geometry.facets.split_faces`).
 
-This module is the registry only: it imports the reader modules, none imports it. Other
+This module is the registry only: it imports the reader modules, none of which imports it. Other
 formats are added with :func:`register_reader` (a function ``source, **options ->
 CreasePattern``).
 """
@@ -137,9 +137,8 @@ def reader_for(path, suffix: str | None = None) -> PatternReader:
         suffix = Path(named).suffix if isinstance(named, str | os.PathLike) else ""
     suffix = str(suffix).lower()
     if suffix not in READERS:
-        name = Path(path).name if _is_path(path) else source_name(path)
         raise FormatError(
-            f"{name}: unknown crease-pattern format {suffix or '(no suffix)'!r}; "
+            f"{source_name(path)}: unknown crease-pattern format {suffix or '(no suffix)'!r}; "
             f"known: {', '.join(READERS)}"
         )
     return READERS[suffix]
