@@ -121,7 +121,13 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "READERS",
             "PatternReader",
         ],
-        "line_drawing": ["PatternWarning", "pattern_from_lines"],
+        "line_drawing": [
+            "PatternWarning",
+            "LineDrawing",
+            "pattern_from_drawing",
+            "pattern_from_lines",
+        ],
+        "bounded": ["read_source", "source_name"],
         "printable": [
             "PrintableLayout",
             "printable_layout",

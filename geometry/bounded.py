@@ -6,12 +6,19 @@ to: a ``<use>`` or DXF block ``INSERT`` is counted as the size of what it refers
 just above the limit, so a doubling bomb (2^25 elements from 2 kB) is refused in well under a
 second. Every refusal is one :class:`~holofold.geometry.errors.FormatError` line naming the file
 and never quoting its content.
+
+A file is given as a *source*: a path, the file's bytes, or a binary file object
+(:func:`read_source` reads at most the size limit of it, :func:`source_name` names it in
+messages: the path's name, ``"<bytes>"``, or the file object's name); the checks take a path
+or the bytes.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import re
+import stat
 from pathlib import Path
 
 from holofold.geometry.errors import FormatError
@@ -28,6 +35,8 @@ __all__ = [
     "check_svg_pattern",
     "check_dxf_pattern",
     "expanded_size",
+    "read_source",
+    "source_name",
 ]
 
 #: the largest crease-pattern file read (SVG, DXF, .opx, .cp, FOLD), bytes
@@ -100,13 +109,88 @@ def path_data_problem(d: str) -> str | None:
 SVG_SIZE_UNITS = ("", "px", "mm", "cm", "in", "pt", "pc")
 
 
-def check_file_size(path, limit: int = MAX_PATTERN_BYTES, what: str = "file") -> int:
-    """The size of ``path`` in bytes, refused over ``limit`` before any of it is read."""
-    name = Path(path).name
+_BYTES = (bytes, bytearray, memoryview)
+
+
+def source_name(source) -> str:
+    """The name of a source in messages: a path's file name, ``"<bytes>"``, or a file
+    object's name (``"<file>"`` if it has none)."""
+    if isinstance(source, _BYTES):
+        return "<bytes>"
+    if isinstance(source, str | os.PathLike):
+        return Path(source).name
+    name = getattr(source, "name", None)
+    return Path(name).name if isinstance(name, str) and name else "<file>"
+
+
+def _is_path(source) -> bool:
+    return isinstance(source, str | os.PathLike)
+
+
+def read_source(source, limit: int = MAX_PATTERN_BYTES, what: str = "file") -> bytes:
+    """The bytes of a source (a path, bytes, or a binary file object read from where it
+    stands), refused over ``limit`` bytes before more than ``limit + 1`` of them are read."""
+    name = source_name(source)
+    if isinstance(source, _BYTES):
+        data = bytes(source)
+    elif _is_path(source):
+        check_file_size(source, limit, what)
+        try:
+            return Path(source).read_bytes()
+        except OSError as exc:
+            raise FormatError(f"cannot read {what} {name!r}: {exc.strerror}") from None
+    elif callable(getattr(source, "read", None)):
+        size = _stream_size(source)  # an open file: refused before any of it is read
+        if size is not None and size > limit:
+            raise FormatError(
+                f"{what} {name!r} is {size:,} bytes; at most {limit:,} are read (docs/limits.md)"
+            )
+        try:
+            data = source.read(limit + 1)
+        except OSError as exc:
+            raise FormatError(f"cannot read {what} {name!r}: {exc.strerror}") from None
+        if not isinstance(data, _BYTES):
+            raise FormatError(
+                f"{what} {name!r}: a file object opened as text; open it in binary mode ('rb')"
+            )
+        data = bytes(data)
+    else:
+        raise FormatError(
+            f"{what}: expected a path, bytes or a binary file object, got {type(source).__name__}"
+        )
+    if len(data) > limit:
+        size = f"{len(data):,}" if isinstance(source, _BYTES) else f"over {limit:,}"
+        raise FormatError(
+            f"{what} {name!r} is {size} bytes; at most {limit:,} are read (docs/limits.md)"
+        )
+    return data
+
+
+def _stream_size(stream) -> int | None:
+    """The bytes left in an open regular file from where it stands, None for other streams."""
     try:
-        size = os.stat(path).st_size
-    except OSError as exc:
-        raise FormatError(f"cannot read {what} {name!r}: {exc.strerror}") from None
+        st = os.fstat(stream.fileno())
+        return st.st_size - stream.tell() if stat.S_ISREG(st.st_mode) else None
+    except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+        return None
+
+
+def _open(source):
+    """A binary stream of a path or of bytes."""
+    return io.BytesIO(source) if isinstance(source, _BYTES) else open(source, "rb")
+
+
+def check_file_size(path, limit: int = MAX_PATTERN_BYTES, what: str = "file", name=None) -> int:
+    """The size of ``path`` (or of bytes) in bytes, refused over ``limit`` before any of it is
+    read."""
+    name = name or source_name(path)
+    if isinstance(path, _BYTES):
+        size = len(path)
+    else:
+        try:
+            size = os.stat(path).st_size
+        except OSError as exc:
+            raise FormatError(f"cannot read {what} {name!r}: {exc.strerror}") from None
     if size > limit:
         raise FormatError(
             f"{what} {name!r} is {size:,} bytes; at most {limit:,} are read (docs/limits.md)"
@@ -114,36 +198,39 @@ def check_file_size(path, limit: int = MAX_PATTERN_BYTES, what: str = "file") ->
     return size
 
 
-def check_line_count(path, limit: int = MAX_PATTERN_LINES, what: str = "file") -> int:
-    """The number of lines of ``path``, refused over ``limit`` (counted in 1 MiB blocks)."""
-    check_file_size(path, what=what)
+def check_line_count(path, limit: int = MAX_PATTERN_LINES, what: str = "file", name=None) -> int:
+    """The number of lines of ``path`` (or of bytes), refused over ``limit`` (counted in 1 MiB
+    blocks)."""
+    name = name or source_name(path)
+    check_file_size(path, what=what, name=name)
     n = 0
-    with open(path, "rb") as fh:
+    with _open(path) as fh:
         while block := fh.read(1 << 20):
             n += block.count(b"\n")
             if n > limit:
                 raise FormatError(
-                    f"{what} {Path(path).name!r} has over {limit:,} lines; at most {limit:,} "
+                    f"{what} {name!r} has over {limit:,} lines; at most {limit:,} "
                     "are read (docs/limits.md)"
                 )
     return n
 
 
 def check_token_count(
-    path, token: bytes, what: str, items: str, limit: int = MAX_PATTERN_ELEMENTS
+    path, token: bytes, what: str, items: str, limit: int = MAX_PATTERN_ELEMENTS, name=None
 ) -> int:
-    """How often ``token`` occurs in ``path`` (one per crease line of .cp/.opx), refused over
-    ``limit`` while counting (1 MiB blocks, the file's size checked first)."""
-    check_file_size(path, what=what)
+    """How often ``token`` occurs in ``path`` or bytes (one per crease line of .cp/.opx),
+    refused over ``limit`` while counting (1 MiB blocks, the size checked first)."""
+    name = name or source_name(path)
+    check_file_size(path, what=what, name=name)
     n, tail = 0, b""
-    with open(path, "rb") as fh:
+    with _open(path) as fh:
         while block := fh.read(1 << 20):
             chunk = tail + block
             n += chunk.count(token) - tail.count(token)
             tail = chunk[-(len(token) - 1) :] if len(token) > 1 else b""
             if n > limit:
                 raise FormatError(
-                    f"{what} {Path(path).name!r} has over {limit:,} {items}; at "
+                    f"{what} {name!r} has over {limit:,} {items}; at "
                     f"most {limit:,} are read (docs/limits.md)"
                 )
     return n
@@ -174,14 +261,15 @@ def expanded_size(own: dict, refs: dict, root, caps: tuple, name: str, what: str
     return size(root, frozenset())
 
 
-def check_svg_pattern(path) -> None:
-    """Refuse an SVG crease pattern that is too big, too deep, expands to too many elements or
-    points through ``<use>``, has a non-finite coordinate (``nan``, ``inf``), or a root size in
-    an unknown unit (``100km``, ``100%``): one streaming pass of expat."""
+def check_svg_pattern(path, name: str | None = None) -> None:
+    """Refuse an SVG crease pattern (a path or bytes; ``name`` in messages) that is too big,
+    too deep, expands to too many elements or points through ``<use>``, has a non-finite
+    coordinate (``nan``, ``inf``), or a root size in an unknown unit (``100km``, ``100%``): one
+    streaming pass of expat."""
     from xml.parsers import expat
 
-    name = Path(path).name
-    check_file_size(path, what="SVG file")
+    name = name or source_name(path)
+    check_file_size(path, what="SVG file", name=name)
     parser = expat.ParserCreate()
     caps = (10 * MAX_PATTERN_ELEMENTS + 1, 10 * MAX_PATTERN_POINTS + 1)
     stack: list = [["#root", 0, 0, {}]]
@@ -240,7 +328,7 @@ def check_svg_pattern(path) -> None:
 
     parser.StartElementHandler, parser.EndElementHandler = start, end
     try:
-        with open(path, "rb") as fh:
+        with _open(path) as fh:
             parser.ParseFile(fh)
     except Stop as exc:
         raise FormatError(f"SVG file {name!r}: {exc}") from None
@@ -263,12 +351,12 @@ def check_svg_pattern(path) -> None:
             )
 
 
-def check_dxf_pattern(path) -> None:
-    """Refuse a DXF crease pattern that is too big, too long, or whose block ``INSERT``\\ s expand
-    to too many entities (a block inserting the previous one twice, 30 deep): one pass over its
-    group-code pairs, before ezdxf loads it."""
-    name = Path(path).name
-    check_line_count(path, what="DXF file")
+def check_dxf_pattern(path, name: str | None = None) -> None:
+    """Refuse a DXF crease pattern (a path or bytes; ``name`` in messages) that is too big, too
+    long, or whose block ``INSERT``\\ s expand to too many entities (a block inserting the
+    previous one twice, 30 deep): one pass over its group-code pairs, before ezdxf loads it."""
+    name = name or source_name(path)
+    check_line_count(path, what="DXF file", name=name)
     cap = 10 * MAX_PATTERN_ELEMENTS + 1
     own: dict = {"#model": (0,)}
     refs: dict = {"#model": {}}
@@ -276,7 +364,7 @@ def check_dxf_pattern(path) -> None:
     current = "#model"
     expect = None  # the group code whose value is awaited
     entity = None
-    with open(path, "rb") as fh:
+    with _open(path) as fh:
         lines = iter(fh)
         for code in lines:
             value = next(lines, b"").strip().decode("latin-1")

@@ -17,21 +17,32 @@ Entities: ``LINE``, ``LWPOLYLINE`` and ``POLYLINE`` (straight pieces; bulges are
 curve's extent; ``"refuse"`` refuses curved creases) and ``INSERT`` (block references, exploded
 with their transformation). Units from ``$INSUNITS`` (unitless drawings are read as
 millimetres, with a warning); ``unit`` (metres per drawing unit) overrides.
+
+:func:`dxf_drawing` returns the lines as a :class:`~holofold.geometry.line_drawing.LineDrawing`
+(the file a path, its bytes or a binary file object; the bounded checks of
+:func:`~holofold.geometry.bounded.check_dxf_pattern` run on its bytes before ezdxf parses them);
+:func:`~holofold.geometry.line_drawing.pattern_from_drawing` makes the crease pattern.
 """
 
 from __future__ import annotations
 
-import math
+import io
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 
-from holofold.geometry.bounded import check_dxf_pattern
+from holofold.geometry.bounded import check_dxf_pattern, read_source, source_name
 from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
-from holofold.geometry.line_drawing import pattern_from_lines
+from holofold.geometry.line_drawing import LineDrawing, pattern_from_drawing
 
-__all__ = ["read_dxf_pattern", "dxf_lines", "LAYER_CODES", "ACI_CODES", "MAX_DXF_BYTES"]
+__all__ = [
+    "read_dxf_pattern",
+    "dxf_drawing",
+    "dxf_lines",
+    "LAYER_CODES",
+    "ACI_CODES",
+    "MAX_DXF_BYTES",
+]
 
 #: layer name (upper case) -> FOLD code; holofold's writer uses the first of each group
 LAYER_CODES = {
@@ -100,9 +111,27 @@ def _entities(space, depth: int = 0):
             yield e
 
 
-def dxf_lines(path, *, curves: str = "keep"):
-    """The straight lines of a DXF crease pattern: (segments (n, 2, 2) in drawing units,
-    codes, fold angles in degrees, metres per drawing unit, notes)."""
+def _load(ezdxf, data: bytes, name: str):
+    """The ezdxf document of a DXF file's bytes, as ``ezdxf.readfile`` loads a file: binary DXF
+    by its sentinel, else text in the encoding the header names (undecodable bytes kept)."""
+    from ezdxf.document import Drawing
+    from ezdxf.filemanagement import dxf_stream_info
+    from ezdxf.lldxf.tagger import binary_tags_loader
+    from ezdxf.lldxf.validator import is_dxf_stream
+
+    if data[:22] == b"AutoCAD Binary DXF\r\n\x1a\x00":
+        return Drawing.load(binary_tags_loader(data, errors="surrogateescape"))
+    if not is_dxf_stream(io.TextIOWrapper(io.BytesIO(data), errors="ignore")):
+        raise OSError(f"File '{name}' is not a DXF file.")
+    info = dxf_stream_info(io.TextIOWrapper(io.BytesIO(data), "utf-8", errors="ignore"))
+    text = io.TextIOWrapper(io.BytesIO(data), encoding=info.encoding, errors="surrogateescape")
+    return ezdxf.read(text)
+
+
+def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
+    """The straight lines of a DXF crease pattern (a path, bytes or a binary file object), in
+    drawing units, ``unit`` the metres of one as ``$INSUNITS`` says (millimetres, with a note,
+    when it says none)."""
     try:
         import ezdxf
         from ezdxf import path as ezpath
@@ -111,13 +140,11 @@ def dxf_lines(path, *, curves: str = "keep"):
         raise EnvironmentFault(f"ezdxf cannot be imported ({exc}); pip install ezdxf") from None
     if curves not in ("refuse", "flatten", "keep"):
         raise ParameterError(f"curves = {curves!r}; allowed: refuse, flatten, keep")
-    name = Path(path).name
-    size = Path(path).stat().st_size
-    if size > MAX_DXF_BYTES:
-        raise FormatError(f"{name}: {size} bytes; at most {MAX_DXF_BYTES} (64 MiB) are read")
-    check_dxf_pattern(path)  # lines and block INSERT expansion, before ezdxf loads it
+    name = source_name(source)
+    data = read_source(source, MAX_DXF_BYTES, "DXF file")
+    check_dxf_pattern(data, name)  # lines and block INSERT expansion, before ezdxf loads it
     try:
-        doc = ezdxf.readfile(str(path))
+        doc = _load(ezdxf, data, name)
     except (OSError, ezdxf.DXFError) as exc:
         why = " ".join(str(exc).split())[:200]  # one line
         raise FormatError(f"{name}: not a readable DXF file ({why})") from None
@@ -209,20 +236,23 @@ def dxf_lines(path, *, curves: str = "keep"):
             f"{name}: no crease-pattern lines (LINE/LWPOLYLINE/POLYLINE on crease layers or in "
             "crease colours)"
         )
-    return np.array(segs, float), np.array(codes, dtype="<U1"), np.array(angles), unit, notes
+    unit_note = next((n for n in notes if "$INSUNITS" in n), "")
+    return LineDrawing(np.array(segs, float), np.array(codes, dtype="<U1"), np.array(angles),
+                       unit, name=name, kind="dxf", notes=tuple(notes),
+                       unit_note=unit_note)  # fmt: skip
 
 
-def read_dxf_pattern(path, *, tol: float | None = None, unit: float | None = None,
+def dxf_lines(path, *, curves: str = "keep"):
+    """:func:`dxf_drawing` as a tuple, for callers of the earlier form: (segments (n, 2, 2) in
+    drawing units, codes, fold angles in degrees, metres per drawing unit, notes list)."""
+    d = dxf_drawing(path, curves=curves)
+    return (np.array(d.segments), np.array(d.assignment), np.array(d.fold_angle), d.unit,
+            list(d.notes))  # fmt: skip
+
+
+def read_dxf_pattern(source, *, tol: float | None = None, unit: float | None = None,
                      split: str = "as-needed", curves: str = "keep"):  # fmt: skip
-    """The crease pattern of a DXF file (see the module docstring), metres."""
-    name = Path(path).name
-    S, codes, angles, file_unit, notes = dxf_lines(path, curves=curves)
-    if unit is not None:
-        notes = [n for n in notes if "$INSUNITS" not in n]
-    u = file_unit if unit is None else unit
-    if not (isinstance(u, int | float) and math.isfinite(u) and u > 0):
-        raise ParameterError(f"unit = {u!r} must be a length in metres > 0")
-    return pattern_from_lines(
-        S, codes, angles, name=name, unit=float(u), tol=tol, split=split,
-        meta={"kind": "dxf", "source": name}, notes=notes,
-    )  # fmt: skip
+    """The crease pattern of a DXF file (a path, bytes or a binary file object; see the module
+    docstring), metres."""
+    drawing = dxf_drawing(source, curves=curves)
+    return pattern_from_drawing(drawing, tol=tol, unit=unit, split=split)

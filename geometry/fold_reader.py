@@ -23,14 +23,21 @@ index of the first problem). What it accepts, each with a :class:`PatternWarning
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from pathlib import Path
 
 import numpy as np
 
+from holofold.geometry.bounded import read_source, source_name
 from holofold.geometry.errors import FormatError
 from holofold.geometry.fold_io import _UNITS, MAX_FOLD_BYTES, _Bad, _parse, load_fold
-from holofold.geometry.line_drawing import PatternWarning, finish_pattern, pattern_from_lines
+from holofold.geometry.line_drawing import (
+    LineDrawing,
+    PatternWarning,
+    finish_pattern,
+    pattern_from_drawing,
+)
 from holofold.geometry.pattern import ASSIGNMENTS
 
 __all__ = ["read_fold_pattern", "fold_frames"]
@@ -85,17 +92,24 @@ def _is_cp(fr: dict) -> bool:
     return len(c[0]) == 2 or all(isinstance(v, list) and len(v) >= 3 and v[2] == 0 for v in c)
 
 
-def read_fold_pattern(path, *, frame: int | None = None, unit: float | None = None,
+def read_fold_pattern(source, *, frame: int | None = None, unit: float | None = None,
                       split: str = "as-needed"):  # fmt: skip
-    """The crease pattern of a FOLD file (see the module docstring), metres."""
-    path = Path(path)
-    name = path.name
+    """The crease pattern of a FOLD file (a path, bytes or a binary file object; see the module
+    docstring), metres."""
+    name = source_name(source)
     where = f"FOLD file {name!r}"
     try:
-        size = path.stat().st_size
-        if size > MAX_FOLD_BYTES:
-            raise FormatError(f"{where}: {size} bytes; at most {MAX_FOLD_BYTES} (64 MiB) are read")
-        d = _parse(path.read_bytes())
+        if isinstance(source, str | os.PathLike):
+            path = Path(source)
+            size = path.stat().st_size
+            if size > MAX_FOLD_BYTES:
+                raise FormatError(
+                    f"{where}: {size} bytes; at most {MAX_FOLD_BYTES} (64 MiB) are read"
+                )
+            data = path.read_bytes()
+        else:
+            data = read_source(source, MAX_FOLD_BYTES, "FOLD file")
+        d = _parse(data)
     except OSError as exc:
         raise FormatError(f"{where}: cannot be read ({exc.strerror})") from None
     except _Bad as exc:
@@ -284,8 +298,6 @@ def _from_edges(fr: dict, where: str, name: str, split: str, notes):
     fu = fr.get("frame_unit", "m")
     if fu not in _UNITS:
         raise FormatError(f"{where}: frame_unit = {fu!r}; expected one of {' '.join(_UNITS)}")
-    return pattern_from_lines(
-        S, np.array(asg, dtype="<U1"), np.array(ang, float), name=name, unit=_UNITS[fu],
-        tol=1e-9 * span if span > 0 else None, split=split, meta={"kind": "fold", "source": name},
-        notes=notes,
-    )  # fmt: skip
+    drawing = LineDrawing(S, np.array(asg, dtype="<U1"), np.array(ang, float), _UNITS[fu],
+                          name=name, kind="fold", notes=tuple(notes))  # fmt: skip
+    return pattern_from_drawing(drawing, tol=1e-9 * span if span > 0 else None, split=split)

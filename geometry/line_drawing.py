@@ -1,5 +1,9 @@
-"""The line-drawing pipeline every crease-pattern reader shares: drawn lines (drawing units)
-to a :class:`~holofold.geometry.pattern.CreasePattern` in metres through the planar
+"""The line-drawing pipeline every crease-pattern reader shares.
+
+A line reader (SVG, DXF, ORIPA ``.opx`` and ``.cp``) returns one :class:`LineDrawing` (the
+drawn lines in drawing units, their assignments and fold angles, metres per drawing unit, the
+notes of what the reader assumed); :func:`pattern_from_drawing` turns it into a
+:class:`~holofold.geometry.pattern.CreasePattern` in metres through the planar
 arrangement (:func:`~holofold.geometry.arrangement.arrange_lines`), cuts separated
 (:func:`~holofold.geometry.cuts.separate_cuts`) and faces split where the model needs it
 (:func:`~holofold.geometry.facets.split_faces`); every repair is one :class:`PatternWarning`
@@ -7,14 +11,27 @@ line. The readers (:mod:`~holofold.geometry.readers`, the registry by suffix) bu
 
 from __future__ import annotations
 
+import math
 import warnings
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from holofold.geometry.arrangement import arrange_lines
+from holofold.geometry.cuts import separate_cuts
 from holofold.geometry.errors import FormatError, ParameterError
+from holofold.geometry.facets import SPLIT_MODES, split_faces
 from holofold.geometry.pattern import MAX_PANELS, CreasePattern
 
-__all__ = ["PatternWarning", "MAX_DRAWN_METRES", "finish_pattern", "pattern_from_lines"]
+__all__ = [
+    "PatternWarning",
+    "LineDrawing",
+    "MAX_DRAWN_METRES",
+    "check_unit",
+    "finish_pattern",
+    "pattern_from_drawing",
+    "pattern_from_lines",
+]
 
 
 class PatternWarning(UserWarning):
@@ -22,8 +39,6 @@ class PatternWarning(UserWarning):
 
 
 def _check_split(split: str) -> str:
-    from holofold.geometry.facets import SPLIT_MODES
-
     if split not in SPLIT_MODES:
         raise ParameterError(f"split = {split!r}; allowed: {', '.join(SPLIT_MODES)}")
     return split
@@ -52,9 +67,6 @@ def finish_pattern(
 ) -> CreasePattern:  # fmt: skip
     """A :class:`CreasePattern` from a flat layout (metres) and its faces: cuts separated,
     faces split as the model needs (``split``), each repair warned about in one line."""
-    from holofold.geometry.cuts import separate_cuts
-    from holofold.geometry.facets import split_faces
-
     split = _check_split(split)
     notes = list(notes)
     xy = np.asarray(xy, float)
@@ -100,8 +112,6 @@ def pattern_from_lines(
     """The crease pattern of drawn lines (drawing units; ``unit`` metres per drawing unit;
     ``tol`` the merge distance in drawing units, default 2e-3 of the drawing's larger side),
     placed with the lower-left corner of its extent at the origin."""
-    from holofold.geometry.arrangement import arrange_lines
-
     if not (np.isfinite(unit) and unit > 0):
         raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
     if tol is not None and not (np.isfinite(tol) and tol > 0):
@@ -122,4 +132,102 @@ def pattern_from_lines(
     return finish_pattern(
         xy, arr.faces, arr.edges, arr.assignment, arr.fold_angle,
         name=name, notes=[*notes, *arr.notes], split=split, meta=meta,
+    )  # fmt: skip
+
+
+def check_unit(unit) -> float:
+    """``unit`` (metres per drawing unit) as a float, refused unless a finite number > 0."""
+    if not (isinstance(unit, int | float) and math.isfinite(unit) and unit > 0):
+        raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
+    return float(unit)
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
+@dataclass(frozen=True)
+class LineDrawing:
+    """The lines of a crease-pattern drawing, as a line reader found them.
+
+    Attributes
+    ----------
+    segments : (n, 2, 2) float
+        Drawn lines, drawing units (y up).
+    assignment : (n,) str
+        FOLD codes (``M``, ``V``, ``F``, ``B``, ``C``, ``J``, ``U``).
+    fold_angle : (n,) float
+        Target fold angles, degrees (valley > 0).
+    unit : float
+        Metres per drawing unit (as the file states it, or the reader's assumption).
+    name : str
+        The source in messages: a file name, ``"<bytes>"`` or a file object's name.
+    kind : str
+        The format family, kept in the pattern's ``meta["kind"]`` (``"svg"``, ``"dxf"``,
+        ``"oripa"``, ``"fold"``).
+    notes : tuple of str
+        What the reader assumed or left out, each a :class:`PatternWarning` line once the
+        pattern is made.
+    curves : tuple of :class:`~holofold.geometry.curved.Curve`
+        The curves kept, already cut into straight pieces among ``segments`` (drawing units).
+    unit_note : str
+        The note (one of ``notes``) saying the unit was assumed; :meth:`with_unit` drops it.
+    """
+
+    segments: np.ndarray
+    assignment: np.ndarray
+    fold_angle: np.ndarray
+    unit: float
+    name: str = "<lines>"
+    kind: str = "lines"
+    notes: tuple[str, ...] = ()
+    curves: tuple = ()
+    unit_note: str = ""
+
+    def __post_init__(self):
+        S = np.array(self.segments, float)  # copies: the caller's arrays stay writeable
+        if S.size == 0:
+            S = S.reshape(0, 2, 2)
+        if S.ndim != 3 or S.shape[1:] != (2, 2):
+            raise ParameterError(f"segments: expected an (n, 2, 2) array, got shape {S.shape}")
+        n = len(S)
+        asg = np.array(self.assignment, dtype="<U1")
+        ang = np.array(self.fold_angle, float)
+        if asg.shape != (n,) or ang.shape != (n,):
+            raise ParameterError(
+                f"assignment {asg.shape} and fold_angle {ang.shape}: one entry per segment ({n})"
+            )
+        object.__setattr__(self, "segments", _frozen(S))
+        object.__setattr__(self, "assignment", _frozen(asg))
+        object.__setattr__(self, "fold_angle", _frozen(ang))
+        object.__setattr__(self, "unit", check_unit(self.unit))
+        object.__setattr__(self, "notes", tuple(str(n) for n in self.notes))
+        object.__setattr__(self, "curves", tuple(self.curves))
+
+    def __len__(self) -> int:
+        return len(self.segments)
+
+    def with_unit(self, unit: float | None) -> LineDrawing:
+        """The same drawing at ``unit`` metres per drawing unit (None: as it is), without the
+        note that the unit was assumed."""
+        if unit is None:
+            return self
+        notes = tuple(n for n in self.notes if not self.unit_note or n != self.unit_note)
+        return replace(self, unit=check_unit(unit), notes=notes, unit_note="")
+
+
+def pattern_from_drawing(
+    drawing: LineDrawing, *, tol: float | None = None, unit: float | None = None,
+    split: str = "as-needed",
+) -> CreasePattern:  # fmt: skip
+    """The crease pattern of a :class:`LineDrawing` (metres): end points merged within ``tol``
+    (drawing units; default 2e-3 of the drawing's larger side), crossings split, faces found,
+    cuts separated, faces split as ``split`` asks (:data:`~holofold.geometry.facets.SPLIT_MODES`);
+    ``unit`` (metres per drawing unit) overrides the drawing's. Each note and repair is one
+    :class:`PatternWarning` line naming ``drawing.name``; ``meta`` holds its kind and name."""
+    d = drawing.with_unit(unit)
+    return pattern_from_lines(
+        d.segments, d.assignment, d.fold_angle, name=d.name, unit=d.unit, tol=tol, split=split,
+        meta={"kind": d.kind, "source": d.name}, notes=d.notes,
     )  # fmt: skip

@@ -7,35 +7,47 @@ leaves them out); ``.cp`` has one line per crease, ``type x0 y0 x1 y1``. ORIPA d
 down, so y is turned up. Neither has a unit or fold angles: one drawing unit is read as a
 millimetre unless ``unit`` says otherwise (ORIPA's default sheet is 400 units wide), and
 mountains and valleys fold fully (-+180 degrees).
+
+:func:`opx_drawing` and :func:`cp_drawing` return the lines as a
+:class:`~holofold.geometry.line_drawing.LineDrawing` (the file a path, its bytes or a binary
+file object, its lines counted before it is parsed);
+:func:`~holofold.geometry.line_drawing.pattern_from_drawing` makes the crease pattern.
 """
 
 from __future__ import annotations
 
-import math
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import numpy as np
 
-from holofold.geometry.bounded import check_token_count
-from holofold.geometry.errors import FormatError, ParameterError
-from holofold.geometry.line_drawing import pattern_from_lines
+from holofold.geometry.bounded import check_token_count, read_source, source_name
+from holofold.geometry.errors import FormatError
+from holofold.geometry.line_drawing import LineDrawing, pattern_from_drawing
 
-__all__ = ["read_opx_pattern", "read_cp_pattern", "ORIPA_TYPES", "MAX_ORIPA_BYTES"]
+__all__ = [
+    "read_opx_pattern",
+    "read_cp_pattern",
+    "opx_drawing",
+    "cp_drawing",
+    "ORIPA_TYPES",
+    "MAX_ORIPA_BYTES",
+]
 
 #: ORIPA line type -> FOLD code (0 and 4: auxiliary lines, not read)
 ORIPA_TYPES = {1: "B", 2: "M", 3: "V"}
 _ANGLE = {"M": -180.0, "V": 180.0, "B": 0.0}
 #: the largest ORIPA file read, bytes
 MAX_ORIPA_BYTES = 64 * 2**20
+#: the note of a file without a unit (dropped when the caller gives one)
+_NO_UNIT = "no unit in the file: one drawing unit read as 1 mm; give unit"
 
 
-def _read_text(path) -> bytes:
-    p = Path(path)
-    size = p.stat().st_size
-    if size > MAX_ORIPA_BYTES:
-        raise FormatError(f"{p.name}: {size} bytes; at most {MAX_ORIPA_BYTES} (64 MiB) are read")
-    return p.read_bytes()
+def _bytes(source, token: bytes, what: str) -> tuple[bytes, str]:
+    """(bytes, name) of an ORIPA file, its lines (``token``\\ s) counted first."""
+    name = source_name(source)
+    data = read_source(source, MAX_ORIPA_BYTES, what)
+    check_token_count(data, token, what, "lines", name=name)
+    return data, name
 
 
 def _value(obj, prop: str, kind: type, default):
@@ -53,12 +65,12 @@ def _value(obj, prop: str, kind: type, default):
     return default
 
 
-def opx_lines(path):
-    """(segments (n, 2, 2) ORIPA units y up, codes, angles, notes) of an ``.opx`` file."""
-    name = Path(path).name
-    check_token_count(path, b"OriLineProxy", ".opx file", "lines")
+def opx_drawing(source) -> LineDrawing:
+    """The lines of an ``.opx`` file (a path, bytes or a binary file object), ORIPA units with
+    y up."""
+    data, name = _bytes(source, b"OriLineProxy", ".opx file")
     try:
-        root = ET.fromstring(_read_text(path))
+        root = ET.fromstring(data)
     except ET.ParseError as exc:
         raise FormatError(f"{name}: not well-formed XML ({exc})") from None
     segs, codes = [], []
@@ -79,12 +91,12 @@ def opx_lines(path):
     return _finish(name, segs, codes, aux)
 
 
-def cp_lines(path):
-    """(segments, codes, angles, notes) of a ``.cp`` file (``type x0 y0 x1 y1`` per line)."""
-    name = Path(path).name
-    check_token_count(path, b"\n", ".cp file", "lines")
+def cp_drawing(source) -> LineDrawing:
+    """The lines of a ``.cp`` file (``type x0 y0 x1 y1`` per line; a path, bytes or a binary
+    file object), y up."""
+    data, name = _bytes(source, b"\n", ".cp file")
     try:
-        text = _read_text(path).decode("utf-8-sig")
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise FormatError(f"{name}: not a text file") from None
     segs, codes = [], []
@@ -108,37 +120,27 @@ def cp_lines(path):
     return _finish(name, segs, codes, aux)
 
 
-def _finish(name, segs, codes, aux):
+def _finish(name, segs, codes, aux) -> LineDrawing:
     if not segs:
         raise FormatError(f"{name}: no border, mountain or valley lines")
-    notes = ["no unit in the file: one drawing unit read as 1 mm; give unit"]
+    notes = [_NO_UNIT]
     if aux:
         notes.append(f"{aux} auxiliary line(s) (type 0 or 4) left out")
     S = np.array(segs, float)
     if not np.isfinite(S).all():
         raise FormatError(f"{name}: a line has non-finite coordinates")
     c = np.array(codes, dtype="<U1")
-    return S, c, np.array([_ANGLE[x] for x in codes]), notes
+    return LineDrawing(S, c, np.array([_ANGLE[x] for x in codes]), 1e-3, name=name,
+                       kind="oripa", notes=tuple(notes), unit_note=_NO_UNIT)  # fmt: skip
 
 
-def _read(lines, path, tol, unit, split):
-    name = Path(path).name
-    S, codes, angles, notes = lines(path)
-    if unit is not None:
-        notes = [n for n in notes if "no unit" not in n]
-        if not (isinstance(unit, int | float) and math.isfinite(unit) and unit > 0):
-            raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
-    return pattern_from_lines(
-        S, codes, angles, name=name, unit=1e-3 if unit is None else float(unit), tol=tol,
-        split=split, meta={"kind": "oripa", "source": name}, notes=notes,
-    )  # fmt: skip
+def read_opx_pattern(source, *, tol=None, unit=None, split: str = "as-needed"):
+    """The crease pattern of an ORIPA ``.opx`` file (a path, bytes or a binary file object;
+    see the module docstring), metres."""
+    return pattern_from_drawing(opx_drawing(source), tol=tol, unit=unit, split=split)
 
 
-def read_opx_pattern(path, *, tol=None, unit=None, split: str = "as-needed"):
-    """The crease pattern of an ORIPA ``.opx`` file (see the module docstring), metres."""
-    return _read(opx_lines, path, tol, unit, split)
-
-
-def read_cp_pattern(path, *, tol=None, unit=None, split: str = "as-needed"):
-    """The crease pattern of a ``.cp`` file (see the module docstring), metres."""
-    return _read(cp_lines, path, tol, unit, split)
+def read_cp_pattern(source, *, tol=None, unit=None, split: str = "as-needed"):
+    """The crease pattern of a ``.cp`` file (a path, bytes or a binary file object; see the
+    module docstring), metres."""
+    return pattern_from_drawing(cp_drawing(source), tol=tol, unit=unit, split=split)

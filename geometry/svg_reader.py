@@ -17,25 +17,39 @@ none`` are left out. The y axis is turned up, so that the pattern is not mirrore
 pattern swaps mountains and valleys). By default (``curves="keep"``) a curve (C, Q, S, T, A
 path segments) is cut by :func:`~holofold.geometry.curved.discretise`; ``curves="refuse"``
 refuses curved creases (and flattens curved borders and cuts into 16 segments with a warning),
-``curves="flatten"`` cuts every curve into 16. Then
-:func:`~holofold.geometry.readers.pattern_from_lines` merges end points within ``tol``, splits
-crossing lines and finds the faces.
+``curves="flatten"`` cuts every curve into 16. :func:`svg_drawing` returns the lines as a
+:class:`~holofold.geometry.line_drawing.LineDrawing`; then
+:func:`~holofold.geometry.line_drawing.pattern_from_drawing` merges end points within ``tol``,
+splits crossing lines and finds the faces. The file is a path, its bytes or a binary file
+object; the bounded checks (:func:`~holofold.geometry.bounded.check_svg_pattern`) run on its
+bytes before svgelements parses them.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 
-from holofold.geometry.bounded import check_svg_pattern
+from holofold.geometry.bounded import check_svg_pattern, read_source, source_name
+from holofold.geometry.curved import (
+    CHORD_DEFAULT,
+    LENGTH_DEFAULT,
+    curve_from_svg_segment,
+    discretise,
+)
 from holofold.geometry.errors import FormatError, ParameterError
-from holofold.geometry.line_drawing import pattern_from_lines
+from holofold.geometry.line_drawing import LineDrawing, check_unit, pattern_from_drawing
 
-__all__ = ["read_svg_pattern", "svg_lines", "SVG_COLOURS", "CURVE_MODES", "MAX_SVG_BYTES"]
+__all__ = [
+    "read_svg_pattern",
+    "svg_drawing",
+    "svg_lines",
+    "SVG_COLOURS",
+    "CURVE_MODES",
+    "MAX_SVG_BYTES",
+]
 
 #: stroke colour (r, g, b) -> FOLD code (Origami Simulator's import convention)
 SVG_COLOURS = {
@@ -138,35 +152,27 @@ def _without_legend(data: bytes):
     return io.BytesIO(ET.tostring(root))
 
 
-def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None):
-    """The straight lines of an SVG crease pattern, in SVG px with y up.
-
-    Returns
-    -------
-    segments : (n, 2, 2) float
-    assignment : (n,) str
-    fold_angle : (n,) float
-        Degrees (valley > 0).
-    notes : list of str
-    metres_per_px : float
-        The length of one px of ``segments``.
+def svg_drawing(
+    source, *, curves: str = "keep", curve_chord=None, curve_length=None
+) -> LineDrawing:
+    """The straight lines of an SVG crease pattern (a path, bytes or a binary file object), in
+    SVG px with y up, ``unit`` the metres of one px as the document's width says.
 
     With ``curves="keep"`` a curve is cut by :func:`~holofold.geometry.curved.discretise` with
     chord deviation ``curve_chord`` and piece length ``curve_length`` (px; defaults relative to
-    the drawing's larger side, :data:`~holofold.geometry.curved.CHORD_DEFAULT`).
+    the drawing's larger side, :data:`~holofold.geometry.curved.CHORD_DEFAULT`); the curves
+    kept are the drawing's ``curves``.
     """
     import svgelements as se
 
     if curves not in CURVE_MODES:
         raise ParameterError(f"curves = {curves!r}; allowed: {', '.join(CURVE_MODES)}")
-    name = Path(path).name
-    size = os.path.getsize(path)
-    if size > MAX_SVG_BYTES:
-        raise FormatError(f"{name}: {size} bytes; at most {MAX_SVG_BYTES} (64 MiB) are read")
-    check_svg_pattern(path)  # counts after <use> expansion, finite numbers, root size unit
-    source = _without_legend(Path(path).read_bytes())
+    name = source_name(source)
+    data = read_source(source, MAX_SVG_BYTES, "SVG file")
+    check_svg_pattern(data, name)  # counts after <use> expansion, finite numbers, root size unit
+    stream = _without_legend(data)
     try:
-        svg = se.SVG.parse(source, reify=True, ppi=96.0)
+        svg = se.SVG.parse(stream, reify=True, ppi=96.0)
     except Exception as exc:  # noqa: BLE001 - any parse failure of a user file: one line
         raise FormatError(
             f"{name}: not a readable SVG file ({type(exc).__name__}: {exc})"
@@ -232,8 +238,6 @@ def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None
                 pts = np.array([[seg.start.x, seg.start.y], [seg.end.x, seg.end.y]])
             else:  # a curve
                 if curves == "keep":
-                    from holofold.geometry.curved import curve_from_svg_segment
-
                     cv = curve_from_svg_segment(seg, code, ang)
                     if cv is not None:
                         kept.append(cv)
@@ -249,8 +253,6 @@ def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None
                 codes.append(code)
                 angles.append(ang)
     if kept:
-        from holofold.geometry.curved import CHORD_DEFAULT, LENGTH_DEFAULT, discretise
-
         pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
         pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
         allp = np.concatenate(pts)
@@ -294,28 +296,31 @@ def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None
     S = np.array(segs, float)
     S[..., 1] *= -1.0  # y up
     mpp = _metres_per_px(svg, name)
-    return S, np.array(codes, dtype="<U1"), np.array(angles, float), notes, mpp
+    return LineDrawing(S, np.array(codes, dtype="<U1"), np.array(angles, float), mpp,
+                       name=name, kind="svg", notes=tuple(notes), curves=tuple(kept))  # fmt: skip
+
+
+def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None):
+    """:func:`svg_drawing` as a tuple, for callers of the earlier form: (segments (n, 2, 2) px,
+    assignment (n,), fold_angle (n,) degrees, notes list, metres per px)."""
+    d = svg_drawing(path, curves=curves, curve_chord=curve_chord, curve_length=curve_length)
+    return (np.array(d.segments), np.array(d.assignment), np.array(d.fold_angle), list(d.notes),
+            d.unit)  # fmt: skip
 
 
 def read_svg_pattern(
-    path, *, tol: float | None = None, unit: float | None = None, split: str = "as-needed",
+    source, *, tol: float | None = None, unit: float | None = None, split: str = "as-needed",
     curves: str = "keep",
 ):  # fmt: skip
-    """The crease pattern of an SVG file (see the module docstring), metres.
+    """The crease pattern of an SVG file (a path, bytes or a binary file object; see the module
+    docstring), metres.
 
     ``tol``: merge distance in SVG px (default 2e-3 of the drawing's larger side); ``unit``:
     metres per SVG px (default: as the document's width says; 0.0254/96 for a CSS pixel);
     ``split``: which faces to triangulate (:data:`~holofold.geometry.facets.SPLIT_MODES`);
     ``curves``: :data:`CURVE_MODES`.
     """
-    name = Path(path).name
-    if unit is not None and not (
-        isinstance(unit, int | float) and math.isfinite(unit) and unit > 0
-    ):
-        raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
-    S, codes, angles, notes, per_px = svg_lines(path, curves=curves)
-    meta = {"kind": "svg", "source": name}
-    return pattern_from_lines(
-        S, codes, angles, name=name, unit=per_px if unit is None else unit, tol=tol, split=split,
-        meta=meta, notes=notes,
-    )  # fmt: skip
+    if unit is not None:
+        check_unit(unit)  # before the file is read
+    drawing = svg_drawing(source, curves=curves)
+    return pattern_from_drawing(drawing, tol=tol, unit=unit, split=split)
