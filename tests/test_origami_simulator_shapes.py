@@ -24,10 +24,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "validation"))
 
 import origami_simulator_compare as osc  # noqa: E402
 
-# (file, fraction) where both tools fold cleanly (validation/origami_simulator_compare.md)
-BOTH_CLEAN = [
-    ("waterbombBase.svg", 1.0),
-]
+# (file, fraction) where both tools fold cleanly (validation/origami_simulator_compare.md):
+# Origami Simulator settled, bars strained <= 0.1 %, no crossing triangles; holofold's verdict
+# a success with no crossing faces
+BOTH_CLEAN = [("waterbombBase.svg", 1.0), ("squareBase.svg", 1.0)]
+# the same but Origami Simulator's flat-folded state stacks layers at zero distance, where its
+# float32 round-off reads as crossing triangles (the crossing test is left out for these)
+STACKED = [("singlesquaretwist.svg", 1.0), ("boatBase.svg", 1.0)]
 
 
 def _stored(name: str, fraction: float) -> dict:
@@ -35,18 +38,26 @@ def _stored(name: str, fraction: float) -> dict:
 
 
 def test_stored_origami_simulator_states_are_clean():
-    """The stored states are settled, unstrained (<= 0.1 %) and free of crossing triangles."""
+    """The stored states are settled and unstrained (<= 0.1 %); those counted clean have no
+    crossing triangles."""
     from holofold.mechanics.intersection import intersecting_faces
 
-    for name, f in BOTH_CLEAN:
+    for name, f in BOTH_CLEAN + STACKED:
         res = _stored(name, f)
         assert res["settled"], name
         assert osc.os_strain(res) <= osc.STRAIN_CLEAN, name
         _, X, T = osc.os_arrays(res)
-        assert len(intersecting_faces(X, T)) == 0, name
+        assert (len(intersecting_faces(X, T)) == 0) == ((name, f) in BOTH_CLEAN), name
 
 
-@pytest.mark.parametrize(("name", "fraction"), BOTH_CLEAN)
+def test_stored_states_at_half_fold_are_strained():
+    """At 50 % Origami Simulator drives every crease to half its target, which is no rigid
+    state of these vertices: its bars strain by more than 0.2 % (none is clean there)."""
+    for name in ("waterbombBase.svg", "squareBase.svg", "birdBase.svg", "miura-ori.svg"):
+        assert osc.os_strain(_stored(name, 0.5)) > 2 * osc.STRAIN_CLEAN, name
+
+
+@pytest.mark.parametrize(("name", "fraction"), BOTH_CLEAN + STACKED)
 def test_holofold_folds_the_shape_origami_simulator_folds(name, fraction):
     hf = osc.fold_holofold(DATA / name, [fraction], limit=120.0)
     flat_h, X_h, verdict, clean = hf[fraction]
