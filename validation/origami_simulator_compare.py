@@ -280,16 +280,21 @@ _DIHEDRAL = [np.array(m, float) for m in (
 def match_vertices(flat_a: np.ndarray, flat_b: np.ndarray, tol: float = 1e-4) -> list:
     """Candidate pairings (i, j) of the vertices of two flat layouts (n, 2): both centred on
     their bounding box and scaled to largest side 1, ``b`` turned by each of the 8 axis flips /
-    quarter turns, mutual nearest neighbours within ``tol``; every turn that matches the most
+    quarter turns, mutual nearest neighbours within ``tol`` (vertices that share their flat
+    place with another, split along a cut, left out); every turn that matches the most
     vertices (several for a symmetric sheet)."""
     A, _ = _normalised(flat_a)
     B0, _ = _normalised(flat_b)
+    # vertices split along a cut share a flat position: ambiguous, left out
+    lone_a = np.array([len(x) == 1 for x in cKDTree(A).query_ball_point(A, tol)])
+    lone_b = np.array([len(x) == 1 for x in cKDTree(B0).query_ball_point(B0, tol)])
     found = []
     for M in _DIHEDRAL:
         B = B0 @ M.T
         da, ja = cKDTree(B).query(A)
         _, ib = cKDTree(A).query(B)
-        i = np.flatnonzero((da < tol) & (ib[ja] == np.arange(len(A))))
+        ok = (da < tol) & (ib[ja] == np.arange(len(A))) & lone_a & lone_b[ja]
+        i = np.flatnonzero(ok)
         found.append((i, ja[i]))
     most = max(len(i) for i, _ in found)
     return [(i, j) for i, j in found if len(i) == most]
