@@ -30,7 +30,6 @@ __all__ = [
     "scatter",
     "assemble_batch",
     "band_newton_step",
-    "dense_newton_step",
     "small_newton_step",
     "lapack_addresses",
     "thermal_sides",
@@ -307,44 +306,6 @@ def _accept(x, Uflat, s, free) -> int:
     for q in range(free.shape[0]):
         Uflat[s, free[q]] += x[q]
     return 0
-
-
-@njit(**_OPTS)
-def dense_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, addrs, Uflat, dU, info, res,
-):  # fmt: skip
-    """:func:`band_newton_step` on the dense LU path: the free-free block summed column-major
-    (the Fortran copy ``scipy.linalg.lapack.dgetrf`` makes of the row-major block), ``dgetrf``,
-    ``dgetrs`` of ``(Fi[s] - f)[free]``, which is also kept in ``res[j]`` (``res`` may be
-    ``dU``: then only the solution stays). ``info[j]``: 0 done, 1 singular (``dgetrf`` info >
-    0; ``res[j]`` not written), 2 a non-finite solution; U is updated only for 0."""
-    nf = free.shape[0]
-    trans = np.array([ord("N")], np.uint8)
-    n_ = np.array([nf], np.int32)
-    one = np.array([1], np.int32)
-    inf_ = np.zeros(1, np.int32)
-    piv = np.empty(nf, np.int32)
-    a = np.empty(nf * nf)
-    f = np.empty(Uflat.shape[1])
-    for j in range(idx.shape[0]):
-        s = idx[j]
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, a,
-        )  # fmt: skip
-        _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
-        if inf_[0] > 0:
-            info[j] = 1
-            continue
-        x = dU[j]
-        r = res[j]
-        for q in range(nf):
-            d = free[q]
-            r[q] = Fi[s, d] - f[d]
-            x[q] = r[q]
-        _fcall(addrs[1], (trans, n_, one, a, n_, piv, x, n_, inf_))
-        info[j] = _accept(x, Uflat, s, free)
 
 
 @njit(**_OPTS)

@@ -23,7 +23,6 @@ __all__ = [
     "scatter",
     "assemble_batch",
     "band_newton_step",
-    "dense_newton_step",
     "small_newton_step",
     "newton_increments",
     "lapack_addresses",
@@ -118,32 +117,6 @@ def band_newton_step(
         x = dU[j]
         x[perm] = y
         info[j] = _accept(x, Uflat, s, free)
-
-
-def dense_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, addrs, Uflat, dU, info, res,
-):  # fmt: skip
-    """One Newton update per sample on the dense LU path (``_compiled``'s twin: the tangent
-    lists fill the column-major free-free block; info 0 done, 1 singular, 2 non-finite)."""
-    nf = free.shape[0]
-    a = np.empty(nf * nf)
-    f = np.empty(Uflat.shape[1])
-    for j in range(idx.shape[0]):
-        s = idx[j]
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, a,
-        )  # fmt: skip
-        lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
-        if inf > 0:
-            info[j] = 1
-            continue
-        r = (Fi[s] - f)[free]
-        res[j] = r
-        x, _ = dgetrs(lu, piv, r)
-        dU[j] = x
-        info[j] = _accept(dU[j], Uflat, s, free)
 
 
 def small_newton_step(
