@@ -27,8 +27,10 @@ with the cached minimum-degree ordering, and CHOLMOD's supernodal sparse Cholesk
 is installed), the best of the rounds' timings each. A
 structure's floor per iteration is the cheapest path's best timing over its captured
 tangents (one size and sparsity: a busy machine only adds to a timing), so a sample's floor
-is sum(iterations x that cost). ``solver`` names the path the assembler takes; the gripper
-row also gives the floor with the solver it uses. ``batch ms`` is the time per design of a
+is sum(iterations x that cost). ``solver`` names the path the assembler takes (on the dense
+path the Cholesky it tries first); ``--before-lu`` adds a ``[LU]`` row per workload, its
+designs run with the dense path forced onto LU (before issue 37), interleaved with the other
+runs and against the same floor. ``batch ms`` is the time per design of a
 batch of 16 copies of the design (4 for the canopy) through ``scenario.evaluate_batch``, the
 path the runner takes for databases, and ``batch/floor`` its ratio, the one the targets are
 read against where it exists. The database row runs ``evaluate_designs`` on the 3000
