@@ -27,8 +27,10 @@ with the cached minimum-degree ordering, and CHOLMOD's supernodal sparse Cholesk
 is installed), the best of the rounds' timings each. A
 structure's floor per iteration is the cheapest path's best timing over its captured
 tangents (one size and sparsity: a busy machine only adds to a timing), so a sample's floor
-is sum(iterations x that cost). ``solver`` names the path the assembler takes; the gripper
-row also gives the floor with the solver it uses. ``batch ms`` is the time per design of a
+is sum(iterations x that cost). ``solver`` names the path the assembler takes (on the dense
+path the Cholesky it tries first); ``--before-lu`` adds a ``[LU]`` row per workload, its
+designs run with the dense path forced onto LU (before issue 37), interleaved with the other
+runs and against the same floor. ``batch ms`` is the time per design of a
 batch of 16 copies of the design (4 for the canopy) through ``scenario.evaluate_batch``, the
 path the runner takes for databases, and ``batch/floor`` its ratio, the one the targets are
 read against where it exists. The database row runs ``evaluate_designs`` on the 3000
@@ -37,7 +39,7 @@ workers / 2, which other jobs on the machine disturb less) and prints the floor 
 (per-row floors of 120 rows spread over the file, scaled to 3000 rows and divided by the 2
 cores).
 
-    python benchmarks/bench_floor.py [--repeat 7] [--no-db] [--only arch]
+    python benchmarks/bench_floor.py [--repeat 7] [--no-db] [--only arch] [--before-lu]
 """
 
 from __future__ import annotations
@@ -82,9 +84,10 @@ def _published(stem: str, i: int, names) -> dict:
     return dict(zip(names, map(float, arr[i, : len(names)]), strict=True))
 
 
-#: workloads whose floor is that of the solver they use (the gripper keeps dense LU for its
-#: published-row figures, docs/bar-and-hinge.md §5.2), not the cheapest factorisation
-OWN_SOLVER_FLOOR = {"gripper two-panel"}
+#: workloads whose floor is that of the solver they use, not the cheapest factorisation (the
+#: gripper's was, while it kept the dense LU; since issue 37 it takes the banded Cholesky and
+#: its target is against the cheapest floor)
+OWN_SOLVER_FLOOR: set[str] = set()
 
 #: designs per batch for the batched time (the runner sends up to 16 rows of one key per task)
 BATCH = {"canopy Miura 36x12": 4}
@@ -331,7 +334,32 @@ _PATHS = {
 
 
 def solver_path(red) -> str:
-    return _PATHS[linear.solver_path(red)]
+    path = linear.solver_path(red)
+    if path == "dense":  # the Cholesky it tries first (the LU only where that fails)
+        return f"{linear.small_cholesky(red)} Cholesky"
+    return _PATHS[path]
+
+
+class forced_lu:
+    """Context: the dense path's Newton steps factorise by LU, as before issue 37 (each
+    :class:`~holofold.mechanics.newton_step.DenseStepper` starts with its LU flag set)."""
+
+    def __enter__(self):
+        from holofold.mechanics import newton_step
+
+        self.orig = orig = newton_step.DenseStepper.__init__
+
+        def init(step, *args, **kwargs):
+            orig(step, *args, **kwargs)
+            step.lu[0] = 1
+
+        newton_step.DenseStepper.__init__ = init
+        return self
+
+    def __exit__(self, *exc):
+        from holofold.mechanics import newton_step
+
+        newton_step.DenseStepper.__init__ = self.orig
 
 
 class Floor:
@@ -450,6 +478,12 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=7, help="timed runs per workload")
     ap.add_argument("--no-db", action="store_true", help="skip the 3000-row arch database")
     ap.add_argument("--only", default="", help="only workloads whose name contains this")
+    ap.add_argument(
+        "--before-lu",
+        action="store_true",
+        help="also time each design with its dense-path steps forced onto LU (before issue "
+        "37), interleaved with the other runs: a second row '<name> [LU]' against the same floor",
+    )
     args = ap.parse_args(argv)
     print(f"per sample, BLAS 1 thread, CPU time min / median of {args.repeat} runs (and wall")
     print("median); floor = iterations x (cheapest factorisation + solve of the actual tangents),")
@@ -482,12 +516,17 @@ def main(argv=None) -> int:
             if bfn is not None:
                 bfn()
             own = name in OWN_SOLVER_FLOOR  # the target is against the solver it keeps
-            cpu, wall, tbs, blocks = [], [], [], []
+            cpu, wall, tbs, blocks, lus = [], [], [], [], []
             for _ in range(args.repeat):
                 t, w = clock(), time.perf_counter()
                 fn()
                 cpu.append(clock() - t)
                 wall.append(time.perf_counter() - w)
+                if args.before_lu:
+                    with forced_lu():
+                        t = clock()
+                        fn()
+                        lus.append(clock() - t)
                 if bfn is not None:
                     t = clock()
                     bfn()
@@ -513,6 +552,14 @@ def main(argv=None) -> int:
                 f"{TARGET.get(name, ''):>7}  {paths}{extra}",
                 flush=True,
             )
+            if lus:
+                lmin, lmed = min(lus), statistics.median(lus)
+                print(
+                    f"{name + ' [LU]':<20} {iters:>6d} {1e3 * lmin:>9.2f} {1e3 * lmed:>10.2f} "
+                    f"{'-':>9} {'-':>9} {1e3 * floor:>9.2f} {'-':>9} {lmin / floor:>10.1f} "
+                    f"{'-':>12} {TARGET.get(name, ''):>7}  dense LU (forced, as before)",
+                    flush=True,
+                )
     limit = getattr(threads, "single_thread", None)
     if limit is not None:  # the default BLAS limit of every simulating entry point
         with threadpool_limits(2):

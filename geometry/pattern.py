@@ -24,12 +24,14 @@ oriented; :func:`orient_faces` gives a consistently oriented copy where one is n
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import networkx as nx
 import numpy as np
 
 from holofold.geometry.errors import DegenerateGeometryError, InvalidPatternError
+
+if TYPE_CHECKING:  # networkx (0.2 s CPU to import) loads in to_networkx only
+    import networkx as nx
 
 __all__ = [
     "ASSIGNMENTS",
@@ -629,6 +631,8 @@ class CreasePattern:
         ``index`` (position in :attr:`edges`), ``assignment`` and ``fold_angle``. The graph
         attributes hold ``faces`` (lists) and ``meta``.
         """
+        import networkx as nx
+
         g = nx.Graph(faces=[f.tolist() for f in self.faces], meta=dict(self.meta))
         for v in range(self.n_vertices):
             attrs = {"coords": self.coords[v].tolist()}

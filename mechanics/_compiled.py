@@ -30,7 +30,7 @@ __all__ = [
     "scatter",
     "assemble_batch",
     "band_newton_step",
-    "dense_newton_step",
+    "small_newton_step",
     "lapack_addresses",
     "thermal_sides",
     "thermal_system",
@@ -309,40 +309,92 @@ def _accept(x, Uflat, s, free) -> int:
 
 
 @njit(**_OPTS)
-def dense_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, addrs, Uflat, dU, info, res,
+def small_newton_step(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, chol_lists,
+    full_lists, views, flats, Fi, free, perm, bw, addrs, Uflat, dU, info, res, lu,
 ):  # fmt: skip
-    """:func:`band_newton_step` on the dense LU path: the free-free block summed column-major
-    (the Fortran copy ``scipy.linalg.lapack.dgetrf`` makes of the row-major block), ``dgetrf``,
-    ``dgetrs`` of ``(Fi[s] - f)[free]``, which is also kept in ``res[j]`` (``res`` may be
-    ``dU``: then only the solution stays). ``info[j]``: 0 done, 1 singular (``dgetrf`` info >
-    0; ``res[j]`` not written), 2 a non-finite solution; U is updated only for 0."""
+    """One Newton update of each sample ``s = idx[j]`` on the dense-path model (at most
+    ``DENSE_MAX_DOF`` free DOFs) by the cheapest factorisation that holds: a Cholesky, and
+    the LU of the whole matrix only where the tangent is not positive definite.
+
+    ``bw >= 0``: the banded Cholesky (``chol_lists`` the ``"banded"`` sums, ``perm`` the
+    band's order; ``dpbtrf``/``dpbtrs``); ``bw < 0``: the dense Cholesky of the column-major
+    matrix (``chol_lists`` its ``"dense_cm"`` sums; ``dpotrf``/``dpotrs`` on a copy, so that
+    the LU finds the matrix whole). Where the Cholesky fails, or ``lu[j]`` is 1 on entry, the
+    whole matrix (``full_lists``, ``"dense_cm"``) is factorised by LU (``dgetrf``/``dgetrs``)
+    and ``lu[j]`` is set to 1. ``addrs``: dgetrf, dgetrs, then dpbtrf, dpbtrs (banded) or
+    dpotrf, dpotrs (dense). ``res[j]`` receives ``(Fi[s] - f)[free]``; ``dU[j]`` the solution;
+    ``info[j]``: 0 done (``Uflat[s, free] += dU[j]``), 1 singular, 2 a non-finite solution
+    (U not updated)."""
     nf = free.shape[0]
-    trans = np.array([ord("N")], np.uint8)
+    c_u = np.array([ord("U")], np.uint8)
+    c_n = np.array([ord("N")], np.uint8)
     n_ = np.array([nf], np.int32)
+    kd_ = np.array([max(bw, 0)], np.int32)
+    ld_ = np.array([max(bw, 0) + 1], np.int32)
     one = np.array([1], np.int32)
     inf_ = np.zeros(1, np.int32)
     piv = np.empty(nf, np.int32)
     a = np.empty(nf * nf)
+    c = np.empty((bw + 1) * nf if bw >= 0 else nf * nf)
+    y = np.empty(nf)
     f = np.empty(Uflat.shape[1])
     for j in range(idx.shape[0]):
         s = idx[j]
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, a,
-        )  # fmt: skip
+        x = dU[j]
+        r = res[j]
+        if lu[j] == 0:
+            if bw >= 0:
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    chol_lists, views, flats, f, c,
+                )  # fmt: skip
+            else:
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    full_lists, views, flats, f, a,
+                )  # fmt: skip
+                c[:] = a
+            if bw >= 0:
+                _fcall(addrs[2], (c_u, n_, kd_, c, ld_, inf_))
+            else:
+                _fcall(addrs[2], (c_u, n_, c, n_, inf_))
+            if inf_[0] == 0:
+                for q in range(nf):
+                    d = free[q]
+                    r[q] = Fi[s, d] - f[d]
+                if bw >= 0:
+                    for q in range(nf):
+                        y[q] = r[perm[q]]
+                    _fcall(addrs[3], (c_u, n_, kd_, one, c, ld_, y, n_, inf_))
+                    for q in range(nf):
+                        x[perm[q]] = y[q]
+                else:
+                    for q in range(nf):
+                        x[q] = r[q]
+                    _fcall(addrs[3], (c_u, n_, one, c, n_, x, n_, inf_))
+                info[j] = _accept(x, Uflat, s, free)
+                continue
+            lu[j] = 1
+            if bw >= 0:  # the band held only the Cholesky's entries: the whole matrix now
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    full_lists, views, flats, f, a,
+                )  # fmt: skip
+        else:
+            _assemble_sample(
+                X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                full_lists, views, flats, f, a,
+            )  # fmt: skip
         _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
         if inf_[0] > 0:
             info[j] = 1
             continue
-        x = dU[j]
-        r = res[j]
         for q in range(nf):
             d = free[q]
             r[q] = Fi[s, d] - f[d]
             x[q] = r[q]
-        _fcall(addrs[1], (trans, n_, one, a, n_, piv, x, n_, inf_))
+        _fcall(addrs[1], (c_n, n_, one, a, n_, piv, x, n_, inf_))
         info[j] = _accept(x, Uflat, s, free)
 
 

@@ -23,7 +23,7 @@ __all__ = [
     "scatter",
     "assemble_batch",
     "band_newton_step",
-    "dense_newton_step",
+    "small_newton_step",
     "newton_increments",
     "lapack_addresses",
 ]
@@ -119,29 +119,53 @@ def band_newton_step(
         info[j] = _accept(x, Uflat, s, free)
 
 
-def dense_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, addrs, Uflat, dU, info, res,
+def small_newton_step(
+    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, chol_lists,
+    full_lists, views, flats, Fi, free, perm, bw, addrs, Uflat, dU, info, res, lu,
 ):  # fmt: skip
-    """One Newton update per sample on the dense LU path (``_compiled``'s twin: the tangent
-    lists fill the column-major free-free block; info 0 done, 1 singular, 2 non-finite)."""
+    """One Newton update per sample on a dense-path model: banded (``bw >= 0``) or dense
+    Cholesky, the LU of the whole matrix where it fails or ``lu[j]`` is 1 (then set); the
+    compiled twin's semantics (``_compiled.small_newton_step``)."""
     nf = free.shape[0]
     a = np.empty(nf * nf)
+    c = np.empty((bw + 1) * nf if bw >= 0 else nf * nf)
     f = np.empty(Uflat.shape[1])
     for j in range(idx.shape[0]):
         s = idx[j]
+        if lu[j] == 0:
+            if bw >= 0:
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    chol_lists, views, flats, f, c,
+                )  # fmt: skip
+                fac, inf = dpbtrf(c.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
+            else:
+                _assemble_sample(
+                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
+                    full_lists, views, flats, f, a,
+                )  # fmt: skip
+                fac, inf = dpotrf(a.reshape(nf, nf).T, lower=0, clean=0)
+            if inf == 0:
+                r = (Fi[s] - f)[free]
+                res[j] = r
+                if bw >= 0:
+                    dU[j, perm] = dpbtrs(fac, r[perm], lower=0)[0]
+                else:
+                    dU[j] = dpotrs(fac, r, lower=0)[0]
+                info[j] = _accept(dU[j], Uflat, s, free)
+                continue
+            lu[j] = 1
         _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
+            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, full_lists,
             views, flats, f, a,
         )  # fmt: skip
-        lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
+        fac, piv, inf = dgetrf(a.reshape(nf, nf).T)
         if inf > 0:
             info[j] = 1
             continue
         r = (Fi[s] - f)[free]
         res[j] = r
-        x, _ = dgetrs(lu, piv, r)
-        dU[j] = x
+        dU[j] = dgetrs(fac, piv, r)[0]
         info[j] = _accept(dU[j], Uflat, s, free)
 
 

@@ -314,7 +314,9 @@ class Assembler:
         if path == "none":
             return linear.zero_solver
         if path == "dense":
-            return linear.dense_solver(self._tangent(a, "dense").reshape(red.n_free, -1))
+            return linear.dense_solver(
+                self._tangent(a, "dense").reshape(red.n_free, -1), symmetric=True
+            )
         if path == "banded":
             solve = linear.band_solver(self._tangent(a, "banded"), red)
             if solve is not None:
@@ -495,7 +497,7 @@ class BatchAssembler:
         """The solver of sample ``s`` from its dense block, band or CSR data ``values``
         (``rest``: its rest angles, for the LU fallback's own evaluation)."""
         if path == "dense":
-            return linear.dense_solver(values.reshape(red.n_free, red.n_free))
+            return linear.dense_solver(values.reshape(red.n_free, red.n_free), symmetric=True)
         if path in ("banded", "cholesky"):
             factor = linear.band_solver if path == "banded" else linear.cholesky_solver
             solve = factor(values, red)

@@ -74,7 +74,7 @@ class KernelWarning(RuntimeWarning):
 class KernelPath:
     """A kernel path: its name and the module of its functions (``bar_elements``,
     ``spring_elements``, ``scatter``, ``assemble_batch``, ``band_newton_step``,
-    ``dense_newton_step``, ``lapack_addresses``)."""
+    ``small_newton_step``, ``lapack_addresses``)."""
 
     name: str
     module: ModuleType

@@ -1,8 +1,10 @@
 """Linear solvers of the reduced (free-free) tangent, and the choice among them.
 
 :func:`solver_path` picks, per reduction, the fastest path for a symmetric tangent: dense
-LAPACK LU up to :data:`DENSE_MAX_DOF` free DOFs, then a banded Cholesky (LAPACK ``dpbtrf``)
-on the cached reverse Cuthill-McKee band while its work ``nf (bw + 1)^2`` stays under
+LAPACK up to :data:`DENSE_MAX_DOF` free DOFs (a Cholesky, banded where the band is narrow,
+:func:`small_cholesky`, and the LU only where the tangent is not positive definite), then a
+banded Cholesky (LAPACK ``dpbtrf``) on the cached reverse Cuthill-McKee band while its work
+``nf (bw + 1)^2`` stays under
 :data:`CHOLESKY_MIN_WORK`, and a supernodal sparse Cholesky above it (:func:`cholesky_backend`:
 CHOLMOD where ``holofold[cholmod]`` is installed, else holofold's own multifrontal one,
 :mod:`~holofold.mechanics.supernodal`, on the compiled kernel path). Without either (no cvxopt
@@ -21,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.linalg.lapack import dgetrf, dgetrs, dpbtrf, dpbtrs
+from scipy.linalg.lapack import dgetrf, dgetrs, dpbtrf, dpbtrs, dpotrf, dpotrs
 
 from holofold.mechanics.sparsity import ReducedPattern
 from holofold.mechanics.status import SingularSystemError
@@ -31,6 +33,8 @@ __all__ = [
     "DENSE_MAX_DOF",
     "BANDED_MAX_WORK",
     "CHOLESKY_MIN_WORK",
+    "SMALL_BAND_SHARE",
+    "small_cholesky",
     "SOLVER_PATHS",
     "cholesky_backend",
     "solver_path",
@@ -56,6 +60,12 @@ DENSE_MAX_DOF = 200
 #: (benchmarks/bench_large_solvers.py) 3.3 / 2.4 ms at 36 x 12, 32 / 14 at 72 x 24, 505 / 56
 #: at 120 x 40, 3334 / 167 at 100 x 100.
 CHOLESKY_MIN_WORK = 4e7
+#: A dense-path model (at most :data:`DENSE_MAX_DOF` free DOFs) whose reverse Cuthill-McKee
+#: band (bandwidth + 1) is at most this share of its free DOFs is factorised by the banded
+#: Cholesky, else by the dense one (:func:`small_cholesky`); the LU only where the Cholesky
+#: fails. Factorisation + one solve of the two-panel gripper's tangent (99 DOFs, bandwidth 32:
+#: 0.33 of nf), CPU us at load 12: band 19.4, dense Cholesky 37.5, dense LU 61.9.
+SMALL_BAND_SHARE = 0.5
 #: Without the sparse Cholesky: band work up to which the banded Cholesky beats SuperLU
 #: (bench_large_solvers, band / SuperLU, two runs at load 13-20: 195-505 / 282-314 ms at
 #: 120 x 40 (work 6.9e9), 291-453 / 359-382 at 100 x 50 (1.1e10), 506-921 / 573-794 at
@@ -85,6 +95,14 @@ def solver_path(red: ReducedPattern, dense_max: int = DENSE_MAX_DOF) -> str:
     if cholesky_backend() is not None:
         return "cholesky"
     return "banded" if work <= BANDED_MAX_WORK else "superlu"
+
+
+def small_cholesky(red: ReducedPattern) -> str:
+    """The Cholesky a dense-path reduction tries first (the LU of the whole matrix where the
+    tangent is not positive definite): ``"banded"`` where its band is narrow
+    (:data:`SMALL_BAND_SHARE`), else ``"dense"``."""
+    nf = red.n_free
+    return "banded" if red.band.bandwidth + 1 <= SMALL_BAND_SHARE * nf else "dense"
 
 
 def cholesky_backend() -> str | None:
@@ -118,27 +136,33 @@ def zero_solver(rhs):
     return np.zeros_like(rhs, dtype=float)
 
 
-def dense_solver(K: np.ndarray):
-    """``solve(rhs)`` by LAPACK LU of the dense (nf, nf) ``K`` (``dgetrf`` once, ``dgetrs`` per
-    right-hand side; several right-hand sides by ``np.linalg.solve``). A singular K raises at
-    the solve."""
-    lu = None
+def dense_solver(K: np.ndarray, symmetric: bool = False):
+    """``solve(rhs)`` by LAPACK of the dense (nf, nf) ``K``: for a ``symmetric`` K (a tangent)
+    its Cholesky (``dpotrf`` once, of the upper triangle; ``dpotrs`` per right-hand side, one
+    (nf,) or several (nf, k)) where it is positive definite, else (and for any other K) its LU
+    (``dgetrf``, ``dgetrs``). A singular K raises at the solve. ``solve.factorisation()``:
+    ``"cholesky"``, ``"lu"`` or None before the first solve."""
+    fac = None
 
     def solve(rhs):
-        nonlocal lu
-        if np.ndim(rhs) != 1:
-            try:
-                x = np.linalg.solve(K, rhs)
-            except np.linalg.LinAlgError as exc:
-                raise SingularSystemError(f"singular stiffness matrix ({exc})") from None
-            return finite(x)
-        if lu is None:
-            lu = dgetrf(K)
-        if lu[2] > 0:
-            raise SingularSystemError(SINGULAR)
-        x, _ = dgetrs(lu[0], lu[1], rhs)
+        nonlocal fac
+        if fac is None:
+            info = 1
+            if symmetric:
+                c, info = dpotrf(K, lower=0, clean=0)
+                fac = ("cholesky", c)
+            if info != 0:
+                lu, piv, info = dgetrf(K)
+                fac = ("lu", lu, piv, info)
+        if fac[0] == "cholesky":
+            x, _ = dpotrs(fac[1], rhs, lower=0)
+        else:
+            if fac[3] > 0:
+                raise SingularSystemError(SINGULAR)
+            x, _ = dgetrs(fac[1], fac[2], rhs)
         return finite(x)
 
+    solve.factorisation = lambda: None if fac is None else fac[0]
     return solve
 
 

@@ -16,7 +16,13 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from holofold.mechanics import kernels
-from holofold.mechanics.linear import NON_FINITE, SINGULAR, SingularSystemError, solver_path
+from holofold.mechanics.linear import (
+    NON_FINITE,
+    SINGULAR,
+    SingularSystemError,
+    small_cholesky,
+    solver_path,
+)
 
 if TYPE_CHECKING:
     from holofold.mechanics.assembly import Assembler, BatchAssembler
@@ -26,6 +32,8 @@ __all__ = ["DenseStepper", "NewtonRecords", "batch_newton_step", "batch_newton_i
 _LAPACK = {"banded": ("dpbtrf", "dpbtrs"), "dense": ("dgetrf", "dgetrs")}
 #: the LAPACK routines of the whole-solve call (dense: LU's for the fallback, Cholesky's)
 _SOLVE = {"banded": _LAPACK["banded"], "dense": (*_LAPACK["dense"], "dpotrf", "dpotrs")}
+#: the small-model step's: the LU's, then the Cholesky's it tries first (small_cholesky)
+_SMALL = {"banded": (*_LAPACK["dense"], *_LAPACK["banded"]), "dense": _SOLVE["dense"]}
 
 
 def _error(code: int) -> SingularSystemError:
@@ -35,30 +43,33 @@ def _error(code: int) -> SingularSystemError:
 class DenseStepper:
     """One design's Newton update on the dense path, its arguments bound once.
 
-    ``step()`` evaluates the kernels at ``U``, factorises the free-free block (LU), solves for
-    ``(F - f_int)[free]``, adds the solution to ``U[free]`` (in place) and returns it (a buffer
-    the next call overwrites); ``r``, if given, receives the residual. Raises
-    :class:`SingularSystemError` (U left alone). Build it with
-    :meth:`~holofold.mechanics.assembly.Assembler.dense_stepper`.
+    ``step()`` evaluates the kernels at ``U``, factorises the free-free block (the Cholesky of
+    :func:`~holofold.mechanics.linear.small_cholesky`, banded or dense; the LU of the whole
+    block where the tangent is not positive definite, and from then on for this stepper's
+    life, one increment: :attr:`lu`), solves for ``(F - f_int)[free]``, adds the solution to
+    ``U[free]`` (in place) and returns it (a buffer the next call overwrites); ``r``, if
+    given, receives the residual. Raises :class:`SingularSystemError` (U left alone). Build it
+    with :meth:`~holofold.mechanics.assembly.Assembler.dense_stepper`.
     """
 
     def __init__(self, asm: Assembler, U, F, spring_rest=None, r=None):
         red = asm.reduction
         path = kernels.active()
-        self._fn = path.module.dense_newton_step
+        self._fn = path.module.small_newton_step
         rest = asm.theta0 if spring_rest is None else spring_rest
         theta0 = np.ascontiguousarray(rest, dtype=float).reshape(1, -1)
         self.dU = np.empty((1, red.n_free))
         self.info = np.zeros(1, np.int8)
+        #: 1 once the tangent was not positive definite: LU from then on
+        self.lu = np.zeros(1, np.int8)
         res = self.dU if r is None else r.reshape(1, -1)
         scratch = asm._buffers()
         one = asm.inputs.batch_of_one()
+        chol, full, perm, bw, addrs = _small_args(red, path.module)
         self._args = (
             *one.with_displacements(U.reshape(1, -1, 3)), theta0, np.array([asm.k_nonneg]),
-            np.zeros(1, np.intp),
-            asm.pattern.force_sums, red.tangent_sums("dense_cm"), scratch, scratch.flat(),
-            F.reshape(1, -1), red.free, path.module.lapack_addresses(*_LAPACK["dense"]),
-            U.reshape(1, -1), self.dU, self.info, res,
+            _ONE, asm.pattern.force_sums, chol, full, scratch, scratch.flat(), F.reshape(1, -1),
+            red.free, perm, bw, addrs, U.reshape(1, -1), self.dU, self.info, res, self.lu,
         )  # fmt: skip
 
     def __call__(self) -> np.ndarray:
@@ -66,6 +77,27 @@ class DenseStepper:
         if self.info[0]:
             raise _error(int(self.info[0]))
         return self.dU[0]
+
+
+def _small_args(red, module):
+    """(Cholesky sums, whole-matrix sums, perm, bw, addrs) of :func:`small_newton_step` for
+    ``red`` on the kernel path ``module`` (cached on the reduction): the band's order and half
+    bandwidth, or an empty order and -1 for the dense Cholesky (:func:`~holofold.mechanics.
+    linear.small_cholesky`); the LAPACK addresses, LU's first."""
+
+    def build(red):
+        full = red.tangent_sums("dense_cm")
+        if small_cholesky(red) == "banded":
+            band = red.band
+            addrs = module.lapack_addresses(*_SMALL["banded"])
+            return red.tangent_sums("banded"), full, band.perm, int(band.bandwidth), addrs
+        return full, full, _NO_PERM, -1, module.lapack_addresses(*_SMALL["dense"])
+
+    return red.symbolic(f"small_step:{module.__name__}", build)
+
+
+_NO_PERM = np.zeros(0, np.intp)
+_ONE = np.zeros(1, np.intp)  # the sample index of a batch of one
 
 
 def batch_newton_step(batch: BatchAssembler, U, rhs_force, active):
@@ -103,10 +135,11 @@ def batch_newton_step(batch: BatchAssembler, U, rhs_force, active):
                     *common, red.tangent_sums("banded"), batch.scratch, flats, Fi, red.free,
                     band.perm, band.bandwidth, addrs, U, dU, fj, info,
                 )  # fmt: skip
-            else:
-                ck.dense_newton_step(
-                    *common, red.tangent_sums("dense_cm"), batch.scratch, flats, Fi, red.free,
-                    addrs, U, dU, info, dU,
+            else:  # the Cholesky first, the LU where it fails (as DenseStepper)
+                chol, full, perm, bw, small = _small_args(red, ck)
+                ck.small_newton_step(
+                    *common, chol, full, batch.scratch, flats, Fi, red.free, perm, bw, small,
+                    U, dU, info, dU, np.zeros(idx.size, np.int8),
                 )  # fmt: skip
             dU_all[idx] = dU
             rest[idx] = False
