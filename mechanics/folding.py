@@ -308,6 +308,7 @@ class FoldSettings:
     extrapolate: bool = False
     check_intersections: bool = True
     contact: object = None
+    line_search: bool = True
 
 
 def _fold_settings(given: FoldSettings | None, options: dict) -> FoldSettings:
@@ -396,6 +397,7 @@ def fold_pattern(
     st = _fold_settings(settings, options)
     model, profile, max_step_deg, rel_tol = st.model, st.profile, st.max_step_deg, st.rel_tol
     max_iter, time_limit, extrapolate = st.max_iter, st.time_limit, st.extrapolate
+    line_search = st.line_search
     check_intersections, contact = st.check_intersections, st.contact
     fraction = check_range("fraction", fraction, 0.0, 1.0)
     max_step_deg = check_range("max_step_deg", max_step_deg, 0.0, 90.0, low_open=True)
@@ -456,6 +458,7 @@ def fold_pattern(
     fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
     flows: list[float] = []  # steps carried by pseudo-transient flow where Newton stalled
+    searched = 0  # steps that converged only with the line search
     stalled = ""
     import time
 
@@ -474,6 +477,14 @@ def fold_pattern(
             structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
             max_iter=max_iter, U0=U0, assembler=asm,
         )  # fmt: skip
+        if line_search and not (res.ok and np.isfinite(res.U).all()):
+            # the full Newton steps failed: the same step again, the steps backtracked on the
+            # energy and the residual (solve_selffold's line_search), before a smaller step
+            res = solve_selffold(
+                structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
+                max_iter=max_iter, U0=U0, assembler=asm, line_search=True,
+            )  # fmt: skip
+            searched += bool(res.ok)
         accepted = res.U if res.ok and np.isfinite(res.U).all() else None
         if panels is not None:  # contact hook: keep the step collision free (issue 32 item 2)
             accepted = panels.step(asm, U, accepted, rest(nxt), tol, max_iter)
@@ -611,6 +622,8 @@ def fold_pattern(
     if flows:
         where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
         note += f"; Newton stalled at {where} % and a pseudo-transient flow carried the fold on"
+    if searched:
+        note += f"; {searched} steps converged only with the line search"
     if snaps:
         where = ", ".join(f"{100 * x:.1f}" for x in snaps[:5])
         note += f"; snaps at {where} % (no nearby equilibrium: the energy minimum beyond)"
