@@ -308,7 +308,8 @@ class FoldSettings:
     extrapolate: bool = False
     check_intersections: bool = True
     contact: object = None
-    line_search: bool = True
+    line_search: bool = False
+    retry_iter: int = 0
 
 
 def _fold_settings(given: FoldSettings | None, options: dict) -> FoldSettings:
@@ -397,7 +398,7 @@ def fold_pattern(
     st = _fold_settings(settings, options)
     model, profile, max_step_deg, rel_tol = st.model, st.profile, st.max_step_deg, st.rel_tol
     max_iter, time_limit, extrapolate = st.max_iter, st.time_limit, st.extrapolate
-    line_search = st.line_search
+    line_search, retry_iter = st.line_search, st.retry_iter
     check_intersections, contact = st.check_intersections, st.contact
     fraction = check_range("fraction", fraction, 0.0, 1.0)
     max_step_deg = check_range("max_step_deg", max_step_deg, 0.0, 90.0, low_open=True)
@@ -477,12 +478,13 @@ def fold_pattern(
             structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
             max_iter=max_iter, U0=U0, assembler=asm,
         )  # fmt: skip
-        if line_search and not (res.ok and np.isfinite(res.U).all()):
-            # the full Newton steps failed: the same step again, the steps backtracked on the
-            # energy and the residual (solve_selffold's line_search), before a smaller step
+        if (line_search or retry_iter > max_iter) and not (res.ok and np.isfinite(res.U).all()):
+            # the step failed: the same step again before a smaller one, with more iterations
+            # (Newton often still converges, linearly, when the cap is hit) and/or the
+            # backtracking line search
             res = solve_selffold(
                 structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
-                max_iter=max_iter, U0=U0, assembler=asm, line_search=True,
+                max_iter=max(max_iter, retry_iter), U0=U0, assembler=asm, line_search=line_search,
             )  # fmt: skip
             searched += bool(res.ok)
         accepted = res.U if res.ok and np.isfinite(res.U).all() else None
@@ -623,7 +625,7 @@ def fold_pattern(
         where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
         note += f"; Newton stalled at {where} % and a pseudo-transient flow carried the fold on"
     if searched:
-        note += f"; {searched} steps converged only with the line search"
+        note += f"; {searched} steps converged only when retried"
     if snaps:
         where = ", ".join(f"{100 * x:.1f}" for x in snaps[:5])
         note += f"; snaps at {where} % (no nearby equilibrium: the energy minimum beyond)"

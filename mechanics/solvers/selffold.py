@@ -54,6 +54,7 @@ def solve_selffold(
     start_rest=None,
     assembler: Assembler | None = None,
     line_search: bool = False,
+    max_rotation: float | None = None,
 ) -> SolveResult:
     """Fold by driving the spring rest angles to ``target_rest``.
 
@@ -78,6 +79,9 @@ def solve_selffold(
     line_search : bool
         Backtrack Newton updates that raise both the potential energy and the residual
         (see the module docstring); default False (the reference's full steps).
+    max_rotation : float, optional
+        Largest change of any spring's dihedral angle in one Newton update, rad: a longer
+        update is halved until it fits (:func:`_limit_rotation`); default None (no bound).
 
     Returns
     -------
@@ -108,7 +112,7 @@ def solve_selffold(
         try:
             E = None
             while step < max_iter and R > tol:
-                if line_search:
+                if line_search or max_rotation is not None:
                     before = U[free].copy()
                 if dense is not None:
                     if line_search and E is None:
@@ -123,7 +127,12 @@ def solve_selffold(
                     U[free] += dU
                 R = math.sqrt(r @ r)  # = float(np.sqrt(r @ r)): both correctly rounded
                 step += 1
+                if max_rotation is not None and R > tol:
+                    _limit_rotation(structure, U, free, before, dU, max_rotation)
+                    E = None
                 if line_search and R > tol:
+                    if E is None:
+                        E = asm.internal_force(U, rest)[0] - F0v @ U
                     E = _backtrack(asm, U, before, dU, r, R, E, rest, F0v)
         except SingularSystemError as exc:
             hist.failure = f"increment {i}, iteration {step}: {exc}"
@@ -167,4 +176,25 @@ def _backtrack(asm, U, before, dU, r, R, E, rest, F0v) -> float:
         else:
             a_new = 0.5 * a
         a = max(a_new, _MIN_STEP)
+        U[free] = before + a * dU
+
+
+def _limit_rotation(structure, U, free, before, dU, bound: float) -> None:
+    """Halve the update ``U[free] = before + dU`` (``U`` (ndof,), in place) until no spring's
+    dihedral angle turns by more than ``bound`` rad from the update's start (at most 10
+    halvings): a full step that turns a hinge by 180 degrees (a wing that passes through its
+    hinge line) leaves the basin of the equilibrium."""
+    from holofold.mechanics.springs import dihedral_angle
+
+    X = structure.nodes.ravel()
+    start = U.copy()
+    start[free] = before
+    th0 = dihedral_angle((X + start).reshape(-1, 3), structure.springs)
+    a = 1.0
+    for _ in range(10):
+        th = dihedral_angle((X + U).reshape(-1, 3), structure.springs)
+        turn = np.abs((th - th0 + math.pi) % (2.0 * math.pi) - math.pi)
+        if turn.max(initial=0.0) <= bound:
+            return
+        a *= 0.5
         U[free] = before + a * dU
