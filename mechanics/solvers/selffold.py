@@ -11,13 +11,17 @@ The spring rest angles move linearly from ``start_rest`` to ``target_rest`` over
 Note the reference's order: the residual norm is that of the residual *before* the update, and the
 update is applied even on the iteration that meets the tolerance. Snap-through cannot be followed.
 
-``line_search=True`` (what :func:`~holofold.mechanics.folding.fold_pattern` uses) keeps that
-order but backtracks a Newton update that does not lower the potential energy
-``Pi = E(U) - F0 . U`` by the Armijo amount ``1e-4 a r . dU`` and does not lower ``||r||``
+``line_search=True`` (:func:`~holofold.mechanics.folding.fold_pattern`'s optional retry of a
+failed step) keeps that order but backtracks a Newton update that does not lower the potential
+energy ``Pi = E(U) - F0 . U`` by the Armijo amount ``1e-4 a r . dU`` and does not lower ``||r||``
 either (:func:`_backtrack`): the full step's linearised rotations stretch the stiff panel bars
 (a residual 100-1000x the step's start), and from a state far from equilibrium the full step
 can leave the basin altogether. A full step that passes either test is taken as it is, so the
-last, quadratically converging iterations are the plain ones.
+last, quadratically converging iterations are the plain ones. Measured (docs/patterns.md,
+"Stalls: step control"): it lands on Newton's equilibrium but takes 2-4x the iterations on a
+waterbomb step and doubles the factorisations of the surface fold check: the energy that the
+full step's stretch adds is removed by the next full step, so cutting the step only slows the
+fold. Off by default.
 """
 
 from __future__ import annotations
@@ -54,7 +58,6 @@ def solve_selffold(
     start_rest=None,
     assembler: Assembler | None = None,
     line_search: bool = False,
-    max_rotation: float | None = None,
 ) -> SolveResult:
     """Fold by driving the spring rest angles to ``target_rest``.
 
@@ -79,9 +82,6 @@ def solve_selffold(
     line_search : bool
         Backtrack Newton updates that raise both the potential energy and the residual
         (see the module docstring); default False (the reference's full steps).
-    max_rotation : float, optional
-        Largest change of any spring's dihedral angle in one Newton update, rad: a longer
-        update is halved until it fits (:func:`_limit_rotation`); default None (no bound).
 
     Returns
     -------
@@ -112,7 +112,7 @@ def solve_selffold(
         try:
             E = None
             while step < max_iter and R > tol:
-                if line_search or max_rotation is not None:
+                if line_search:
                     before = U[free].copy()
                 if dense is not None:
                     if line_search and E is None:
@@ -127,12 +127,7 @@ def solve_selffold(
                     U[free] += dU
                 R = math.sqrt(r @ r)  # = float(np.sqrt(r @ r)): both correctly rounded
                 step += 1
-                if max_rotation is not None and R > tol:
-                    _limit_rotation(structure, U, free, before, dU, max_rotation)
-                    E = None
                 if line_search and R > tol:
-                    if E is None:
-                        E = asm.internal_force(U, rest)[0] - F0v @ U
                     E = _backtrack(asm, U, before, dU, r, R, E, rest, F0v)
         except SingularSystemError as exc:
             hist.failure = f"increment {i}, iteration {step}: {exc}"
@@ -176,25 +171,4 @@ def _backtrack(asm, U, before, dU, r, R, E, rest, F0v) -> float:
         else:
             a_new = 0.5 * a
         a = max(a_new, _MIN_STEP)
-        U[free] = before + a * dU
-
-
-def _limit_rotation(structure, U, free, before, dU, bound: float) -> None:
-    """Halve the update ``U[free] = before + dU`` (``U`` (ndof,), in place) until no spring's
-    dihedral angle turns by more than ``bound`` rad from the update's start (at most 10
-    halvings): a full step that turns a hinge by 180 degrees (a wing that passes through its
-    hinge line) leaves the basin of the equilibrium."""
-    from holofold.mechanics.springs import dihedral_angle
-
-    X = structure.nodes.ravel()
-    start = U.copy()
-    start[free] = before
-    th0 = dihedral_angle((X + start).reshape(-1, 3), structure.springs)
-    a = 1.0
-    for _ in range(10):
-        th = dihedral_angle((X + U).reshape(-1, 3), structure.springs)
-        turn = np.abs((th - th0 + math.pi) % (2.0 * math.pi) - math.pi)
-        if turn.max(initial=0.0) <= bound:
-            return
-        a *= 0.5
         U[free] = before + a * dU
