@@ -414,6 +414,12 @@ def fold_pattern(
     fraction = check_range("fraction", fraction, 0.0, 1.0)
     max_step_deg = check_range("max_step_deg", max_step_deg, 0.0, 90.0, low_open=True)
     rel_tol = check_range("rel_tol", rel_tol, 0.0, 1.0, low_open=True)
+    if (
+        isinstance(retry_iter, bool)
+        or not isinstance(retry_iter, (int, np.integer))
+        or retry_iter < 0
+    ):
+        raise ParameterError(f"retry_iter = {retry_iter!r}: a whole number >= 0 (0: no retry)")
     if model not in MODELS:
         raise ParameterError(f"model = {model!r}; allowed: {', '.join(MODELS)}")
     if not pattern.faces:

@@ -94,3 +94,11 @@ def test_a_retried_step_carries_the_many_angle_square_twist_past_its_stall():
     assert retried.reached > plain.reached + 0.01
     assert retried.verdict != "stalls"
     assert "converged only when retried" in retried.note
+
+
+@pytest.mark.parametrize("bad", [-1, 2.5, True])
+def test_retry_iter_must_be_a_whole_number(bad):
+    from holofold.geometry.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="retry_iter"):
+        fold_pattern(_os("simpleVertex.svg"), 0.1, retry_iter=bad, **_PP)
