@@ -476,7 +476,7 @@ def fold_pattern(
     fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
     flows: list[float] = []  # steps carried by pseudo-transient flow where Newton stalled
-    searched = 0  # steps that converged only with the line search
+    searched = 0  # steps that converged only when retried
     stalled = ""
     import time
 
