@@ -296,7 +296,8 @@ class FoldSettings:
     """How :func:`fold_pattern` folds (each field's meaning: its parameters): the model
     (``"concentrated"`` or ``"compliant"``) and its switches (``profile``), the steps
     (``max_step_deg``, degrees; ``rel_tol``; ``max_iter``; ``time_limit``, s;
-    ``extrapolate``), and what stops a fold (``check_intersections``, ``contact``). Checked
+    ``extrapolate``), the step control of a step that fails (``retry_iter``,
+    ``line_search``), and what stops a fold (``check_intersections``, ``contact``). Checked
     by :func:`fold_pattern`, with its messages."""
 
     model: str = "concentrated"
@@ -308,6 +309,8 @@ class FoldSettings:
     extrapolate: bool = False
     check_intersections: bool = True
     contact: object = None
+    line_search: bool = False
+    retry_iter: int = 0
 
 
 def _fold_settings(given: FoldSettings | None, options: dict) -> FoldSettings:
@@ -381,6 +384,16 @@ def fold_pattern(
         (:func:`~holofold.mechanics.intersection.has_intersections`); the first that does
         stops the fold at the last clean state (verdict ``folds until panels touch``).
         Default True.
+    retry_iter : int
+        A step that does not converge within ``max_iter`` is tried again with this many
+        iterations before it is halved (Newton on a bending-dominated fold often still
+        converges, linearly, when the cap is hit; a diverging step costs the extra
+        iterations for nothing); 0 (default): no retry. Measured in docs/patterns.md
+        ("Stalls: step control").
+    line_search : bool
+        Also retry a failed step with backtracking Newton updates (the energy's Armijo test
+        or a lower residual: ``solve_selffold(line_search=True)``); default False (measured:
+        1.2-1.9x the factorisations, no verdict changed).
     contact : bool or PanelContact, optional
         Barrier contact between the thick panels with collision-free steps
         (:mod:`~holofold.mechanics.contact`, needs ``holofold[contact]``); default off.
@@ -396,10 +409,17 @@ def fold_pattern(
     st = _fold_settings(settings, options)
     model, profile, max_step_deg, rel_tol = st.model, st.profile, st.max_step_deg, st.rel_tol
     max_iter, time_limit, extrapolate = st.max_iter, st.time_limit, st.extrapolate
+    line_search, retry_iter = st.line_search, st.retry_iter
     check_intersections, contact = st.check_intersections, st.contact
     fraction = check_range("fraction", fraction, 0.0, 1.0)
     max_step_deg = check_range("max_step_deg", max_step_deg, 0.0, 90.0, low_open=True)
     rel_tol = check_range("rel_tol", rel_tol, 0.0, 1.0, low_open=True)
+    if (
+        isinstance(retry_iter, bool)
+        or not isinstance(retry_iter, (int, np.integer))
+        or retry_iter < 0
+    ):
+        raise ParameterError(f"retry_iter = {retry_iter!r}: a whole number >= 0 (0: no retry)")
     if model not in MODELS:
         raise ParameterError(f"model = {model!r}; allowed: {', '.join(MODELS)}")
     if not pattern.faces:
@@ -456,6 +476,7 @@ def fold_pattern(
     fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
     flows: list[float] = []  # steps carried by pseudo-transient flow where Newton stalled
+    searched = 0  # steps that converged only when retried
     stalled = ""
     import time
 
@@ -474,6 +495,15 @@ def fold_pattern(
             structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
             max_iter=max_iter, U0=U0, assembler=asm,
         )  # fmt: skip
+        if (line_search or retry_iter > max_iter) and not (res.ok and np.isfinite(res.U).all()):
+            # the step failed: the same step again before a smaller one, with more iterations
+            # (Newton often still converges, linearly, when the cap is hit) and/or the
+            # backtracking line search
+            res = solve_selffold(
+                structure, rest(nxt), start_rest=rest(done), increments=1, tol=tol,
+                max_iter=max(max_iter, retry_iter), U0=U0, assembler=asm, line_search=line_search,
+            )  # fmt: skip
+            searched += bool(res.ok)
         accepted = res.U if res.ok and np.isfinite(res.U).all() else None
         if panels is not None:  # contact hook: keep the step collision free (issue 32 item 2)
             accepted = panels.step(asm, U, accepted, rest(nxt), tol, max_iter)
@@ -611,6 +641,8 @@ def fold_pattern(
     if flows:
         where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
         note += f"; Newton stalled at {where} % and a pseudo-transient flow carried the fold on"
+    if searched:
+        note += f"; {searched} steps converged only when retried"
     if snaps:
         where = ", ".join(f"{100 * x:.1f}" for x in snaps[:5])
         note += f"; snaps at {where} % (no nearby equilibrium: the energy minimum beyond)"

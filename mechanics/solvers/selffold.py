@@ -10,6 +10,18 @@ The spring rest angles move linearly from ``start_rest`` to ``target_rest`` over
 
 Note the reference's order: the residual norm is that of the residual *before* the update, and the
 update is applied even on the iteration that meets the tolerance. Snap-through cannot be followed.
+
+``line_search=True`` (:func:`~holofold.mechanics.folding.fold_pattern`'s optional retry of a
+failed step) keeps that order but backtracks a Newton update that does not lower the potential
+energy ``Pi = E(U) - F0 . U`` by the Armijo amount ``1e-4 a r . dU`` and does not lower ``||r||``
+either (:func:`_backtrack`): the full step's linearised rotations stretch the stiff panel bars
+(a residual 100-1000x the step's start), and from a state far from equilibrium the full step
+can leave the basin altogether. A full step that passes either test is taken as it is, so the
+last, quadratically converging iterations are the plain ones. Measured (docs/patterns.md,
+"Stalls: step control"): it lands on Newton's equilibrium but takes 2-4x the iterations on a
+waterbomb step and doubles the factorisations of the surface fold check: the energy that the
+full step's stretch adds is removed by the next full step, so cutting the step only slows the
+fold. Off by default.
 """
 
 from __future__ import annotations
@@ -45,6 +57,7 @@ def solve_selffold(
     F0=None,
     start_rest=None,
     assembler: Assembler | None = None,
+    line_search: bool = False,
 ) -> SolveResult:
     """Fold by driving the spring rest angles to ``target_rest``.
 
@@ -66,6 +79,9 @@ def solve_selffold(
         Rest angles at the start (default ``structure.spring_rest``), rad.
     assembler : Assembler, optional
         A prebuilt ``Assembler(structure)``.
+    line_search : bool
+        Backtrack Newton updates that raise both the potential energy and the residual
+        (see the module docstring); default False (the reference's full steps).
 
     Returns
     -------
@@ -94,18 +110,65 @@ def solve_selffold(
         # the compiled dense step where it applies, else the same operations here
         dense = asm.dense_stepper(U, F0v, rest, r)
         try:
+            E = None
             while step < max_iter and R > tol:
+                if line_search:
+                    before = U[free].copy()
                 if dense is not None:
-                    dense()
+                    if line_search and E is None:
+                        E = asm.internal_force(U, rest)[0] - F0v @ U
+                    dU = dense()
                 else:
-                    _, f, solve = asm.evaluate_factorized(U, rest)
+                    e, f, solve = asm.evaluate_factorized(U, rest)
+                    if line_search and E is None:
+                        E = e - F0v @ U
                     r = (F0v - f)[free]
-                    U[free] += solve(r)
+                    dU = solve(r)
+                    U[free] += dU
                 R = math.sqrt(r @ r)  # = float(np.sqrt(r @ r)): both correctly rounded
                 step += 1
+                if line_search and R > tol:
+                    E = _backtrack(asm, U, before, dU, r, R, E, rest, F0v)
         except SingularSystemError as exc:
             hist.failure = f"increment {i}, iteration {step}: {exc}"
             hist.record(U, s, False, step - 1, R)
             break
         hist.record(U, s, R <= tol, step - 1, R)
     return hist.result(tol, "||r||", F0v, target, "solve_selffold")
+
+
+#: Armijo constant of the line search, and its smallest step fraction
+_ARMIJO = 1e-4
+_MIN_STEP = 1.0 / 64
+
+
+def _backtrack(asm, U, before, dU, r, R, E, rest, F0v) -> float:
+    """Backtrack the Newton update ``U[free] = before + dU`` (``U`` (ndof,), updated in place)
+    from the state with residual ``r`` (its norm ``R``) and potential ``E``: keep the first
+    step fraction ``a`` (1, then a safeguarded quadratic fit of the energy, at least a tenth
+    and at most half the last ``a``) whose potential passes the Armijo test
+    ``Pi(a) <= E - 1e-4 a r.dU`` (only when ``dU`` is a descent direction, ``r.dU > 0``) or
+    whose residual is below ``(1 - 1e-4 a) R``; below ``a`` = 1/64 keep the smallest.
+    Returns the potential at the kept state."""
+    free = asm.free_dofs
+    slope = float(r @ dU)  # -dPi/da at a = 0
+    a = 1.0
+    while True:
+        Et, f = asm.internal_force(U, rest)
+        Et -= F0v @ U
+        rt = (F0v - f)[free]
+        if not np.isfinite(Et):
+            ok = False
+        else:
+            ok = (slope > 0 and Et <= E - _ARMIJO * a * slope) or math.sqrt(rt @ rt) <= (
+                1.0 - _ARMIJO * a
+            ) * R
+        if ok or a <= _MIN_STEP:
+            return Et
+        if slope > 0 and np.isfinite(Et):  # minimiser of the quadratic through E, -slope, Et
+            q = slope * a * a / (2.0 * (Et - E + slope * a))
+            a_new = min(max(q, 0.1 * a), 0.5 * a)
+        else:
+            a_new = 0.5 * a
+        a = max(a_new, _MIN_STEP)
+        U[free] = before + a * dU
