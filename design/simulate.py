@@ -32,8 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from holofold.geometry import CreasePattern, ParameterError, check_range
+from holofold.geometry.errors import EnvironmentFault
 from holofold.geometry.physical import check_sheet
 from holofold.geometry.vertex_sets import VertexSet, parse_vertex_set
+from holofold.mechanics.contact import INSTALL as CONTACT_INSTALL
+from holofold.mechanics.contact import has_ipctk
 from holofold.mechanics.folding import MODELS, FoldResult, crease_classes, fold_pattern
 from holofold.mechanics.materials import Material, get_material
 from holofold.mechanics.status import Status
@@ -115,6 +118,11 @@ class PatternSetting:
         Largest rest-angle change per fold step, degrees.
     collisions : bool
         Check the folded thick panels for collisions.
+    contact : bool
+        Barrier contact between the thick panels while folding
+        (:mod:`holofold.mechanics.contact`, needs ``holofold[contact]``): the fold stops where
+        the panels touch instead of passing them through each other and stopping at the last
+        clean state. Off by default (its cost: docs/patterns.md).
     thick : str
         The thickness technique of the panels checked (``"centred"``, ``"offset"``,
         ``"tapered"``) or ``"auto"`` (default): the first of them that folds without overlap
@@ -136,6 +144,7 @@ class PatternSetting:
     max_step_deg: float = 3.0
     collisions: bool = True
     thick: str = "auto"
+    contact: bool = False
 
     def __post_init__(self):
         if isinstance(self.material, str):
@@ -154,6 +163,8 @@ class PatternSetting:
             raise ParameterError(f"load names must differ: {names}")
         if self.loads and not self.supports:
             raise ParameterError("loads need supports: give the vertices that hold the pattern")
+        if self.contact and not has_ipctk():  # before any work
+            raise EnvironmentFault(CONTACT_INSTALL)
 
 
 @dataclass(frozen=True)
@@ -317,7 +328,7 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
     fold = fold_pattern(
         pattern, s.fold, panel_thickness=s.panel_thickness, crease_thickness=s.crease_thickness,
         crease_width=s.crease_width, E=s.material.E, nu=s.material.nu, model=s.model,
-        max_step_deg=s.max_step_deg,
+        max_step_deg=s.max_step_deg, contact=s.contact,
     )  # fmt: skip
     outcomes = []
     if s.loads:

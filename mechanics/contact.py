@@ -33,6 +33,9 @@ __all__ = ["PanelContact", "contact_model", "has_ipctk", "intersects"]
 
 INSTALL = "panel contact needs the IPC Toolkit: pip install 'holofold[contact]' (ipctk)"
 CCD_SAFETY = 0.9  # fraction of the collision-free step taken
+#: Levenberg-Marquardt shift of the barrier solve where the tangent gives no descent (a snap
+#: with panels in contact), from MU_MIN to MU_MAX x the tangent's mean diagonal
+MU_MIN, MU_MAX = 1e-8, 1e8
 
 
 def has_ipctk() -> bool:
@@ -96,6 +99,7 @@ class PanelContact:
         self.n_dof = self.X0.size
         self._panel_of_node = _panel_of_node(structure)
         self.last_active = 0
+        self.touched = (0, (-1, -1))  # the most pairs within reach in the last solve, where
         self.newton_steps = 0
         X = self.X0
         if ipc.has_intersections(self.mesh, X):
@@ -198,6 +202,7 @@ class PanelContact:
         if U_trial is not None and np.isfinite(U_trial).all():
             if self.free_step(U_prev, U_trial) >= 1.0 and self.active(U_trial) == 0:
                 self.last_active = 0
+                self.touched = (0, (-1, -1))
                 return U_trial
         return self._solve(asm, np.asarray(U_prev, float).reshape(-1, 3), rest, tol, max_iter)
 
@@ -206,25 +211,30 @@ class PanelContact:
 
         free = asm.free_dofs
         U = U.ravel().copy()
+        self.touched = (0, (-1, -1))
 
         def total(Uv):
             b = self.energy(Uv)
             return asm.internal_force(Uv, rest)[0] + b if math.isfinite(b) else math.inf
 
+        import scipy.sparse as sp
+
+        mu, scale = 0.0, 0.0  # Levenberg-Marquardt shift where the tangent is not a descent
         for _ in range(max(4 * max_iter, 60)):
             e, f, K = asm.evaluate_reduced(U, rest, dense=False)
             eb, gb, Hb, n = self.evaluate(U)
             self.last_active = n
+            if n > self.touched[0]:
+                self.touched = self.touching(U)
             r = -(f + gb)[free]
             if math.sqrt(r @ r) <= tol:
                 return U.reshape(-1, 3)
             A = (K + Hb[free][:, free]).tocsc()
-            try:
-                d = splu(A).solve(r)
-            except RuntimeError:
+            scale = scale or float(np.abs(A.diagonal()).mean())
+            d = self._descent(A, r, mu, scale, sp, splu)
+            if d is None:
                 return None
-            if not np.isfinite(d).all():
-                return None
+            d, mu = d
             self.newton_steps += 1
             trial = U.copy()
             trial[free] += d
@@ -242,10 +252,30 @@ class PanelContact:
                 ):
                     break
                 alpha *= 0.5
-            else:
-                return None
+            else:  # no decrease along the update: a larger shift (a shorter, steeper step)
+                mu = max(4.0 * mu, MU_MIN * scale)
+                if mu > MU_MAX * scale:
+                    return None
+                continue
             U = cand
+            mu = mu / 4.0 if mu > MU_MIN * scale else 0.0
         return None
+
+    @staticmethod
+    def _descent(A, r, mu, scale, sp, splu):
+        """``(d, mu)``: the update solving ``(A + mu I) d = r`` with ``mu`` raised from the given
+        one until ``d`` descends (``r @ d > 0``); None past ``MU_MAX * scale``."""
+        eye = sp.identity(A.shape[0], format="csc")
+        while True:
+            try:
+                d = splu((A + mu * eye).tocsc() if mu else A).solve(r)
+            except RuntimeError:
+                d = None
+            if d is not None and np.isfinite(d).all() and float(r @ d) > 0:
+                return d, mu
+            mu = max(4.0 * mu, MU_MIN * scale)
+            if mu > MU_MAX * scale:
+                return None
 
 
 def _panel_of_node(structure) -> np.ndarray:

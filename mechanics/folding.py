@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from holofold.geometry.errors import ParameterError, check_range
+from holofold.geometry.errors import ParameterError, check_range, record_or_keywords
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.compat import PHYSICAL, Profile
 from holofold.mechanics.hinges import build_compliant, build_concentrated, crease_rest_targets
@@ -200,7 +200,8 @@ class FoldResult:
         against its assignment along the path (NaN: none did).
     touch_at : float
         The fraction of the first state in which panels passed through each other (the fold
-        stops at the state before it; NaN: every state was clean).
+        stops at the state before it); with contact, the fraction from which the panels whose
+        barrier stopped the fold were within its reach (NaN: neither).
     touch_where : (int, int)
         Two faces that pass through each other there ((-1, -1): none, or not located).
     halvings : int
@@ -313,18 +314,6 @@ class FoldSettings:
     retry_iter: int = 0
 
 
-def _fold_settings(given: FoldSettings | None, options: dict) -> FoldSettings:
-    """The record, or one made of the former keywords (``max_step_deg=2.0``, ...)."""
-    for k in options:
-        if k not in FoldSettings.__dataclass_fields__:
-            raise TypeError(f"fold_pattern() got an unexpected keyword argument {k!r}")
-    if given is None:
-        return FoldSettings(**options)
-    if options:
-        raise TypeError(f"fold_pattern(settings=...): give {next(iter(options))} in the record")
-    return given
-
-
 def fold_pattern(
     pattern: CreasePattern,
     fraction: float = 1.0,
@@ -406,7 +395,7 @@ def fold_pattern(
     from holofold.mechanics.leave_flat import flow_to_equilibrium
     from holofold.mechanics.solvers import solve_selffold
 
-    st = _fold_settings(settings, options)
+    st = record_or_keywords(FoldSettings, settings, options, "fold_pattern", "settings")
     model, profile, max_step_deg, rel_tol = st.model, st.profile, st.max_step_deg, st.rel_tol
     max_iter, time_limit, extrapolate = st.max_iter, st.time_limit, st.extrapolate
     line_search, retry_iter = st.line_search, st.retry_iter
@@ -476,6 +465,8 @@ def fold_pattern(
     fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
     flows: list[float] = []  # steps carried by pseudo-transient flow where Newton stalled
+    contact_from = math.nan  # first accepted state with panels within the barrier's reach
+    held = None  # (pairs, (panel, panel)): the barrier holds the panels where the fold stops
     searched = 0  # steps that converged only when retried
     stalled = ""
     import time
@@ -510,6 +501,8 @@ def fold_pattern(
         if accepted is not None:
             U = accepted.copy()
             done = nxt
+            if panels is not None and panels.touched[0] and math.isnan(contact_from):
+                contact_from = done
             fr.append(done)
             Us.append(U.copy())
             clock.append(time.perf_counter() - started)
@@ -535,6 +528,13 @@ def fold_pattern(
                 (flows if flowed else snaps).append(done)
                 h = h0
                 continue
+            if panels is not None and panels.touched[0]:
+                # the barrier holds the panels apart and the actuation cannot fold them on:
+                # the sheet stops where its layers touch (not a stall of the solver)
+                held = panels.touched
+                if math.isnan(contact_from):
+                    contact_from = done
+                break
             why = "; ".join(res.status.reasons) or "non-finite displacement"
             stalled = f"step {100 * done:.1f} -> {100 * nxt:.1f} % does not converge ({why})"
             break
@@ -574,6 +574,13 @@ def fold_pattern(
     bend = float(np.degrees(energy.panel_bend.max(initial=0.0)))
     strain = float(energy.panel_strain.max(initial=0.0))
     touched = ""
+    if held is not None:  # contact on: the layers touch and stop the fold
+        a, b = held[1]
+        touch_at, touch_where = float(contact_from), held[1]
+        touched = (
+            f"panels {a} and {b} touch at {100 * contact_from:.1f} % (held a panel thickness "
+            f"apart) and stop the fold at {100 * done:.1f} %"
+        )
     if hit is not None:
         a, b = touch_where
         touched = (
@@ -638,6 +645,13 @@ def fold_pattern(
         note += (
             f"; {came_back} driven creases turned against their assignment on the way and came back"
         )
+    if held is None and not math.isnan(contact_from):  # contact on, the fold went on
+        pairs, (a, b) = panels.touching(Uh[-1])
+        if pairs:
+            note += (
+                f"; panels {a} and {b} touch from {100 * contact_from:.1f} % and are held a "
+                "panel thickness apart"
+            )
     if flows:
         where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
         note += f"; Newton stalled at {where} % and a pseudo-transient flow carried the fold on"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -105,3 +106,20 @@ def test_contact_without_active_pairs_changes_nothing():
     assert on.verdict == off.verdict
     scale = np.abs(off.U[-1]).max()
     assert np.abs(on.U[-1] - off.U[-1]).max() <= 1e-9 * scale
+
+
+@pytest.mark.slow
+def test_a_snap_into_the_layers_is_a_contact_stop_not_a_stall():
+    """Origami Simulator's pinwheel base (200 mm, 1 mm PP panels): its snap at 88.5 % runs
+    into its own layers; with contact the fold stops there, held, and says which panels."""
+    from holofold.design import scaled_pattern
+    from holofold.geometry import read_pattern
+
+    p = read_pattern(Path(__file__).parent / "data" / "origami-simulator" / "pinwheelBase.svg")
+    p = scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))
+    pp = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9, nu=0.42)
+    on = fold_pattern(p, 1.0, contact=True, **pp)
+    assert on.verdict == "folds until panels touch"
+    assert 0.85 < on.touch_at <= on.reached < 0.9
+    assert min(on.touch_where) >= 0 and "held a panel thickness apart" in on.note
+    assert not any(intersects(on.structure, U) for U in on.U)

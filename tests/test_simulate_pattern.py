@@ -193,6 +193,17 @@ def test_simulate_command_refuses_in_one_line(tmp_path, capsys):
     assert code == 2 and "known: paper" in capsys.readouterr().err
 
 
+def test_contact_without_ipc_toolkit_stops_before_any_work(tmp_path, capsys, monkeypatch):
+    import holofold.design.simulate as sim
+
+    monkeypatch.setattr(sim, "has_ipctk", lambda: False)
+    out = tmp_path / "o"
+    code = main(["simulate", str(OS / "simpleVertex.svg"), "--contact", "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code != 0 and "pip install 'holofold[contact]'" in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+
+
 def test_a_sheet_too_small_for_its_creases_is_refused_not_given_a_negative_mass(tmp_path, capsys):
     """The issue's Miura scaled to 3 mm with 1 mm creases: the panels vanish under their hinge
     strips (before: mass -0.0045 g, 'folds rigidly'); refused in one line, nothing written."""

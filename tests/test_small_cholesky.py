@@ -6,9 +6,9 @@ each path on both kernel paths, against the dense LU."""
 import numpy as np
 import pytest
 from scipy.linalg import lu_factor, lu_solve
+from test_kernel_paths import path  # noqa: F401  (the kernel-path fixture: numpy, compiled)
 
 from holofold.design.scenarios.gripper import gripper_model
-from holofold.mechanics import kernels
 from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.linear import (
     DENSE_MAX_DOF,
@@ -26,31 +26,6 @@ ROW = dict(
     W=0.000286383490247001,
 )  # fmt: skip
 RTOL = 1e-12
-
-
-def _compiled_reason():
-    try:
-        kernels.kernel_path("compiled")
-    except Exception as exc:  # EnvironmentFault: no numba here
-        return str(exc)
-    return None
-
-
-_NO_COMPILED = _compiled_reason()
-PATHS = [
-    "numpy",
-    pytest.param(
-        "compiled",
-        marks=pytest.mark.skipif(bool(_NO_COMPILED), reason=f"compiled path: {_NO_COMPILED}"),
-    ),
-]
-
-
-@pytest.fixture(params=PATHS)
-def path(request, monkeypatch):
-    """Run the test on one kernel path (HOLOFOLD_KERNELS)."""
-    monkeypatch.setenv(kernels.ENV, request.param)
-    return kernels.kernel_path(request.param)
 
 
 @pytest.fixture(scope="module")
@@ -138,7 +113,7 @@ def test_dense_solver_raises_on_a_singular_matrix():
 
 @pytest.mark.parametrize("cholesky", ["banded", "dense"])
 @pytest.mark.parametrize("state", ["definite", "indefinite"])
-def test_newton_step_agrees_with_lu(gripper, path, state, cholesky, monkeypatch):
+def test_newton_step_agrees_with_lu(gripper, path, state, cholesky, monkeypatch):  # noqa: F811
     """One Newton step (the kernel path's ``small_newton_step``) on the gripper's tangent:
     the Cholesky where it is positive definite, else the LU (and ``lu`` set for the rest of
     the increment); the solution solves K dU = r to 1e-12 relative residual, as the step
@@ -174,7 +149,7 @@ def test_newton_step_agrees_with_lu(gripper, path, state, cholesky, monkeypatch)
         asm.reduction._symbolic.pop(f"small_step:{path.module.__name__}", None)
 
 
-def test_the_lu_stays_for_the_increment(gripper, path):
+def test_the_lu_stays_for_the_increment(gripper, path):  # noqa: F811
     """Once the Cholesky failed, the stepper (one increment) factorises by LU directly."""
     asm, U_pd, U_ind = gripper
     U = U_ind.copy()

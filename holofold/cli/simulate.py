@@ -78,6 +78,11 @@ def register(subparsers) -> argparse.ArgumentParser:
     )  # fmt: skip
     p.add_argument("--increments", type=int, default=5, help="load increments (default 5)")
     p.add_argument("--no-collisions", action="store_true", help="skip the collision check")
+    p.add_argument(
+        "--contact", action="store_true",
+        help="barrier contact between the thick panels while folding (needs holofold[contact]; "
+        "slower: docs/patterns.md)",
+    )  # fmt: skip
     p.add_argument("--units", choices=("mm", "m"), default="mm", help="STL/OBJ unit (mm)")
     p.add_argument(
         "-o", "--output", required=True,
@@ -188,7 +193,7 @@ def _setting(args):
         material=mat, panel_thickness=args.panel_thickness,
         crease_thickness=args.crease_thickness, crease_width=args.crease_width, fold=args.fold,
         model=args.model, supports=tuple(args.support), support_dofs=args.support_dofs,
-        loads=loads, collisions=not args.no_collisions,
+        loads=loads, collisions=not args.no_collisions, contact=args.contact,
     )  # fmt: skip
     return setting
 
