@@ -97,7 +97,7 @@ class PanelContact:
         self.kappa = float(kappa)
         self.barrier = ipc.BarrierPotential(self.dhat, self.kappa)
         self.n_dof = self.X0.size
-        self._panel_of_node = _panel_of_node(structure)
+        self._panels_of_node = _panels_of_node(structure)
         self.last_active = 0
         self.touched = (0, (-1, -1))  # the most pairs within reach in the last solve, where
         self.newton_steps = 0
@@ -165,20 +165,32 @@ class PanelContact:
 
     def touching(self, U) -> tuple[int, tuple[int, int]]:
         """``(pairs, (panel, panel))``: the number of primitive pairs closer than ``dmin +
-        dhat`` at ``U`` and two panels of the closest one (``(-1, -1)`` when none; a primitive
-        is placed in the panel of its first vertex)."""
+        dhat`` at ``U`` and two panels of the closest one, each a panel holding the whole of
+        its primitive (``(-1, -1)`` when none)."""
         X = self._pos(U)
         c = self._collisions(X)
         if not len(c):
             return 0, (-1, -1)
         E, F = self.mesh.edges, self.mesh.faces
-        best, ids = math.inf, None
+        best, k = math.inf, 0
         for i in range(len(c)):
             d = c[i].compute_distance(c[i].dof(X, E, F))
             if d < best:
-                best, ids = d, c[i].vertex_ids(E, F)
-        a, b = (int(self._panel_of_node[ids[0]]), int(self._panel_of_node[ids[2]]))
-        return len(c), (min(a, b), max(a, b))
+                best, k = d, i
+        # each c[i] is a view into the set: read the closest one by index, while c lives
+        ids = [int(v) for v in c[k].vertex_ids(E, F) if v >= 0]
+        name = type(c[k]).__name__  # FaceVertex: (v, f0, f1, f2); EdgeEdge, EdgeVertex: 2
+        cut = 2 if name.startswith(("EdgeEdge", "EdgeVertex")) else 1
+        a = self._panels_of(ids[cut:] if name.startswith("Face") else ids[:cut])
+        b = self._panels_of(ids[:cut] if name.startswith("Face") else ids[cut:])
+        pa = min(a, default=-1)
+        pb = min(b - {pa}, default=min(b, default=-1))
+        return len(c), (min(pa, pb), max(pa, pb))
+
+    def _panels_of(self, nodes) -> set:
+        """The panels holding every node of ``nodes``."""
+        sets = [self._panels_of_node[n] for n in nodes]
+        return set.intersection(*sets) if sets else set()
 
     def free_step(self, U0, U1) -> float:
         """Largest fraction in [0, 1] of the straight path ``U0 -> U1`` on which no two
@@ -278,16 +290,16 @@ class PanelContact:
                 return None
 
 
-def _panel_of_node(structure) -> np.ndarray:
-    """(nn,) int: a panel holding each node (-1 for none), from ``structure.tri_panel``."""
-    out = np.full(len(structure.nodes), -1, np.intp)
+def _panels_of_node(structure) -> list[set]:
+    """The panels holding each node (empty for none), from ``structure.tri_panel``."""
+    out: list[set] = [set() for _ in range(len(structure.nodes))]
     panel = getattr(structure, "tri_panel", None)
     if panel is None:
         return out
-    tri, panel = np.asarray(structure.triangles), np.asarray(panel)
-    keep = panel >= 0
-    for col in range(3)[::-1]:  # the first triangle's panel wins: assigned last
-        out[tri[keep, col][::-1]] = panel[keep][::-1]
+    for tri, p in zip(np.asarray(structure.triangles), np.asarray(panel), strict=True):
+        if p >= 0:
+            for n in tri:
+                out[n].add(int(p))
     return out
 
 
