@@ -46,9 +46,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "PrintablePart",
             "parse_bed",
             "part_fit",
-            "ThicknessChoice",
-            "choose_thickness",
-            "THICK_CHOICES",
         ],
         "batches": ["batch_spans"],
         "evaluation": [
@@ -107,17 +104,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "row_limits": ["RowTimeout", "ON_INVALID", "check_on_invalid", "resolve_row_timeout"],
         "sampling": ["sample_designs", "METHODS"],
-        "simulate": [
-            "PatternLoad",
-            "PatternSetting",
-            "PatternSimulation",
-            "LoadOutcome",
-            "simulate_pattern",
-            "write_simulation",
-            "plot_simulation",
-            "scaled_pattern",
-            "pattern_mass",
-        ],
         "scenarios.strip": ["StripSetting", "StripLoad", "strip_scenario", "STRIP_FEATURES"],
         "scenarios": [
             "Scenario",

@@ -2,7 +2,7 @@
 
 :func:`pattern_files` expands files and folders (searched recursively for the suffixes of
 :data:`holofold.geometry.READERS`); :func:`check_pattern_file` reads and folds one file with
-:func:`holofold.design.simulate_pattern` under a time limit and returns its record (a plain
+:func:`holofold.mechanics.simulate_pattern` under a time limit and returns its record (a plain
 dict: a pattern that is refused, crashes or times out is a record with its reason);
 :func:`run_pattern_batch` writes the records to a JSON-lines file as each finishes (one complete
 line appended, flushed and fsynced), skipping files already recorded there (same resolved path
@@ -124,7 +124,7 @@ def _fold_fields(fold) -> dict:
 
 
 def _simulate(path, setting, options, size, scale, stage):
-    from .simulate import scaled_pattern, simulate_pattern
+    from holofold.mechanics import scaled_pattern, simulate_pattern
 
     reader = reader_for(path)
     given = {k: v for k, v in options.items() if v is not None and k in reader.options}

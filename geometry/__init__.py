@@ -63,6 +63,13 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "thick_panel_mesh",
         ],
         "thick_part": ["thick_printable"],
+        "thick_choice": [
+            "THICK_CHOICES",
+            "THICK_CODES",
+            "ThicknessChoice",
+            "choose_thickness",
+            "thick_name",
+        ],
         "facets": ["split_faces", "nonconvex_faces", "SPLIT_MODES"],
         "families": [
             "Parameter",

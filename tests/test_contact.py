@@ -112,8 +112,8 @@ def test_contact_without_active_pairs_changes_nothing():
 def test_a_snap_into_the_layers_is_a_contact_stop_not_a_stall():
     """Origami Simulator's pinwheel base (200 mm, 1 mm PP panels): its snap at 88.5 % runs
     into its own layers; with contact the fold stops there, held, and says which panels."""
-    from holofold.design import scaled_pattern
     from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
 
     p = read_pattern(Path(__file__).parent / "data" / "origami-simulator" / "pinwheelBase.svg")
     p = scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))

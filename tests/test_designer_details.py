@@ -9,9 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from holofold.cli import main
-from holofold.design.simulate import scaled_pattern
 from holofold.geometry import read_pattern
-from holofold.mechanics import fold_pattern
+from holofold.mechanics import fold_pattern, scaled_pattern
 
 _OS = Path(__file__).parent / "data" / "origami-simulator"
 

@@ -157,8 +157,8 @@ def test_fold_angles_are_tracked_through_180_degrees(name):
     """Origami Simulator's pinwheel base and Russian triangle at 100 %: valleys pass 180 deg
     (a dihedral angle known modulo 360 would read them as mountains near -180, which called
     these folds 'bifurcation at flat'); unwrapped along the path they keep their side."""
-    from holofold.design import scaled_pattern
     from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
 
     p = scaled_pattern(read_pattern(_OS / name), 0.2)
     # the path as actuated, not stopped where panels pass through each other (checked below)
@@ -185,8 +185,8 @@ def test_fold_angles_are_tracked_through_180_degrees(name):
 def test_a_crease_turning_against_its_assignment_is_reported_with_where_it_started():
     """Origami Simulator's flapping bird leaves flat on another branch: two driven creases end
     folded against their assignment; the verdict says so and from which fraction."""
-    from holofold.design import scaled_pattern
     from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
 
     r = fold_pattern(scaled_pattern(read_pattern(_OS / "flappingBird.svg"), 0.2), 1.0, **_PP)
     assert r.verdict == "turns against its assignment" and r.wrong_way.size >= 1

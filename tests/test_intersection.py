@@ -112,7 +112,7 @@ def test_simulation_files_of_a_touching_fold_are_clean(tmp_path):
     numpy test) and is clean; the summary says where the fold stopped and which panels."""
     import json
 
-    from holofold.design import PatternSetting, simulate_pattern, write_simulation
+    from holofold.mechanics import PatternSetting, simulate_pattern, write_simulation
 
     sim = simulate_pattern(_strip(), PatternSetting())
     assert sim.fold.verdict == "folds until panels touch"

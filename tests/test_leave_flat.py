@@ -17,8 +17,8 @@ _PP = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1
 
 
 def _os(name):
-    from holofold.design import scaled_pattern
     from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
 
     p = read_pattern(_OS / name)
     return scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))

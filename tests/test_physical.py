@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import holofold.geometry as g
-from holofold.design import PatternSetting, scaled_pattern, simulate_pattern
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.physical import SheetWarning, check_sheet, sheet_mass
+from holofold.mechanics import PatternSetting, scaled_pattern, simulate_pattern
 
 
 def _miura():

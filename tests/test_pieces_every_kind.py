@@ -14,9 +14,15 @@ import pytest
 import trimesh
 
 from holofold.cli import main
-from holofold.design.buildability import choose_thickness, thick_name
 from holofold.design.scenarios.files import read_scenario
-from holofold.geometry import Bed, miura_sheet, print_time_text, segment_part
+from holofold.geometry import (
+    Bed,
+    choose_thickness,
+    miura_sheet,
+    print_time_text,
+    segment_part,
+    thick_name,
+)
 from holofold.geometry.thick import miura_path, path_overlap
 
 ROOT = Path(__file__).resolve().parents[1]

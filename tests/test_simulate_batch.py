@@ -170,7 +170,7 @@ def test_two_workers_give_the_same_lines(patterns, batch, tmp_path):
 
 
 def test_a_crash_while_folding_is_a_line(monkeypatch, tmp_path):
-    import holofold.design.simulate as simulate
+    import holofold.mechanics.pattern_simulation as simulate
 
     def boom(pattern, setting):
         raise RuntimeError("solver blew up")
@@ -199,7 +199,8 @@ def _dies_on_popup(path, *args):
 
 @pytest.mark.processes
 def test_a_worker_that_dies_takes_only_its_pattern(patterns, batch, tmp_path):
-    from holofold.design import PatternSetting, run_pattern_batch
+    from holofold.design import run_pattern_batch
+    from holofold.mechanics import PatternSetting
 
     out = tmp_path / "d.jsonl"
     files = pattern_files([patterns])

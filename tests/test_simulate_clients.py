@@ -17,7 +17,7 @@ import pytest
 from test_real_clients import _node_modules, _rigid_residual
 
 import holofold.geometry as g
-from holofold.design import PatternLoad, PatternSetting, simulate_pattern, write_simulation
+from holofold.mechanics import PatternLoad, PatternSetting, simulate_pattern, write_simulation
 
 pytestmark = pytest.mark.slow
 

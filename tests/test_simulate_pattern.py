@@ -1,6 +1,6 @@
 """Simulating a user's crease pattern: named vertex sets, holofold simulate, the pattern kind
-of scenario files (geometry/vertex_sets.py, design/simulate.py, design/scenarios/pattern_kind.py,
-holofold/cli/simulate.py)."""
+of scenario files (geometry/vertex_sets.py, mechanics/pattern_simulation.py,
+design/scenarios/pattern_kind.py, holofold/cli/simulate.py)."""
 
 from __future__ import annotations
 
@@ -14,15 +14,15 @@ import pytest
 
 import holofold.geometry as g
 from holofold.cli import main
-from holofold.design import (
+from holofold.design import read_scenario
+from holofold.geometry import ParameterError, parse_vertex_set
+from holofold.mechanics import (
     PatternLoad,
     PatternSetting,
-    read_scenario,
+    get_material,
     simulate_pattern,
     write_simulation,
 )
-from holofold.geometry import ParameterError, parse_vertex_set
-from holofold.mechanics import get_material
 
 OS = Path(__file__).parent / "data" / "origami-simulator"
 
@@ -106,7 +106,7 @@ def test_mass_is_the_thinned_flat_sheet():
         )
     e = p.edges[p.interior]
     L = np.linalg.norm(xy[e[:, 1]] - xy[e[:, 0]], axis=1).sum()
-    from holofold.design import pattern_mass
+    from holofold.mechanics import pattern_mass
 
     assert pattern_mass(p, s) == pytest.approx(
         1270 * (area * 1e-3 + L * 1e-3 * (0.3e-3 - 1e-3)), rel=1e-12
@@ -194,7 +194,7 @@ def test_simulate_command_refuses_in_one_line(tmp_path, capsys):
 
 
 def test_contact_without_ipc_toolkit_stops_before_any_work(tmp_path, capsys, monkeypatch):
-    import holofold.design.simulate as sim
+    import holofold.mechanics.pattern_simulation as sim
 
     monkeypatch.setattr(sim, "has_ipctk", lambda: False)
     out = tmp_path / "o"

@@ -21,8 +21,8 @@ SIZE = 0.2  # m
 
 
 def _os(name):
-    from holofold.design import scaled_pattern
     from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
 
     p = read_pattern(_OS / name)
     return scaled_pattern(p, SIZE / float(np.ptp(p.flat, axis=0).max()))

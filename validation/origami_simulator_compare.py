@@ -341,9 +341,8 @@ def fold_holofold(path: Path, fractions, limit: float = 300.0):
     """holofold's folds of ``path`` (scaled to 200 mm, PP section): {fraction: (flat (n, 2),
     coords (n, 3), verdict, clean)}; one fold to the largest fraction, the smaller ones taken
     from its path where it passes through them exactly, else folded on their own."""
-    from holofold.design import scaled_pattern
     from holofold.geometry import read_pattern
-    from holofold.mechanics import fold_pattern
+    from holofold.mechanics import fold_pattern, scaled_pattern
     from holofold.mechanics.intersection import intersecting_faces
 
     with warnings.catch_warnings():

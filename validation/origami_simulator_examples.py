@@ -29,9 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from holofold.design import scaled_pattern
 from holofold.geometry import read_pattern
-from holofold.mechanics import fold_pattern
+from holofold.mechanics import fold_pattern, scaled_pattern
 
 SECTION = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9, nu=0.42)
 SIZE = 0.2  # m

@@ -3,7 +3,7 @@
 docs/scenarios.md §8.4. The file names a crease pattern (FOLD, SVG, DXF, ORIPA; read once, when
 the scenario file is read, by :func:`holofold.geometry.read_pattern`), the material, the
 supports and loads as named vertex sets (:mod:`holofold.geometry.vertex_sets`) and the design
-features. Every design is :func:`holofold.design.simulate.simulate_pattern`: the pattern, scaled
+features. Every design is :func:`holofold.mechanics.simulate_pattern`: the pattern, scaled
 by ``scale``, folded by rest-angle actuation to ``fold`` x its fold angles, then loaded.
 
 Features (SI): ``tpanel``, ``tcrease``, ``W`` (panel and crease thickness, crease width, m),
@@ -46,13 +46,13 @@ from holofold.design.scenarios.pattern_loads import (
     row_thickness,
     write_row_files,
 )
-from holofold.design.simulate import (
+from holofold.geometry import CreasePattern
+from holofold.mechanics import (
     PatternLoad,
     PatternSetting,
     scaled_pattern,
     simulate_pattern,
 )
-from holofold.geometry import CreasePattern
 from holofold.mechanics.materials import Material
 
 __all__ = [

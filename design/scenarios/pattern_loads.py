@@ -2,7 +2,7 @@
 
 The ``pattern`` and ``surface`` kinds (:mod:`~holofold.design.scenarios.pattern_kind`,
 :mod:`~holofold.design.scenarios.surface_kind`) fold a crease pattern and load it with
-:func:`~holofold.design.simulate.simulate_pattern`: their ``[supports]`` and ``[[load]]``
+:func:`~holofold.mechanics.simulate_pattern`: their ``[supports]`` and ``[[load]]``
 tables name vertex sets (:mod:`holofold.geometry.vertex_sets`), their rows get a stiffness per
 load, the mass, ``overlap`` and ``clearance`` of the same simulation, and their files (as the
 sheet kind's) are the fabrication set, without the solids where the thick panels cannot be made.
@@ -15,7 +15,6 @@ import warnings
 
 import numpy as np
 
-from holofold.design.buildability import THICK_CODES
 from holofold.design.scenarios.base import Column
 from holofold.design.scenarios.config import (
     Section,
@@ -24,9 +23,9 @@ from holofold.design.scenarios.config import (
     read_dofs,
     read_loads,
 )
-from holofold.design.simulate import PatternLoad, PatternSimulation
-from holofold.geometry import CreasePattern
+from holofold.geometry import THICK_CODES, CreasePattern, choose_thickness
 from holofold.geometry.vertex_sets import parse_vertex_set
+from holofold.mechanics import PatternLoad, PatternSimulation
 from holofold.mechanics.materials import Material
 from holofold.mechanics.status import Status
 
@@ -144,7 +143,6 @@ THICK_COLUMN = Column(
 def row_thickness(state: CreasePattern, row, path=()):
     """The row's thick panels in ``state`` (:func:`~holofold.design.buildability.
     choose_thickness` with ``thick = "auto"``, over ``path``)."""
-    from holofold.design.buildability import choose_thickness
 
     try:
         return choose_thickness(state, float(row["tpanel"]), float(row["W"]), path=tuple(path))

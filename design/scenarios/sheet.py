@@ -34,7 +34,7 @@ Columns, SI units:
 ``thick``
     the thickness technique of those panels, 0 centred, 1 offset, 2 tapered: the setting's
     ``thick``, or with ``thick = "auto"`` (the default) the first whose panels fold from flat
-    to that extension without collision (:func:`~holofold.design.buildability.choose_thickness`;
+    to that extension without collision (:func:`~holofold.geometry.choose_thickness`;
     offset and tapered panels are checked at four states on the way and report ``overlap``
     over the path and ``clearance`` nan). The files and the printable part use it.
 
@@ -53,7 +53,6 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.buildability import THICK_CHOICES
 from holofold.design.scenarios.base import Column, Scenario, integer, positive
 from holofold.design.scenarios.config import (
     Section,
@@ -74,7 +73,7 @@ from holofold.design.scenarios.sheet_families import (
     miura_sides,
     sheet_family,
 )
-from holofold.geometry import MAX_PANELS
+from holofold.geometry import MAX_PANELS, THICK_CHOICES, choose_thickness
 from holofold.geometry.errors import DegenerateGeometryError
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
@@ -523,11 +522,10 @@ def sheet_fold_path(setting: SheetSetting, row) -> tuple[CreasePattern, list[Cre
 
 
 def sheet_thickness(setting: SheetSetting, row):
-    """The design's thick panels (:func:`~holofold.design.buildability.choose_thickness`):
+    """The design's thick panels (:func:`~holofold.geometry.choose_thickness`):
     the setting's technique, or with ``thick = "auto"`` the first of centred, offset and
     tapered whose panels fold from flat to the smallest modelled extension without collision
     (trimesh, scipy.spatial and manifold3d load on first use)."""
-    from holofold.design.buildability import choose_thickness
 
     state, way = sheet_fold_path(setting, row)
     return choose_thickness(state, float(row["tpanel"]), float(row["W"]), path=way,

@@ -43,7 +43,6 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.buildability import THICK_CHOICES
 from holofold.design.scenarios.base import Column, Scenario, integer, positive
 from holofold.design.scenarios.config import (
     Section,
@@ -68,7 +67,13 @@ from holofold.fitting import (
     read_svg_curve,
     strip_geometry,
 )
-from holofold.geometry import LENGTH_UNITS, non_simple_faces
+from holofold.geometry import (
+    LENGTH_UNITS,
+    THICK_CHOICES,
+    ThicknessChoice,
+    choose_thickness,
+    non_simple_faces,
+)
 from holofold.geometry.pattern import CreasePattern
 from holofold.mechanics.analyses import load_along, secant_stiffness_batch
 from holofold.mechanics.assembly import BatchAssembler
@@ -495,12 +500,11 @@ def strip_view(setting: StripSetting, row):
 
 def strip_thickness(setting: StripSetting, row, geometry=None):
     """The design's thick panels in the strip's shape
-    (:class:`~holofold.design.buildability.ThicknessChoice`): centred panels, or with
+    (:class:`~holofold.geometry.ThicknessChoice`): centred panels, or with
     ``setting.thick`` another technique or "auto" (the first of centred, offset and tapered
-    whose panels do not overlap: :func:`~holofold.design.buildability.choose_thickness` on the
+    whose panels do not overlap: :func:`~holofold.geometry.choose_thickness` on the
     strip's flat development and shape). ``geometry``: the design's strip, if built. A strip is
     not folded from flat in the model, so only its final shape is checked."""
-    from holofold.design.buildability import ThicknessChoice, choose_thickness
 
     tp, w = float(row["tpanel"]), float(row["W"])
     fit = None

@@ -7,7 +7,7 @@ and the features. Load directions are in the target's frame. Every design is
 fitted (:func:`holofold.fitting.fit_surface`: m x n quads over ``coverage`` of the target's
 chart, starting from a Miura-ori folded to ``ext``), then its flat pattern is folded to the
 fitted fold angles by the bar-and-hinge simulator and loaded
-(:func:`holofold.design.simulate.simulate_pattern`): the honest fold of docs/surface-fit.md §4
+(:func:`holofold.mechanics.simulate_pattern`): the honest fold of docs/surface-fit.md §4
 is part of every row.
 
 Features (SI): ``m``, ``n`` (quads along and across the zig-zag direction, categorical),
@@ -51,7 +51,6 @@ from holofold.design.scenarios.pattern_loads import (
     surface_lines,
     write_row_files,
 )
-from holofold.design.simulate import PatternLoad, PatternSetting, simulate_pattern
 from holofold.fitting import (
     BUILTIN_SURFACES,
     MESH_SURFACE_TYPES,
@@ -63,7 +62,13 @@ from holofold.fitting import (
     read_surface,
 )
 from holofold.geometry import LENGTH_UNITS, CreasePattern
-from holofold.mechanics import FOLD_TOLERANCE, aligned_deviation
+from holofold.mechanics import (
+    FOLD_TOLERANCE,
+    PatternLoad,
+    PatternSetting,
+    aligned_deviation,
+    simulate_pattern,
+)
 from holofold.mechanics.materials import Material
 from holofold.mechanics.status import Status
 

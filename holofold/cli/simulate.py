@@ -127,8 +127,8 @@ def run(args) -> int:
 
     import numpy as np
 
-    from holofold.design import scaled_pattern, simulate_pattern, write_simulation
     from holofold.geometry import check_output_folder, check_range, read_pattern, reader_for
+    from holofold.mechanics import scaled_pattern, simulate_pattern, write_simulation
 
     if _is_batch(args):
         return _run_batch(args)
@@ -171,8 +171,7 @@ def run(args) -> int:
 
 def _setting(args):
     """The PatternSetting of the parsed arguments."""
-    from holofold.design import PatternLoad, PatternSetting
-    from holofold.mechanics import Material, get_material
+    from holofold.mechanics import Material, PatternLoad, PatternSetting, get_material
 
     mat = get_material(args.material)
     if args.E is not None or args.nu is not None or args.density is not None:

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from holofold.geometry import CreasePattern, ParameterError, check_range
+from holofold.geometry import CreasePattern, ParameterError, check_range, choose_thickness
 from holofold.geometry.errors import EnvironmentFault
 from holofold.geometry.physical import check_sheet
 from holofold.geometry.vertex_sets import VertexSet, parse_vertex_set
@@ -126,7 +126,7 @@ class PatternSetting:
     thick : str
         The thickness technique of the panels checked (``"centred"``, ``"offset"``,
         ``"tapered"``) or ``"auto"`` (default): the first of them that folds without overlap
-        (:func:`holofold.design.buildability.choose_thickness`, over up to four states of the
+        (:func:`holofold.geometry.choose_thickness`, over up to four states of the
         fold path).
     """
 
@@ -367,8 +367,6 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
         clash = overlap is not None and (overlap > 1e-12 or (clearance or 0.0) < 0)
         if overlap is not None and (s.thick not in ("auto", "centred")
                                     or (s.thick == "auto" and clash)):  # fmt: skip
-            from holofold.design.buildability import choose_thickness
-
             k = len(fold.coords)
             way = [fold.folded(int(i)) for i in np.unique(np.linspace(0, k - 1, 5).round())[1:-1]]
             try:
