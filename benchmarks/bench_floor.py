@@ -452,7 +452,7 @@ def database(floor_rows: int = 120):
     spaced rows (BLAS on 1 thread, as the workers run) times 3000 / 2."""
     import pandas as pd
 
-    from holofold.design.runner import evaluate_designs
+    from holofold.design.database.runner import evaluate_designs
 
     cols = open(REF / "data3_FeatureName.txt").read().split()
     df = pd.DataFrame(np.loadtxt(REF / "data3_ShapeFit.txt", delimiter=","), columns=cols)

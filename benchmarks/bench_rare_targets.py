@@ -64,8 +64,8 @@ from holofold.design import (
     rule_ranges,
     sample_designs,
 )
-from holofold.design.loop import _box_of, _roles, refine_designs
-from holofold.design.row_status import failed_rows
+from holofold.design.database.row_status import failed_rows
+from holofold.design.loop.design_loop import _box_of, _roles, refine_designs
 
 HERE = Path(__file__).resolve().parent
 CACHE = HERE / ".cache" / "rare"
@@ -341,8 +341,8 @@ def loop(ctx: Context, **kw) -> Run:
     simulations routed through the cache."""
     import tempfile
 
-    import holofold.design.loop as design_loop
-    import holofold.design.verify as design_verify
+    import holofold.design.loop.design_loop as design_loop
+    import holofold.design.rules.verify as design_verify
 
     real = design_loop.build_database, design_verify.build_database
 

@@ -53,8 +53,8 @@ from scipy import stats as sstats
 from suite_data import CACHE, EXTERNAL, ROOT, load_databases, suite_targets
 
 from holofold.design import rules_to_records, verify_rule
-from holofold.design.evaluation import rule_scores, split_indices
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.rules.evaluation import rule_scores, split_indices
 
 PAPER = "paper"
 DEFAULT = "default"  #: ForestRuleMiner's defaults: the method whose rules are verified

@@ -27,10 +27,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.evaluation import grid_search, rule_scores, split_indices
+from holofold.design.database.tables import read_table
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner
-from holofold.design.tables import read_table
-from holofold.design.targets import parse_target
+from holofold.design.rules.evaluation import grid_search, rule_scores, split_indices
+from holofold.design.rules.targets import parse_target
 
 FEATURES = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]
 TARGET = "Zstiff > 800 & Xstiff > 600 & error < 0.1"

@@ -109,7 +109,7 @@ def _public_module(module: str) -> bool:
 
 
 def run_design_figures(trees: dict) -> dict:
-    tree = trees["holofold.design.loop"]
+    tree = trees["holofold.design.loop.design_loop"]
     fn = next(n for q, n, _, _ in _functions(tree) if q == "run_design")
     body = fn.body
     has_doc = isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)

@@ -1,14 +1,18 @@
-"""holofold.design: scenarios, databases, design rules and their verification.
+"""holofold.design: scenarios, databases, design rules, the design loop and its report.
 
-The top layer of the library (imports geometry, fitting and mechanics, never the reverse):
-the paper's scenarios (:mod:`~holofold.design.scenarios`), sampling and validated batch
-evaluation (:mod:`~holofold.design.sampling`, :mod:`~holofold.design.runner`), the resumable
-Parquet store (:mod:`~holofold.design.store`), tables (:mod:`~holofold.design.tables`), the
-target language (:mod:`~holofold.design.targets`), the forest rule miner and its evaluation
-(:mod:`~holofold.design.rules`, :mod:`~holofold.design.evaluation`,
-:mod:`~holofold.design.mining`), rules files (:mod:`~holofold.design.rulefile`), reports
-(:mod:`~holofold.design.report`), verification (:mod:`~holofold.design.verify`) and the demo
-(:mod:`~holofold.design.demo`). See docs/rule-miner.md and docs/scenarios.md.
+The top layer of the library (imports geometry, fitting and mechanics, never the reverse), in
+five parts:
+
+- :mod:`~holofold.design.scenarios`: the paper's scenarios and the kinds of scenario files;
+- :mod:`~holofold.design.database`: sampling, validated evaluation row by row on processes or a
+  Dask cluster, the resumable Parquet store, tables;
+- :mod:`~holofold.design.rules`: the target language, the forest rule miner, its evaluation,
+  the ``mine`` workflow, rules files and figures, verification by fresh simulations;
+- :mod:`~holofold.design.loop`: the design loop (what it is asked, how it searches and runs),
+  its rounds, the choice of the design to build and whether it fits the printer;
+- :mod:`~holofold.design.report`: the HTML report, its 3D view, what the designs reach;
+
+and the demo (:mod:`~holofold.design.demo`). See docs/rule-miner.md and docs/scenarios.md.
 """
 
 import lazy_loader
@@ -17,29 +21,35 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
         "demo": ["run_demo", "DEMO_TARGET"],
-        "acquisition": ["likely_designs"],
-        "folder_lock": ["folder_lock", "FolderBusyError"],
-        "loop": ["run_design", "DesignLoop", "LoopState", "DesignOutcome", "choose_design"],
-        "settings": ["DesignProblem", "LoopSettings", "Execution", "DesignFiles"],
-        "strategies": [
+        "loop.acquisition": ["likely_designs"],
+        "database.folder_lock": ["folder_lock", "FolderBusyError"],
+        "loop.design_loop": [
+            "run_design",
+            "DesignLoop",
+            "LoopState",
+            "DesignOutcome",
+            "choose_design",
+        ],
+        "loop.settings": ["DesignProblem", "LoopSettings", "Execution", "DesignFiles"],
+        "loop.strategies": [
             "STRATEGIES",
             "register_strategy",
             "RefineRequest",
             "Proposal",
             "refine_designs",
         ],
-        "objective": ["Objective", "parse_objective"],
-        "choice": ["choose", "Answer", "Candidate", "OVERLAP_TOLERANCE"],
-        "rounds": ["Round", "VerifiedRule", "Counts", "RULE_QUALIFIES"],
-        "summary": ["DesignSummary", "Pick", "Timings"],
-        "describe": [
+        "loop.objective": ["Objective", "parse_objective"],
+        "loop.choice": ["choose", "Answer", "Candidate", "OVERLAP_TOLERANCE"],
+        "loop.rounds": ["Round", "VerifiedRule", "Counts", "RULE_QUALIFIES"],
+        "loop.summary": ["DesignSummary", "Pick", "Timings"],
+        "report.describe": [
             "Distribution",
             "distributions",
             "distributions_text",
             "describe_source",
             "PILOT",
         ],
-        "buildability": [
+        "loop.buildability": [
             "Bed",
             "DEFAULT_BED",
             "PartFit",
@@ -47,8 +57,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "parse_bed",
             "part_fit",
         ],
-        "batches": ["batch_spans"],
-        "evaluation": [
+        "database.batches": ["batch_spans"],
+        "rules.evaluation": [
             "holdout",
             "repeated_holdout",
             "rule_scores",
@@ -56,9 +66,9 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "summarize",
             "HoldoutResult",
         ],
-        "mining": ["mine_rules", "MinedRules"],
-        "report_page": ["write_report_page", "report_page_html"],
-        "report": [
+        "rules.mining": ["mine_rules", "MinedRules"],
+        "report.page": ["write_report_page", "report_page_html"],
+        "rules.report": [
             "rules_to_text",
             "mining_summary",
             "plot_rules",
@@ -69,7 +79,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "plot_folded_design",
             "save_figure",
         ],
-        "rulefile": [
+        "rules.rulefile": [
             "mined_rules",
             "rules_to_records",
             "write_rules",
@@ -85,7 +95,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "Estimate",
             "RuleError",
         ],
-        "runner": [
+        "database.runner": [
             "validate_designs",
             "evaluate_designs",
             "DesignTableError",
@@ -93,17 +103,22 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "check_scheduler",
             "dask_scheduler",
         ],
-        "row_status": ["failed_rows", "converged_rows", "row_statuses", "with_state"],
-        "faults": ["as_environment_fault"],
-        "pattern_batch": [
+        "database.row_status": ["failed_rows", "converged_rows", "row_statuses", "with_state"],
+        "database.faults": ["as_environment_fault"],
+        "database.pattern_batch": [
             "pattern_files",
             "file_sha256",
             "recorded_files",
             "check_pattern_file",
             "run_pattern_batch",
         ],
-        "row_limits": ["RowTimeout", "ON_INVALID", "check_on_invalid", "resolve_row_timeout"],
-        "sampling": ["sample_designs", "METHODS"],
+        "database.row_limits": [
+            "RowTimeout",
+            "ON_INVALID",
+            "check_on_invalid",
+            "resolve_row_timeout",
+        ],
+        "database.sampling": ["sample_designs", "METHODS"],
         "scenarios.strip": ["StripSetting", "StripLoad", "strip_scenario", "STRIP_FEATURES"],
         "scenarios": [
             "Scenario",
@@ -122,8 +137,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "scenario_kinds",
             "kind_names",
         ],
-        "store": ["build_database", "generate_database", "load_database"],
-        "tables": [
+        "database.store": ["build_database", "generate_database", "load_database"],
+        "database.tables": [
             "read_table",
             "write_table",
             "check_table_path",
@@ -131,8 +146,8 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "table_columns",
             "ColumnRoles",
         ],
-        "targets": ["parse_target", "Target", "TargetError"],
-        "verify": [
+        "rules.targets": ["parse_target", "Target", "TargetError"],
+        "rules.verify": [
             "verify_rule",
             "verify_rules",
             "write_verification",

@@ -1,6 +1,7 @@
 """The end-to-end demo: ``holofold design`` on the paper's arch, small enough for a minute.
 
-:func:`run_demo` is what ``holofold demo`` runs: the design loop of :mod:`~holofold.design.loop`
+:func:`run_demo` is what ``holofold demo`` runs: the design loop of
+:mod:`~holofold.design.loop.design_loop`
 on the shipped ``arch.toml`` scenario file (a Miura strip over a half circle of radius 2 m):
 a database of arch designs, rules for :data:`DEMO_TARGET`, their verification by fresh
 simulations, one refinement round, the chosen design with its margins, its fabrication files
@@ -12,9 +13,9 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 
-from holofold.design.loop import run_design
+from holofold.design.loop.design_loop import run_design
+from holofold.design.loop.settings import DesignProblem, Execution, LoopSettings
 from holofold.design.scenarios import shipped_scenarios
-from holofold.design.settings import DesignProblem, Execution, LoopSettings
 
 __all__ = ["DEMO_TARGET", "run_demo"]
 

@@ -14,7 +14,7 @@ when the process leads its own session (started with ``start_new_session=True`` 
     just after an atomic write renamed its file into place;
 ``row``
     in the parent of a run, when the ``n``-th simulated row's result has arrived and before
-    it is stored (``holofold.design.runner.iter_results``).
+    it is stored (``holofold.design.database.runner.iter_results``).
 
 Unset (always outside tests) the variable costs one lookup at import and a ``None`` check
 per event.

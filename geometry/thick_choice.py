@@ -20,7 +20,7 @@ THICK_CODES = {"centred": 0, "offset": 1, "tapered": 2}
 #: what a scenario's ``thick`` key takes: a technique, or "auto" (the first that folds clear)
 THICK_CHOICES = (*THICK_CODES, "auto")
 #: summed overlap of thick panels that counts as none, m^3 (0.001 mm^3; as the loop's
-#: :data:`holofold.design.choice.OVERLAP_TOLERANCE`)
+#: :data:`holofold.design.loop.choice.OVERLAP_TOLERANCE`)
 _CLEAR = 1e-12
 
 

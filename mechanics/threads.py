@@ -4,7 +4,7 @@ The models' linear algebra is small (dense solves of tens to hundreds of DOFs, b
 a few thousand): several BLAS threads only contend for the cores and make it 8-60x slower on
 a busy machine. The solvers, analyses, thermal stages and scenario evaluations therefore run
 inside :func:`single_thread` (as a decorator: :func:`single_threaded`); parallelism comes from
-evaluating designs on several processes (:mod:`holofold.design.runner`).
+evaluating designs on several processes (:mod:`holofold.design.database.runner`).
 
 The limit is re-entrant and cheap: the outermost entry reads and sets the thread count of each
 BLAS/OpenMP library once (about 10 us, nothing when it already is 1; measured in

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from holofold.design import Column, ForestRuleMiner, Scenario, sample_designs
-from holofold.design.acquisition import likely_designs
+from holofold.design.loop.acquisition import likely_designs
 from holofold.mechanics.status import CONVERGED
 
 
@@ -120,7 +120,7 @@ def test_a_mixed_round_samples_half_by_vote_and_half_inside_the_best_rule(tmp_pa
 
 
 def test_the_loop_stops_looking_at_random_for_a_target_no_design_meets(tmp_path, monkeypatch):
-    import holofold.design.loop as design_loop
+    import holofold.design.loop.design_loop as design_loop
     from holofold.design import run_design
 
     monkeypatch.setattr(design_loop, "RANDOM_UP_TO", 100)

@@ -5,7 +5,7 @@ same iterations and statuses), whatever the others do (converge, stall, fail).""
 import numpy as np
 import pytest
 
-from holofold.design.runner import BATCH_ROWS, evaluate_designs, plan_tasks
+from holofold.design.database.runner import BATCH_ROWS, evaluate_designs, plan_tasks
 from holofold.design.scenarios import arch
 from holofold.mechanics import BatchAssembler, solve_newton, solve_newton_batch
 from holofold.mechanics.analyses import load_along, secant_stiffness, secant_stiffness_batch

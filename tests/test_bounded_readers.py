@@ -110,7 +110,7 @@ def test_long_cp_refused_and_content_never_quoted(tmp_path):
 
 
 def test_lock_never_opened_through_a_symlink(tmp_path):
-    from holofold.design.folder_lock import LOCK_NAME, folder_lock
+    from holofold.design.database.folder_lock import LOCK_NAME, folder_lock
 
     victim = tmp_path / "victim"
     victim.write_text("precious")
@@ -123,7 +123,7 @@ def test_lock_never_opened_through_a_symlink(tmp_path):
 
 
 def test_no_write_through_a_linked_subfolder(tmp_path):
-    from holofold.design.folder_lock import LOCK_NAME
+    from holofold.design.database.folder_lock import LOCK_NAME
     from holofold.geometry.outputs import write_text
 
     elsewhere = tmp_path / "elsewhere"

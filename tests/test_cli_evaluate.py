@@ -32,7 +32,7 @@ def test_csv_in_csv_out(tmp_path, data0, capsys):
     assert (res["status"] == "converged").all()
     assert "3 design(s) evaluated" in capsys.readouterr().out
     # the command leaves the library's logging alone (in-process callers still get warnings)
-    assert logging.getLogger("holofold.design.runner").level == logging.NOTSET
+    assert logging.getLogger("holofold.design.database.runner").level == logging.NOTSET
 
 
 def test_parquet_in_parquet_out(tmp_path, data0):

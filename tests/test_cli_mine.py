@@ -158,7 +158,7 @@ def test_the_papers_method_stays_selectable(reference_data, tmp_path, capsys):
 def test_the_papers_grid_knobs_reach_the_miner(tmp_path, capsys, monkeypatch):
     """--ccp-alpha, --criterion and --max-samples set the miner's parameters (Figs. S6-S8);
     a bad value is one line naming the option."""
-    import holofold.design.mining as mining
+    import holofold.design.rules.mining as mining
 
     db = _synthetic_csv(tmp_path)
     seen = {}

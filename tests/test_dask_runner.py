@@ -18,11 +18,11 @@ pytestmark = pytest.mark.processes
 
 import dask  # noqa: E402
 
-import holofold.design.runner as runner  # noqa: E402
-import holofold.design.store as store  # noqa: E402
+import holofold.design.database.runner as runner  # noqa: E402
+import holofold.design.database.store as store  # noqa: E402
 from holofold.cli import main  # noqa: E402
-from holofold.design.runner import check_scheduler, evaluate_designs  # noqa: E402
-from holofold.design.sampling import sample_designs  # noqa: E402
+from holofold.design.database.runner import check_scheduler, evaluate_designs  # noqa: E402
+from holofold.design.database.sampling import sample_designs  # noqa: E402
 from holofold.design.scenarios import Column, Scenario, get_scenario  # noqa: E402
 
 

@@ -581,9 +581,9 @@ def test_overlapping_panels_are_chosen_only_when_allowed_and_then_not_printed_fo
 def test_hits_too_few_to_mine_are_refined_around_instead_of_ending_the_loop(tmp_path, monkeypatch):
     """A rare target's few hits can all fall into the held-out rows (OneClassSplit): the loop
     samples around them, as with hits but no rule, instead of stopping with an error."""
-    import holofold.design.loop as loop
+    import holofold.design.loop.design_loop as loop
     from holofold.design import Column, Scenario
-    from holofold.design.mining import OneClassSplit
+    from holofold.design.rules.mining import OneClassSplit
 
     cheap = Scenario(
         name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
@@ -632,7 +632,7 @@ def test_when_no_design_is_buildable_the_rules_are_mined_for_the_target_alone(tm
     assert res.record.answer == "nearest" and s["buildable"] is False
     assert "The thick panels of every simulated design overlap; shown:" in res.record.headline
     assert "whose panels do not overlap" not in res.record.headline
-    from holofold.design.report_page import report_page_html
+    from holofold.design.report.page import report_page_html
 
     page = report_page_html(tmp_path / "o", res.record)
     assert "No buildable design meets the target: the best, overlapping" in page
@@ -698,7 +698,7 @@ def test_a_search_that_stops_improving_ends_early_with_the_best_design(tmp_path)
 def test_a_round_after_one_without_a_rule_says_it_samples_around_the_hits(tmp_path, monkeypatch):
     # issue 34 (validation/last_mile): a round after one whose miner found no rule announced
     # "half inside the best rule" although the box was that of the designs meeting the target
-    import holofold.design.loop as loop
+    import holofold.design.loop.design_loop as loop
     from holofold.design import Column, Scenario
 
     cheap = Scenario(

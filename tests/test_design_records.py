@@ -1,5 +1,6 @@
-"""The design loop's records (design/settings.py), its refinement strategies as a registry
-(design/strategies.py) and the loop object (design/loop.py: DesignLoop over a LoopState)."""
+"""The design loop's records (design/loop/settings.py), its refinement strategies as a registry
+(design/loop/strategies.py) and the loop object (design/loop/design_loop.py: DesignLoop over a
+LoopState)."""
 
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from holofold.design import (
     run_design,
     sample_designs,
 )
-from holofold.design.strategies import design_key
+from holofold.design.loop.strategies import design_key
 
 DESIGN = Path(__file__).resolve().parents[1] / "design"
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from holofold.design import get_scenario
-from holofold.design.view import DesignView, Load, view_css, view_html
+from holofold.design.report.view import DesignView, Load, view_css, view_html
 
 ROOT = Path(__file__).resolve().parents[1]
 ROW = {"m": 8, "tcrease": 8e-4, "tpanel": 3e-3, "W": 2e-3, "offset": 0.2, "stripeWidth": 0.02,

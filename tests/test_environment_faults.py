@@ -18,7 +18,7 @@ from holofold.design import (
     load_database,
     with_state,
 )
-from holofold.design.store import write_chunk
+from holofold.design.database.store import write_chunk
 from holofold.geometry import EnvironmentFault
 from holofold.mechanics import CONVERGED, Status
 

@@ -105,7 +105,7 @@ def test_a_kill_mid_chunk_keeps_the_rows_finished_before_it(tmp_path):
     # one chunk of 60 rows, checkpoints after every row (the default is every 5 s): a kill -9
     # when the 30th row arrives leaves the 29 before it, and the resume ends exactly
     script = (
-        "import sys; from holofold.design.store import generate_database; "
+        "import sys; from holofold.design.database.store import generate_database; "
         "generate_database('arch', 60, sys.argv[1], seed=5, chunk_size=60, workers=2, "
         "checkpoint=float(sys.argv[2]), progress=False)"
     )

@@ -46,7 +46,7 @@ def _one_line(capsys, *words):
 
 def test_evaluate_refuses_an_unwritable_output_before_simulating(tmp_path, capsys, frozen,
                                                                  monkeypatch):  # fmt: skip
-    import holofold.design.runner as runner
+    import holofold.design.database.runner as runner
 
     src = tmp_path / "designs.csv"
     src.write_text("tcrease,tpanel,W,gama\n8e-4,3e-3,2e-3,1.1\n")
@@ -60,7 +60,7 @@ def test_evaluate_refuses_an_unwritable_output_before_simulating(tmp_path, capsy
 
 def test_mine_refuses_unwritable_json_and_plot_before_training(tmp_path, capsys, frozen,
                                                                monkeypatch):  # fmt: skip
-    import holofold.design.mining as mining
+    import holofold.design.rules.mining as mining
 
     monkeypatch.setattr(mining, "mine_rules", lambda *a, **k: pytest.fail("trained"))
     ro = tmp_path / "ro"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from holofold.design import FewRulesWarning, ForestRuleMiner, parse_target
-from holofold.design.evaluation import baselines, repeated_holdout
+from holofold.design.rules.evaluation import baselines, repeated_holdout
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "validation"))
 import paper_ml_tables as paper  # noqa: E402

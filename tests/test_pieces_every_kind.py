@@ -80,7 +80,7 @@ def test_the_surface_kind_part_is_cut_into_pieces_that_fit():
 def test_offset_panels_are_cut_hinge_face_down():
     """An offset-panel Miura part (the material above the hinge face) cut for a small bed: the
     pieces are the thick_printable part's (volumes add up) and lie on the hinge face."""
-    from holofold.design.buildability import PrintablePart
+    from holofold.design.loop.buildability import PrintablePart
 
     sheet = miura_sheet(8, 8, 0.03, 0.03, math.radians(70), 0.5)
     part = PrintablePart(sheet, 2e-3, 0.5e-3, 2e-3, thick="offset")
@@ -240,7 +240,7 @@ def test_a_closed_cad_solid_gives_its_upper_skin(tmp_path):
 
 
 def test_margins_rules_and_sources_say_units_names_and_relative_paths():
-    from holofold.design.report_page import _condition_text
+    from holofold.design.report.page import _condition_text
     from holofold.design.rules.text import box_text
     from holofold.design.scenarios.base import Column
     from holofold.design.scenarios.files import shipped_scenarios

@@ -12,16 +12,16 @@ import pandas as pd
 import pytest
 from _browser import chromium as _chromium
 
-from holofold.design.report import (
+from holofold.design.report.page import report_page_html, write_report_page
+from holofold.design.rules import ForestRuleMiner
+from holofold.design.rules.report import (
     plot_folded_design,
     plot_rule_boxes,
     plot_target_scatter,
     save_figure,
 )
-from holofold.design.report_page import report_page_html, write_report_page
-from holofold.design.rules import ForestRuleMiner
+from holofold.design.rules.targets import parse_target
 from holofold.design.scenarios import Column
-from holofold.design.targets import parse_target
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -247,7 +247,7 @@ def test_named_levels_read_with_their_names_in_the_design_table(folder):
     # issue 34 (validation/last_mile): the pattern and surface kinds' chosen design read
     # "thick 1", not which technique its panels use; the loop writes the levels' names into
     # design.json and the page reads them back
-    from holofold.design.loop import _scenario_summary
+    from holofold.design.loop.design_loop import _scenario_summary
     from holofold.design.scenarios import Scenario
     from holofold.design.scenarios.pattern_loads import THICK_COLUMN
 

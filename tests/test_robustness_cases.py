@@ -4,8 +4,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from holofold.design.buildability import PartFit
-from holofold.design.loop import _say_chosen
+from holofold.design.loop.buildability import PartFit
+from holofold.design.loop.design_loop import _say_chosen
 
 
 def _said(fab):

@@ -8,10 +8,10 @@ import warnings
 import pandas as pd
 import pytest
 
-import holofold.design.store as store
+import holofold.design.database.store as store
 from holofold.design import Column, Scenario
-from holofold.design.runner import BATCH_ROWS
-from holofold.design.sampling import sample_designs
+from holofold.design.database.runner import BATCH_ROWS
+from holofold.design.database.sampling import sample_designs
 from holofold.mechanics import CONVERGED, Status
 
 CALLS: list = []

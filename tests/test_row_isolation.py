@@ -25,10 +25,10 @@ from holofold.design import (
     sample_designs,
     verify_rule,
 )
-from holofold.design.row_limits import call_with_limit
+from holofold.design.database.row_limits import call_with_limit
+from holofold.design.database.store import build_database
 from holofold.design.scenarios import Column, Scenario
 from holofold.design.scenarios.base import ROW_TIMEOUTS
-from holofold.design.store import build_database
 from holofold.mechanics.status import failed_mask
 
 pytestmark = pytest.mark.processes  # worker processes and row time limits
@@ -141,7 +141,7 @@ def test_row_timeout_settings():
 
 
 def test_limit_interrupts_python_code_in_any_thread(monkeypatch):
-    import holofold.design.row_limits as row_limits
+    import holofold.design.database.row_limits as row_limits
 
     # a 60 s spin (a hang bound): only the watchdog's exception ends it with RowTimeout
     with pytest.raises(RowTimeout):

@@ -9,7 +9,9 @@ import pandas as pd
 import pytest
 from sklearn.model_selection import train_test_split
 
-from holofold.design.evaluation import (
+from holofold.design.database.tables import PUBLISHED, column_roles, read_table
+from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.rules.evaluation import (
     baselines,
     grid_search,
     holdout,
@@ -18,17 +20,15 @@ from holofold.design.evaluation import (
     split_indices,
     summarize,
 )
-from holofold.design.report import (
+from holofold.design.rules.report import (
     plot_feature_importance,
     plot_rule_boxes,
     plot_rule_scatter,
     rules_to_text,
 )
-from holofold.design.rulefile import rules_to_json
-from holofold.design.rules import FewRulesWarning, ForestRuleMiner
+from holofold.design.rules.rulefile import rules_to_json
+from holofold.design.rules.targets import parse_target
 from holofold.design.scenarios import Column
-from holofold.design.tables import PUBLISHED, column_roles, read_table
-from holofold.design.targets import parse_target
 
 D0_FEATURES = ["tcrease", "tpanel", "W", "gama"]
 D3_FEATURES = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]

@@ -7,10 +7,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from holofold.design.evaluation import feature_dependence, holdout, rule_scores
-from holofold.design.mining import mine_rules
 from holofold.design.rules import SELECTION_PARAMS, FewRulesWarning, ForestRuleMiner, boxes_contain
 from holofold.design.rules.boxes import drop_idle_conditions
+from holofold.design.rules.evaluation import feature_dependence, holdout, rule_scores
+from holofold.design.rules.mining import mine_rules
 from holofold.design.rules.statistics import posterior
 
 

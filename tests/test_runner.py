@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from holofold.design.runner import DesignTableError, evaluate_designs, validate_designs
+from holofold.design.database.runner import DesignTableError, evaluate_designs, validate_designs
 from holofold.design.scenarios import Column, Scenario, get_scenario
 from holofold.mechanics.status import Status
 

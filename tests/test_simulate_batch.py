@@ -1,5 +1,5 @@
 """``holofold simulate`` over many files: one JSON line per pattern, resume, time limit,
-workers (design/pattern_batch.py, holofold/cli/simulate.py)."""
+workers (design/database/pattern_batch.py, holofold/cli/simulate.py)."""
 
 from __future__ import annotations
 

@@ -9,7 +9,8 @@ import pytest
 
 from holofold.cli import main
 from holofold.design import get_scenario, read_scenario, shipped_text
-from holofold.design.mining import (
+from holofold.design.rules.miner import FewRulesWarning
+from holofold.design.rules.mining import (
     MAX_MINING_BYTES,
     MAX_MINING_SECONDS,
     MAX_TREE_DEPTH,
@@ -17,7 +18,6 @@ from holofold.design.mining import (
     mine_rules,
     mining_estimate,
 )
-from holofold.design.rules.miner import FewRulesWarning
 from holofold.design.scenarios import ScenarioFileError
 from holofold.fitting import MAX_M
 from holofold.geometry import MAX_PANELS
@@ -62,7 +62,7 @@ def test_force_lets_a_large_forest_through_and_progress_is_told():
 
 
 def test_progress_line_before_long_training(table, monkeypatch):
-    import holofold.design.mining as mining
+    import holofold.design.rules.mining as mining
 
     monkeypatch.setattr(mining, "SECONDS_PER_TREE", 1.0)  # pretend: 1 s per tree
     lines = []

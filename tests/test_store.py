@@ -4,9 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import holofold.design.store as store
+import holofold.design.database.store as store
 from holofold.cli import main
-from holofold.design.sampling import sample_designs
+from holofold.design.database.sampling import sample_designs
 from holofold.design.scenarios import get_scenario
 
 

@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import holofold.design.store as store
+import holofold.design.database.store as store
 from holofold.design import Column, Scenario, column_roles, mine_rules
-from holofold.design.sampling import sample_designs
+from holofold.design.database.sampling import sample_designs
 from holofold.mechanics import CONVERGED
 
 CALLS: list = []

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import pytest
 
-from holofold.design.sampling import sample_designs
+from holofold.design.database.sampling import sample_designs
 from holofold.design.scenarios import arch
 from holofold.design.scenarios.strip import strip_part, strip_thickness
 

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from holofold.design.targets import TargetError, parse_target
+from holofold.design.rules.targets import TargetError, parse_target
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ from packaging.version import Version
 from sklearn.tree import DecisionTreeClassifier
 
 from holofold.design import ForestRuleMiner, column_roles, mine_rules, mined_rules
-from holofold.design.evaluation import baselines, feature_dependence
+from holofold.design.rules.evaluation import baselines, feature_dependence
 
 #: per shipped scenario: its published database (sample files joined) and a target on it
 CASES = {

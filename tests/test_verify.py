@@ -8,8 +8,8 @@ import pytest
 
 from holofold.cli import main
 from holofold.design import verify_rules, write_verification
+from holofold.design.rules.verify import rule_ranges, verify_rule
 from holofold.design.scenarios import get_scenario
-from holofold.design.verify import rule_ranges, verify_rule
 
 
 def test_rule_ranges_intersect_the_scenario_box():
@@ -153,9 +153,9 @@ def test_holofold_verify_is_the_loops_resumable_verification(tmp_path, capsys):
 def test_a_failed_fresh_design_counts_as_one_that_misses_the_target():
     # the parabolic arch of validation/last_mile: 26 of 28 simulated designs met the target and
     # 22 were self-overlapping strips; the rule's precision is 26 / 50, not 26 / 28
-    from holofold.design.rounds import Counts
-    from holofold.design.targets import parse_target
-    from holofold.design.verify import Verification
+    from holofold.design.loop.rounds import Counts
+    from holofold.design.rules.targets import parse_target
+    from holofold.design.rules.verify import Verification
 
     c = Counts(simulated=28, failed=22, meeting=26)
     assert c.tried == 50 and c.precision == pytest.approx(0.52)

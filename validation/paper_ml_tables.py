@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from holofold.design import FewRulesWarning, ForestRuleMiner, parse_target, read_table
-from holofold.design.evaluation import baselines, grid_search, repeated_holdout
+from holofold.design.rules.evaluation import baselines, grid_search, repeated_holdout
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER_MINER = dict(

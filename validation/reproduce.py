@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.runner import evaluate_designs
+from holofold.design.database.runner import evaluate_designs
+from holofold.design.database.tables import read_table
 from holofold.design.scenarios import get_scenario
-from holofold.design.tables import read_table
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -2,7 +2,8 @@
 
 A :class:`Scenario` names the feature columns (with units and the paper's sampling ranges), the
 categorical features, the performance columns, a physical-validity check and the function that
-simulates one design. The runner (:mod:`~holofold.design.runner`) and the ``holofold evaluate``
+simulates one design. The runner (:mod:`~holofold.design.database.runner`) and the ``holofold
+evaluate``
 command work from this description only.
 
 ``evaluate(row)`` takes a mapping of feature name -> value (SI units) and returns a dict with one
@@ -233,10 +234,10 @@ class Scenario:
         :class:`~holofold.geometry.FabricationSet` (files under stable keys with labels).
     view : callable(row) -> DesignView, optional
         The design to look at in 3D, flat to folded, with supports, loads and the target
-        (:class:`holofold.design.view.DesignView`).
+        (:class:`holofold.design.report.view.DesignView`).
     part : callable(row) -> PrintablePart, optional
         The part the design prints (its flat pattern, panel and hinge thicknesses, hinge
-        width; :class:`holofold.design.buildability.PrintablePart`), cut into bed-sized pieces
+        width; :class:`holofold.design.loop.buildability.PrintablePart`), cut into bed-sized pieces
         when it is larger than the printer's bed.
     evaluate_batch : callable(rows) -> list of dict, optional
         Simulates several rows with the same ``batch_key`` together (their Newton solves in
@@ -246,7 +247,8 @@ class Scenario:
         Rows with equal keys have models of one size (e.g. the strip's ``m``).
     row_timeout : float, optional
         The runner's default time limit per row, seconds (a row past it is recorded as
-        ``failed: timeout ...``; see :mod:`~holofold.design.row_limits`); None: the default of
+        ``failed: timeout ...``; see :mod:`~holofold.design.database.row_limits`); None: the
+        default of
         the scenario's ``kind`` (:data:`ROW_TIMEOUTS`).
     bed : str
         The printer's bed of the scenario file's ``bed`` key ("250x210", mm; ``--bed`` wins),
@@ -286,7 +288,7 @@ class Scenario:
     def simulate(self) -> Callable[[Mapping[str, float]], dict]:
         """The evaluator without the row check of :attr:`evaluate`, for callers that checked
         the row already (the runner checks each row once, in
-        :func:`~holofold.design.runner.validate_designs`, and each output once)."""
+        :func:`~holofold.design.database.runner.validate_designs`, and each output once)."""
         return self.evaluate.args[0]
 
     @property

@@ -900,8 +900,8 @@ def write_closed_gripper_files(
 
 def gripper_view(options: GripperOptions, row):
     """From flat (room temperature) to closed by heating, coloured by temperature, with the
-    held base nodes (:class:`~holofold.design.view.DesignView`)."""
-    from holofold.design.view import DesignView
+    held base nodes (:class:`~holofold.design.report.view.DesignView`)."""
+    from holofold.design.report.view import DesignView
 
     res, model = closed_gripper(options, row)
     room = options.material.room_temperature

@@ -141,7 +141,7 @@ THICK_COLUMN = Column(
 
 
 def row_thickness(state: CreasePattern, row, path=()):
-    """The row's thick panels in ``state`` (:func:`~holofold.design.buildability.
+    """The row's thick panels in ``state`` (:func:`~holofold.design.loop.buildability.
     choose_thickness` with ``thick = "auto"``, over ``path``)."""
 
     try:
@@ -191,10 +191,11 @@ def write_row_files(shape: CreasePattern, folder, row, *, units: str = "mm", cut
 def row_part(pattern: CreasePattern, row):
     """The printable part of a design whose crease pattern is ``pattern`` (its flat layout;
     a pattern read flat is its own layout), printed with the row's ``tpanel``, ``tcrease`` and
-    ``W`` (:class:`~holofold.design.buildability.PrintablePart`); None without a flat layout."""
+    ``W`` (:class:`~holofold.design.loop.buildability.PrintablePart`); None without a flat
+    layout."""
     from dataclasses import replace
 
-    from holofold.design.buildability import PrintablePart
+    from holofold.design.loop.buildability import PrintablePart
 
     if pattern.flat is None:
         z = pattern.coords[:, 2]
@@ -221,11 +222,11 @@ def crease_view(
     curve_name: str = "target curve",
     facts: tuple[tuple[str, str], ...] = (),
 ):
-    """The 3D view (:class:`~holofold.design.view.DesignView`) of a crease-pattern design:
+    """The 3D view (:class:`~holofold.design.report.view.DesignView`) of a crease-pattern design:
     the flat layout, then ``states`` (k, nv, 3) m with their ``labels``; the vertex sets held
     and the loads (one arrow per loaded vertex) selected on ``pattern``; ``curve`` (P, 3) m the
     target drawn over every state."""
-    from holofold.design.view import DesignView, Load
+    from holofold.design.report.view import DesignView, Load
 
     frames = np.concatenate([_flat_frame(pattern)[None], np.asarray(states, float)])
     held = (

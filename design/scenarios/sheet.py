@@ -543,8 +543,8 @@ def sheet_shape(setting: SheetSetting, row, ext: float | None = None) -> CreaseP
 def sheet_view(setting: SheetSetting, row):
     """The design folding from flat (Ext = 1) through each modelled extension, with the
     supported nodes (x = min) and the loads shared by the nodes at x = max
-    (:class:`~holofold.design.view.DesignView`)."""
-    from holofold.design.view import DesignView, Load
+    (:class:`~holofold.design.report.view.DesignView`)."""
+    from holofold.design.report.view import DesignView, Load
 
     exts = [1.0] + [e for e in sorted(setting.extensions, reverse=True) if e < 1.0]
     frames = np.stack([sheet_nodes(setting, row, e) for e in exts])
@@ -567,8 +567,8 @@ def sheet_view(setting: SheetSetting, row):
 def sheet_part(setting: SheetSetting, row):
     """The printable part: the sheet's flat layout, printed with panels of ``tpanel`` joined
     by hinge strips of ``tcrease`` and width ``W``
-    (:class:`~holofold.design.buildability.PrintablePart`)."""
-    from holofold.design.buildability import PrintablePart
+    (:class:`~holofold.design.loop.buildability.PrintablePart`)."""
+    from holofold.design.loop.buildability import PrintablePart
 
     got = sheet_thickness(setting, row)
     state, way = sheet_fold_path(setting, row)

@@ -460,8 +460,8 @@ def _fit(setting: StripSetting, row):
 
 def strip_view(setting: StripSetting, row):
     """The design from its flat development to the strip over the curve, with the supported
-    nodes, the loads and the target curve (:class:`~holofold.design.view.DesignView`)."""
-    from holofold.design.view import DesignView, Load
+    nodes, the loads and the target curve (:class:`~holofold.design.report.view.DesignView`)."""
+    from holofold.design.report.view import DesignView, Load
 
     fit = _fit(setting, row)
     pat = fit.flat_pattern if fit.flat is not None else fit.pattern
@@ -529,8 +529,9 @@ def strip_thickness(setting: StripSetting, row, geometry=None):
 def strip_part(setting: StripSetting, row):
     """The printable part: the strip's flat development, printed with panels of ``tpanel``
     joined by hinge strips of ``tcrease`` and width ``W``
-    (:class:`~holofold.design.buildability.PrintablePart`; None if the development overlaps)."""
-    from holofold.design.buildability import PrintablePart
+    (:class:`~holofold.design.loop.buildability.PrintablePart`; None if the development
+    overlaps)."""
+    from holofold.design.loop.buildability import PrintablePart
 
     fit = _fit(setting, row)
     if fit.flat is None:

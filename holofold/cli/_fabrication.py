@@ -78,7 +78,7 @@ def bed_of(args):
 
 def say_part(files, bed, part, units: str, root) -> dict | None:
     """If ``files`` (a fabrication set) holds ``printable``: its fit on ``bed``, cut into pieces
-    when larger (``part``: a :class:`~holofold.design.buildability.PrintablePart`), said in one
+    when larger (``part``: a :class:`~holofold.design.loop.buildability.PrintablePart`), said in one
     line; its JSON record (None without a printable part)."""
     from holofold.design import part_fit
 

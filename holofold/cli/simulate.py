@@ -19,7 +19,7 @@ Lengths in metres.
 
 Several patterns, a folder (searched recursively for the readable formats) or ``-o`` ending in
 ``.jsonl`` check every pattern instead and write one JSON line each to ``-o``, resuming a file
-already there (:mod:`holofold.design.pattern_batch`)::
+already there (:mod:`holofold.design.database.pattern_batch`)::
 
     holofold simulate A.svg B.fold FOLDER/ -o checks.jsonl --workers 2 --time-limit 120
 """

@@ -40,11 +40,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.folder_lock import folder_lock
-from holofold.design.row_checkpoints import CHECKPOINT_SECONDS, RowCheckpoint, move_damaged
-from holofold.design.row_limits import resolve_row_timeout
-from holofold.design.row_status import STATE_COLUMNS, stale_rows, with_state
-from holofold.design.runner import (
+from holofold.design.database.folder_lock import folder_lock
+from holofold.design.database.row_checkpoints import CHECKPOINT_SECONDS, RowCheckpoint, move_damaged
+from holofold.design.database.row_limits import resolve_row_timeout
+from holofold.design.database.row_status import STATE_COLUMNS, stale_rows, with_state
+from holofold.design.database.runner import (
     check_scheduler,
     check_workers,
     dask_scheduler,
@@ -55,9 +55,9 @@ from holofold.design.runner import (
     results_table,
     validate_designs,
 )
-from holofold.design.sampling import sample_designs
+from holofold.design.database.sampling import sample_designs
+from holofold.design.database.tables import write_table
 from holofold.design.scenarios import Scenario, load_scenario
-from holofold.design.tables import write_table
 from holofold.geometry.outputs import atomic_write, write_json
 
 __all__ = ["build_database", "generate_database", "load_database", "scan_chunks", "write_chunk"]
@@ -103,7 +103,7 @@ def build_database(
         Dask every missing row is submitted at once (see ``scheduler``).
     checkpoint : float
         Seconds between two writes of the finished rows of the chunk in flight
-        (:mod:`holofold.design.row_checkpoints`): a killed run loses at most this much
+        (:mod:`holofold.design.database.row_checkpoints`): a killed run loses at most this much
         finished work plus the rows still running. 0 writes after every row.
     workers : int
         Worker processes per chunk (joblib), or of the local Dask cluster with
@@ -114,12 +114,13 @@ def build_database(
         Extra metadata stored in ``meta.json`` (seed, sampling method, ...).
     scheduler : str, optional
         Simulate on a Dask cluster: a scheduler address (``tcp://host:8786``) or ``"local"``
-        (one local cluster for the whole run); see :func:`holofold.design.runner.evaluate_designs`.
+        (one local cluster for the whole run); see
+        :func:`holofold.design.database.runner.evaluate_designs`.
         Every row of the missing chunks is submitted at once and each chunk is written as
         soon as its last row is done (chunks may be written out of order), so no worker
         waits for the slowest row of a chunk. The results are the same as without it.
     on_invalid, row_timeout
-        Per-row isolation, as in :func:`holofold.design.runner.evaluate_designs`: with
+        Per-row isolation, as in :func:`holofold.design.database.runner.evaluate_designs`: with
         ``"skip"`` invalid rows are stored as failed rows with their reason; a row past its
         time limit is stored as ``failed: timeout after ... s`` (a resume keeps it: chunks on
         disk are never simulated again).
@@ -240,7 +241,8 @@ def _build_chunk(
     scenario, designs, checked, invalid, k, chunk_size, chunks, workers, bar, timeout, every
 ) -> None:  # fmt: skip
     """Simulate chunk ``k`` with joblib and write it: the table
-    :func:`~holofold.design.runner.evaluate_designs` gives for its rows. The rows a killed run
+    :func:`~holofold.design.database.runner.evaluate_designs` gives for its rows. The rows a killed
+    run
     checkpointed are taken back, the others simulated in the same tasks (batches of one
     ``batch_key``) as an uninterrupted run, so a resume gives the same outputs."""
     n = len(designs)
@@ -342,7 +344,7 @@ def _redo_stale(
     scenario, designs, done, chunk_size, workers, scheduler, on_invalid, timeout, retry_failed
 ) -> None:
     """Simulate again the stored rows of the sound chunks ``done`` that
-    :func:`~holofold.design.row_status.stale_rows` names; each such chunk is rewritten (new
+    :func:`~holofold.design.database.row_status.stale_rows` names; each such chunk is rewritten (new
     checksum name) and ``done`` updated."""
     found = {}
     for k, p in done.items():
@@ -602,7 +604,8 @@ def generate_database(
 ) -> pd.DataFrame:
     """Sample ``n`` designs of ``scenario`` and simulate them into ``folder`` (resumable).
 
-    ``seed``, ``method`` and ``ranges`` go to :func:`holofold.design.sampling.sample_designs`
+    ``seed``, ``method`` and ``ranges`` go to
+    :func:`holofold.design.database.sampling.sample_designs`
     and are recorded in ``meta.json``; ``run`` (``chunk_size``, ``workers``, ``progress``,
     ``scheduler``, ``row_timeout``, ``retry_failed``, ``checkpoint``) to
     :func:`build_database`, whose defaults and meanings they keep. ``csv`` also writes

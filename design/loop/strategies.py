@@ -7,7 +7,7 @@ folder they are simulated into (so a resumed run finds them) and the words of th
 ``benchmarks/rare_targets.md``):
 
 - ``"likely"``: all where the last round's forest votes for the target
-  (:func:`~holofold.design.acquisition.likely_designs`);
+  (:func:`~holofold.design.loop.acquisition.likely_designs`);
 - ``"around"``: half inside the rules and half in them widened by a quarter of each range
   (:func:`refine_designs`);
 - ``"mixed"`` (the default): half where the forest votes, half uniformly inside the best rule.
@@ -28,11 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from holofold.design.acquisition import likely_designs
+from holofold.design.database.sampling import sample_designs
+from holofold.design.loop.acquisition import likely_designs
 from holofold.design.rules import Rule
-from holofold.design.sampling import sample_designs
+from holofold.design.rules.verify import rule_key, rule_ranges
 from holofold.design.scenarios import Scenario
-from holofold.design.verify import rule_key, rule_ranges
 from holofold.geometry import Registry
 
 __all__ = [

@@ -4,7 +4,7 @@
 miner's settings, decides which columns are design features (the table's ``meta.json`` or the
 published column sets, unless given), leaves out failed simulations, and fits a
 :class:`~holofold.design.rules.ForestRuleMiner` on a hold-out training split
-(:func:`holofold.design.evaluation.holdout`), scoring its rules on the test rows.
+(:func:`holofold.design.rules.evaluation.holdout`), scoring its rules on the test rows.
 """
 
 from __future__ import annotations
@@ -17,17 +17,17 @@ from functools import cached_property
 import numpy as np
 import pandas as pd
 
-from holofold.design.evaluation import (
+from holofold.design.database.row_status import failed_rows
+from holofold.design.database.tables import ColumnRoles
+from holofold.design.rules import ForestRuleMiner
+from holofold.design.rules.evaluation import (
     HoldoutResult,
     feature_dependence,
     holdout,
     split_indices,
 )
-from holofold.design.row_status import failed_rows
-from holofold.design.rules import ForestRuleMiner
 from holofold.design.rules.params import check_params
-from holofold.design.tables import ColumnRoles
-from holofold.design.targets import Target, parse_target
+from holofold.design.rules.targets import Target, parse_target
 
 __all__ = [
     "MinedRules",
@@ -110,7 +110,7 @@ class MinedRules:
     def dependence(self) -> pd.DataFrame:
         """Which features the target depends on, tested on the held-out rows.
 
-        :func:`holofold.design.evaluation.feature_dependence` of the fitted forest on the test
+        :func:`holofold.design.rules.evaluation.feature_dependence` of the fitted forest on the test
         split: one row per feature with ``importance``, ``p_value`` and ``depends``.
         """
         test = self.holdout.test_index
@@ -249,7 +249,7 @@ def mine_rules(
     target : str or Target
         Target expression over the table's columns, e.g. ``"Zstiff > 800 & error < 0.1"``.
     roles : ColumnRoles, optional
-        What the columns are (:func:`holofold.design.tables.column_roles`).
+        What the columns are (:func:`holofold.design.database.tables.column_roles`).
     features, categorical : sequence of str, optional
         See :func:`select_features`.
     test_size : float

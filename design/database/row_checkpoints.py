@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.row_status import row_statuses, status_columns
+from holofold.design.database.row_status import row_statuses, status_columns
 from holofold.geometry.outputs import atomic_write
 
 __all__ = ["CHECKPOINT_SECONDS", "RowCheckpoint", "move_damaged"]

@@ -1,4 +1,4 @@
-// The 3D view of a design in report.html (holofold.design.view): plain JavaScript, no library.
+// The 3D view of a design in report.html (holofold.design.report.view): plain JavaScript, no library.
 (function () {
   var root = document.getElementById(__ID__);
   var D = JSON.parse(root.querySelector("script[type='application/json']").textContent);

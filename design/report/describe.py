@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from holofold.design.row_status import failed_rows
+from holofold.design.database.row_status import failed_rows
 
 __all__ = ["Distribution", "distributions", "distributions_text", "QUANTILES", "PILOT"]
 
@@ -139,9 +139,9 @@ def describe_source(
     from contextlib import nullcontext
     from pathlib import Path
 
-    from holofold.design.sampling import sample_designs
+    from holofold.design.database.sampling import sample_designs
+    from holofold.design.database.store import build_database, load_database
     from holofold.design.scenarios import Column, load_scenario
-    from holofold.design.store import build_database, load_database
 
     path = Path(str(source))
     if path.is_dir():

@@ -2,7 +2,7 @@
 
 ``holofold design --objective "min mass"`` picks, among the designs that meet the target, the
 lightest; ``"max Zstiff"`` the stiffest; the default ``"margin"`` the one with the largest
-worst-case margin to the target's thresholds (:meth:`~holofold.design.targets.Target.margin`).
+worst-case margin to the target's thresholds (:meth:`~holofold.design.rules.targets.Target.margin`).
 Any performance or feature column can be minimised or maximised.
 """
 

@@ -8,9 +8,9 @@ script) gets the same checked record. Its parts:
   performance, margins, whether it meets the target and can be built, and why it is there;
 * :class:`Timings`: seconds per stage of this invocation and summed over every invocation
   on the folder (a resumed run reports both);
-* the rounds (:class:`~holofold.design.rounds.Round`), the pilot's distributions
-  (:class:`~holofold.design.describe.Distribution`) and the part's fit on the printer's bed
-  (:class:`~holofold.design.buildability.PartFit`).
+* the rounds (:class:`~holofold.design.loop.rounds.Round`), the pilot's distributions
+  (:class:`~holofold.design.report.describe.Distribution`) and the part's fit on the printer's bed
+  (:class:`~holofold.design.loop.buildability.PartFit`).
 """
 
 from __future__ import annotations
@@ -19,9 +19,9 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from holofold.design.buildability import PartFit
-from holofold.design.describe import Distribution
-from holofold.design.rounds import Round, VerifiedRule
+from holofold.design.loop.buildability import PartFit
+from holofold.design.loop.rounds import Round, VerifiedRule
+from holofold.design.report.describe import Distribution
 
 __all__ = ["Pick", "Timings", "DesignSummary", "STAGES"]
 
@@ -201,7 +201,7 @@ class DesignSummary:
         condition (``overlap <= ...``) unless overlapping panels are allowed.
     allow_overlap : bool
     answer : str
-        ``rule``, ``designs``, ``nearest`` or ``none`` (:mod:`~holofold.design.choice`).
+        ``rule``, ``designs``, ``nearest`` or ``none`` (:mod:`~holofold.design.loop.choice`).
     headline : str
         The answer in a sentence or three, shown first.
     chosen : Pick or None
@@ -246,7 +246,7 @@ class DesignSummary:
     timings: Timings | None = None
 
     def __post_init__(self):
-        from holofold.design.choice import ANSWER_KINDS
+        from holofold.design.loop.choice import ANSWER_KINDS
 
         if not isinstance(self.scenario, Mapping) or "name" not in self.scenario:
             raise ValueError("the summary's scenario must be an object with a name")

@@ -22,9 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from holofold.design.database.row_limits import RowTimeout, call_with_limit
 from holofold.geometry import READERS, read_pattern, reader_for
-
-from .row_limits import RowTimeout, call_with_limit
 
 __all__ = [
     "pattern_files",

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from holofold.design.sampling import sample_designs
+from holofold.design.database.sampling import sample_designs
 
 __all__ = ["likely_designs", "CANDIDATES"]
 

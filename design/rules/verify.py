@@ -19,17 +19,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.batches import grow
-from holofold.design.rounds import Counts, wilson
-from holofold.design.row_limits import check_on_invalid, resolve_row_timeout
-from holofold.design.row_status import failed_rows
+from holofold.design.database.batches import grow
+from holofold.design.database.row_limits import check_on_invalid, resolve_row_timeout
+from holofold.design.database.row_status import failed_rows
+from holofold.design.database.runner import dask_scheduler
+from holofold.design.database.sampling import sample_designs
+from holofold.design.database.store import build_database
+from holofold.design.database.tables import write_table
+from holofold.design.loop.rounds import Counts, wilson
 from holofold.design.rules.record import Rule
-from holofold.design.runner import dask_scheduler
-from holofold.design.sampling import sample_designs
+from holofold.design.rules.targets import parse_target
 from holofold.design.scenarios import Scenario, load_scenario
-from holofold.design.store import build_database
-from holofold.design.tables import write_table
-from holofold.design.targets import parse_target
 from holofold.geometry.outputs import write_json
 
 __all__ = [
@@ -181,14 +181,16 @@ def verify_rule(
     row_timeout: float | str | None = None,
 ) -> Verification:
     """Simulate ``n`` fresh designs inside ``rule`` and count those meeting ``target`` (an
-    expression or a :class:`~holofold.design.targets.Target`).
+    expression or a :class:`~holofold.design.rules.targets.Target`).
 
     The designs are simulated into resumable databases in ``folder``, in batches
-    ``{a:06d}-{b:06d}`` (:mod:`~holofold.design.batches`): a second call resumes, and a larger
+    ``{a:06d}-{b:06d}`` (:mod:`~holofold.design.database.batches`): a second call resumes, and a
+    larger
     ``n`` adds a batch (design i depends on ``seed`` and i alone). Without ``folder`` a
     temporary one is used and removed. ``workers``, ``progress``, ``scheduler`` (a Dask
     scheduler address or ``"local"``), ``on_invalid`` and ``row_timeout`` are passed to
-    :func:`holofold.design.store.build_database`: with ``on_invalid="skip"`` fresh designs the
+    :func:`holofold.design.database.store.build_database`: with ``on_invalid="skip"`` fresh designs
+    the
     scenario's check refuses (a box reaching past a validity limit) are failed rows, as are
     rows past their time limit; failed rows count in ``n_failed`` and as designs that do not
     meet the target in the precision.

@@ -8,7 +8,8 @@ given its scheduler address) and returns the rows in the same order with the per
 and ``status``. A row whose simulation raises (or whose Dask worker dies) gets
 ``status = "failed: <reason>"`` and empty (NaN) outputs; the batch goes on.
 
-Per-row isolation (:mod:`~holofold.design.row_limits`): ``on_invalid="skip"`` records invalid
+Per-row isolation (:mod:`~holofold.design.database.row_limits`): ``on_invalid="skip"`` records
+invalid
 rows as ``failed: invalid design: <the problems>`` in their place and simulates the others
 (``"fail"``, the default, refuses the table); each row has a time limit (``row_timeout``, by
 default the scenario's) past which it is recorded as ``failed: timeout after ... s`` and the
@@ -30,15 +31,15 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from holofold.design.faults import as_environment_fault
-from holofold.design.row_limits import (
+from holofold.design.database.faults import as_environment_fault
+from holofold.design.database.row_limits import (
     RowTimeout,
     call_with_limit,
     check_on_invalid,
     resolve_row_timeout,
     timeout_reason,
 )
-from holofold.design.row_status import STATE_COLUMNS, status_columns
+from holofold.design.database.row_status import STATE_COLUMNS, status_columns
 from holofold.design.scenarios import Scenario, load_scenario
 from holofold.design.scenarios.base import check_row, single_thread
 from holofold.geometry.fault_points import fault_point

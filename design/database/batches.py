@@ -1,7 +1,7 @@
 """A database grown in batches: asking for more rows later adds a batch, never rebuilds one.
 
 A batched database is a folder of resumable databases
-(:func:`~holofold.design.store.build_database`)
+(:func:`~holofold.design.database.store.build_database`)
 named ``{prefix}{a:06d}-{b:06d}``, each holding rows ``a .. b-1`` of one reproducible sample
 (the sampler draws row i from the seed and i alone, so rows do not depend on how many are
 drawn). :func:`grow` simulates what is missing and returns the first ``n`` rows.

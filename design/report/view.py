@@ -165,7 +165,7 @@ def _script() -> str:
     """The viewer's JavaScript (``viewer.js`` beside this module, inlined into the page)."""
     from importlib.resources import files
 
-    return files("holofold.design").joinpath("viewer.js").read_text(encoding="utf-8")
+    return files("holofold.design.report").joinpath("viewer.js").read_text(encoding="utf-8")
 
 
 def view_html(view: Mapping | DesignView, element_id: str = "design-view") -> str:

@@ -1,5 +1,5 @@
 """What the design loop is asked, how it searches, how it runs and what it writes: four frozen,
-validated records passed whole to :func:`~holofold.design.loop.run_design`.
+validated records passed whole to :func:`~holofold.design.loop.design_loop.run_design`.
 
 - :class:`DesignProblem`: the scenario, the target, the objective, the printer's bed and
   whether a design whose thick panels overlap may be chosen (what the user asks);
@@ -21,15 +21,15 @@ import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, fields, replace
 
-from holofold.design.buildability import DEFAULT_BED, Bed, parse_bed
-from holofold.design.describe import PILOT
-from holofold.design.objective import Objective, parse_objective
-from holofold.design.row_limits import resolve_row_timeout
-from holofold.design.runner import check_scheduler, check_workers
-from holofold.design.sampling import MAX_SAMPLES
+from holofold.design.database.row_limits import resolve_row_timeout
+from holofold.design.database.runner import check_scheduler, check_workers
+from holofold.design.database.sampling import MAX_SAMPLES
+from holofold.design.loop.buildability import DEFAULT_BED, Bed, parse_bed
+from holofold.design.loop.objective import Objective, parse_objective
+from holofold.design.loop.strategies import STRATEGIES
+from holofold.design.report.describe import PILOT
+from holofold.design.rules.targets import Target, parse_target
 from holofold.design.scenarios import Scenario, load_scenario
-from holofold.design.strategies import STRATEGIES
-from holofold.design.targets import Target, parse_target
 from holofold.geometry.units import length_factor
 
 __all__ = ["DesignProblem", "LoopSettings", "Execution", "DesignFiles", "split_options", "made"]

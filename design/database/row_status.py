@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from holofold.design.faults import stored_fault
+from holofold.design.database.faults import stored_fault
 from holofold.mechanics.status import Outcome, Status
 
 __all__ = [

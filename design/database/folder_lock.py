@@ -1,7 +1,8 @@
 """One writer per output folder: an OS file lock held for the whole run.
 
-Every database folder (:func:`~holofold.design.store.build_database`) and design folder
-(:func:`~holofold.design.loop.run_design`) is locked while a run writes into it: the lock file
+Every database folder (:func:`~holofold.design.database.store.build_database`) and design folder
+(:func:`~holofold.design.loop.design_loop.run_design`) is locked while a run writes into it: the
+lock file
 ``.holofold.lock`` in the folder is locked with the operating system's advisory lock
 (``flock`` on POSIX, ``msvcrt.locking`` on Windows), which the OS releases when the process
 ends, however it ends (Ctrl-C, ``kill -9``, a crash), so a lock is never stale. The file also

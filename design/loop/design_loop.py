@@ -12,7 +12,7 @@
    designs, half where the last round's forest votes for the target and half inside its best
    rule (or by the other strategies), add them (and the verification designs) to the database,
    re-mine and re-verify;
-5. **choose** (:mod:`~holofold.design.choice`): from every simulated design, the best under the
+5. **choose** (:mod:`~holofold.design.loop.choice`): from every simulated design, the best under the
    designer's objective inside the best verified rule of all rounds; without a qualifying rule
    the best design meeting the target; without one, the nearest, with its shortfall. A design
    whose thick panels overlap is not chosen unless ``allow_overlap``. Always an answer;
@@ -44,20 +44,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from holofold.design.batches import grow
-from holofold.design.buildability import Bed, part_fit
-from holofold.design.choice import Answer, Candidate, choose
-from holofold.design.describe import distributions
-from holofold.design.folder_lock import folder_lock
-from holofold.design.mining import OneClassSplit, mine_rules
-from holofold.design.objective import Objective, parse_objective
-from holofold.design.rounds import RULE_BAR, Round, VerifiedRule
-from holofold.design.row_status import converged_rows, failed_rows
-from holofold.design.rulefile import mined_rules, write_rules
-from holofold.design.rules import Condition, FewRulesWarning, Rule
-from holofold.design.sampling import sample_designs
-from holofold.design.scenarios import Scenario
-from holofold.design.settings import (
+from holofold.design.database.batches import grow
+from holofold.design.database.folder_lock import folder_lock
+from holofold.design.database.row_status import converged_rows, failed_rows
+from holofold.design.database.sampling import sample_designs
+from holofold.design.database.store import build_database, load_database
+from holofold.design.database.tables import ColumnRoles, write_table
+from holofold.design.loop.buildability import Bed, part_fit
+from holofold.design.loop.choice import Answer, Candidate, choose
+from holofold.design.loop.objective import Objective, parse_objective
+from holofold.design.loop.rounds import RULE_BAR, Round, VerifiedRule
+from holofold.design.loop.settings import (
     DesignFiles,
     DesignProblem,
     Execution,
@@ -65,18 +62,21 @@ from holofold.design.settings import (
     made,
     split_options,
 )
-from holofold.design.store import build_database, load_database
-from holofold.design.strategies import (
+from holofold.design.loop.strategies import (
     STRATEGIES,
     RefineRequest,
     around_hits,
     at_random,
     refine_designs,
 )
-from holofold.design.summary import STAGES, DesignSummary, Pick, Timings
-from holofold.design.tables import ColumnRoles, write_table
-from holofold.design.targets import parse_target
-from holofold.design.verify import as_rule, rule_key, verify_rule
+from holofold.design.loop.summary import STAGES, DesignSummary, Pick, Timings
+from holofold.design.report.describe import distributions
+from holofold.design.rules import Condition, FewRulesWarning, Rule
+from holofold.design.rules.mining import OneClassSplit, mine_rules
+from holofold.design.rules.rulefile import mined_rules, write_rules
+from holofold.design.rules.targets import parse_target
+from holofold.design.rules.verify import as_rule, rule_key, verify_rule
+from holofold.design.scenarios import Scenario
 from holofold.geometry.outputs import write_json
 
 __all__ = [
@@ -146,7 +146,7 @@ def choose_design(
     Returns (index label or None, per-condition margins of that row, how it was chosen).
     Converged rows are preferred; without one inside the box, every row meeting the target
     is considered (and the returned text says so). The loop itself chooses with
-    :func:`holofold.design.choice.choose`, which also weighs the rules of every round and
+    :func:`holofold.design.loop.choice.choose`, which also weighs the rules of every round and
     whether the design can be built.
     """
     obj = objective or parse_objective(None, ())
@@ -263,7 +263,7 @@ def _buildable_target(sc: Scenario, tgt, table: pd.DataFrame, say=lambda text: N
     (a column of NaN, as a pattern scenario without collisions gives, says nothing). When no
     design of ``table`` is buildable, the target alone (rules for a box nothing in the table
     shows to exist would only be looked for at random), said through ``say``."""
-    from holofold.design.choice import OVERLAP_TOLERANCE
+    from holofold.design.loop.choice import OVERLAP_TOLERANCE
 
     ok = table.loc[~failed_rows(table)]
     ov = ok["overlap"].to_numpy(dtype=float)
@@ -281,7 +281,7 @@ def _buildable_target(sc: Scenario, tgt, table: pd.DataFrame, say=lambda text: N
 
 def _stored_rows(folder: Path, prefix: str, covered: int) -> int:
     """Rows already simulated in the batches ``{prefix}a-b`` that continue from ``covered``."""
-    from holofold.design.batches import batch_spans
+    from holofold.design.database.batches import batch_spans
 
     spans = batch_spans(folder, 10**9, prefix, covered)[:-1]  # the last span is the missing one
     done = [
@@ -783,7 +783,7 @@ class DesignLoop:
         write_json(out / "design.json", summary.to_json())
         ledger.append(st.times)
         if self.output.files:
-            from holofold.design.report_page import write_report_page
+            from holofold.design.report.page import write_report_page
 
             write_report_page(out, summary)
         _check_own_summary(out, summary.to_json())
@@ -992,7 +992,7 @@ def _write_files(
 ) -> dict:
     """The chosen design's files, pictures, 3D view and fit on the bed: the summary's
     ``files``, ``images``, ``fabrication`` and ``extras``."""
-    from holofold.design.report import (
+    from holofold.design.rules.report import (
         plot_folded_design,
         plot_rule_boxes,
         plot_target_scatter,

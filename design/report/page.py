@@ -1,7 +1,7 @@
 """The self-contained HTML report of ``holofold design``: one page, the answer first.
 
 :func:`write_report_page` turns the design summary (a
-:class:`~holofold.design.summary.DesignSummary`, or what ``design.json`` holds, validated by
+:class:`~holofold.design.loop.summary.DesignSummary`, or what ``design.json`` holds, validated by
 it) into ``report.html``. The first screen is the answer: how the design was found, stated
 honestly (a verified rule, the best simulated design, or the nearest one and what it misses),
 each target condition with the chosen design's value, margin and met/missed, the part to print
@@ -27,10 +27,10 @@ from collections.abc import Mapping
 from pathlib import Path
 from urllib.parse import quote
 
+from holofold.design.loop.summary import DesignSummary, Pick
+from holofold.design.report.view import view_css, view_html
+from holofold.design.rules.targets import TargetError, parse_target
 from holofold.design.scenarios import Column, format_value
-from holofold.design.summary import DesignSummary, Pick
-from holofold.design.targets import TargetError, parse_target
-from holofold.design.view import view_css, view_html
 from holofold.geometry.outputs import check_output_path, write_text
 
 __all__ = ["write_report_page", "report_page_html"]
@@ -577,7 +577,7 @@ def _reach(summary: DesignSummary, cols: Mapping) -> str:
             )
         out.append(f"<p>{line}</p>")
     if summary.distributions:
-        from holofold.design.describe import QUANTILES
+        from holofold.design.report.describe import QUANTILES
 
         head = ["column", "unit", "designs"] + [
             "min" if q == 0 else "max" if q == 1 else f"{round(100 * q)}\u00a0%" for q in QUANTILES

@@ -6,7 +6,7 @@ stated honestly:
 
 ``rule``
     the best verified rule over all rounds (highest verified precision, then its interval's
-    lower bound) among those verified at :data:`~holofold.design.rounds.RULE_QUALIFIES` or
+    lower bound) among those verified at :data:`~holofold.design.loop.rounds.RULE_QUALIFIES` or
     more that hold a simulated design meeting the target; the chosen design is the best such
     design inside it under the objective;
 ``designs``
@@ -31,9 +31,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from holofold.design.objective import Objective
-from holofold.design.rounds import RULE_BAR, RULE_QUALIFIES, VerifiedRule
-from holofold.design.row_status import converged_rows, failed_rows
+from holofold.design.database.row_status import converged_rows, failed_rows
+from holofold.design.loop.objective import Objective
+from holofold.design.loop.rounds import RULE_BAR, RULE_QUALIFIES, VerifiedRule
 
 __all__ = ["Candidate", "Answer", "choose", "OVERLAP_TOLERANCE", "ANSWER_KINDS"]
 

@@ -1,4 +1,4 @@
-"""Output of mined rules: text, DataFrame and figures (JSON: :mod:`holofold.design.rulefile`).
+"""Output of mined rules: text, DataFrame and figures (JSON: :mod:`holofold.design.rules.rulefile`).
 
 Figures follow the paper: a box chart per rule (each feature's full range as a bar, the rule's
 range shaded; Fig. 2F), a scatter of two features with the rows inside the rule marked against
@@ -15,10 +15,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from holofold.design.rulefile import mined_rules
 from holofold.design.rules import ForestRuleMiner, level_value
+from holofold.design.rules.rulefile import mined_rules
+from holofold.design.rules.targets import Target, parse_target
 from holofold.design.scenarios.base import format_value
-from holofold.design.targets import Target, parse_target
 from holofold.geometry.outputs import atomic_write
 
 __all__ = [
@@ -101,7 +101,7 @@ def rules_to_text(
 def mining_summary(mined, source: str, columns: Mapping | None = None) -> str:
     """What ``holofold mine`` prints: the table, target, features, split and the rules.
 
-    ``mined``: a :class:`~holofold.design.mining.MinedRules`; ``source``: the table's name;
+    ``mined``: a :class:`~holofold.design.rules.mining.MinedRules`; ``source``: the table's name;
     ``columns``: name -> Column for display units (:func:`rules_to_text`).
     """
     m, h = mined.miner, mined.holdout
