@@ -8,7 +8,7 @@ the environment variable ``HOLOFOLD_KERNELS``:
 
 ``auto`` (default)
     compiled where its machine code is ready in the kernel cache; otherwise numpy, while one
-    background process (``python -m holofold.mechanics.kernels compile``, niced) compiles the
+    background process (``python -m holofold.mechanics.kernel_compile``, niced) compiles the
     kernels into the cache, and every process switches to them once they are ready. So a fresh
     environment's first result is not held up by compilation (about 30 s of numba work), and a
     machine without numba, or where it fails to compile, runs on numpy (one warning says why).
@@ -53,7 +53,6 @@ __all__ = [
     "requested",
     "kernel_path",
     "cache_folder",
-    "compile_kernels",
     "check_environment",
 ]
 
@@ -305,7 +304,7 @@ def _start_background_compile() -> None:
     try:
         env = dict(os.environ, **{ENV: "compiled", "HOLOFOLD_KERNEL_CACHE": str(folder.parent)})
         log = open(folder / "compile.log", "ab")  # noqa: SIM115 - the child owns it
-        cmd = [sys.executable, "-m", "holofold.mechanics.kernels", "compile", "--marker"]
+        cmd = [sys.executable, "-m", "holofold.mechanics.kernel_compile", "compile", "--marker"]
         nice = shutil.which("nice")
         if nice:  # the compiler yields the cores to the work it is compiling for
             cmd = [nice, "-n", "10", *cmd]
@@ -334,35 +333,6 @@ def _stale(lock: Path) -> bool:
     return False
 
 
-def compile_kernels(*, marker: bool = False) -> float:
-    """Compile (or load) every specialisation of the compiled kernels that holofold calls, by
-    running small models through each assembly and solver path; returns the seconds it took.
-    With ``marker``, records in the cache folder that they are ready (or why they failed)."""
-    t0 = time.perf_counter()
-    _require_numba()
-    try:
-        from holofold.mechanics._warmup import run_warmup
-
-        os.environ[ENV] = "compiled"
-        run_warmup()
-    except BaseException as exc:
-        if marker:
-            _failed_marker().write_text(f"{type(exc).__name__}: {exc}\n")
-            (cache_folder() / "compiling").unlink(missing_ok=True)
-        if isinstance(exc, Exception) and not isinstance(exc, EnvironmentFault):
-            raise EnvironmentFault(
-                f"the compiled kernels failed to compile ({type(exc).__name__}: {exc}); "
-                f"set {ENV}=numpy to run on the numpy kernels"
-            ) from exc
-        raise
-    if marker:
-        tmp = cache_folder() / f".ready-{os.getpid()}"
-        tmp.write_text(f"{time.perf_counter() - t0:.1f} s\n")
-        tmp.replace(_ready_marker())
-        (cache_folder() / "compiling").unlink(missing_ok=True)
-    return time.perf_counter() - t0
-
-
 def check_environment() -> KernelPath:
     """The kernel path a run will use, checked before any work: the requested path loads and
     scipy's LAPACK answers. Raises :class:`EnvironmentFault` with the cause and the fix.
@@ -382,25 +352,3 @@ def check_environment() -> KernelPath:
     if requested() == "auto" and _AUTO.settled:
         os.environ[ENV] = "numpy"
     return path
-
-
-def _main(argv: list[str]) -> int:
-    import argparse
-
-    parser = argparse.ArgumentParser(
-        prog="python -m holofold.mechanics.kernels",
-        description="Show or compile holofold's kernel paths.",
-    )
-    parser.add_argument("action", choices=["status", "compile"], nargs="?", default="status")
-    parser.add_argument("--marker", action="store_true", help=argparse.SUPPRESS)
-    args = parser.parse_args(argv)
-    if args.action == "compile":
-        seconds = compile_kernels(marker=args.marker)
-        print(f"compiled kernels ready in {cache_folder()} ({seconds:.1f} s)")  # noqa: T201
-        return 0
-    print(f"{ENV}={requested()}; active path: {active().name}; cache: {cache_folder()}")  # noqa: T201
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(_main(sys.argv[1:]))

@@ -62,9 +62,10 @@ def pytest_configure(config):
     if os.environ.get("HOLOFOLD_KERNELS") or hasattr(config, "workerinput"):
         return
     from holofold.mechanics import kernels
+    from holofold.mechanics.kernel_compile import compile_kernels
 
     try:
-        kernels.compile_kernels(marker=True)
+        compile_kernels(marker=True)
         os.environ["HOLOFOLD_KERNELS"] = "compiled"
     except kernels.EnvironmentFault as exc:
         os.environ["HOLOFOLD_KERNELS"] = "numpy"

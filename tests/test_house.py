@@ -19,26 +19,7 @@ LAYERS = {"geometry": "holofold.geometry", "fitting": "holofold.fitting",
           "holofold": "holofold"}  # fmt: skip
 
 #: the circles still there (docs/architecture.md says why), to be broken, never to grow
-LEFT = [
-    {
-        "holofold.mechanics." + m
-        for m in (
-            "_warmup",
-            "assembly",
-            "kernels",
-            "linear",  # joined with the plain install's supernodal Cholesky (merge of h37):
-            "supernodal",  # linear asks kernels whether the compiled path is active
-            "newton_step",
-            "solvers",
-            "solvers._common",
-            "solvers.displacement",
-            "solvers.mgdcm",
-            "solvers.newton",
-            "solvers.selffold",
-            "thermal",
-        )
-    },
-]
+LEFT: list[set[str]] = []
 
 
 def _modules() -> dict[str, Path]:
@@ -55,6 +36,16 @@ def _is_package(path: Path) -> bool:
     return path.name == "__init__.py"
 
 
+def _type_checking_imports(tree: ast.AST) -> list[ast.AST]:
+    """The import statements under ``if TYPE_CHECKING:`` (they never run)."""
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            out += [n for b in node.body for n in ast.walk(b)
+                    if isinstance(n, ast.Import | ast.ImportFrom)]  # fmt: skip
+    return out
+
+
 def _graph() -> nx.DiGraph:
     """module -> module it imports (any import statement, wherever it stands; names
     imported from a package that are its modules count as those modules)."""
@@ -62,7 +53,11 @@ def _graph() -> nx.DiGraph:
     g = nx.DiGraph()
     for name, path in mods.items():
         pkg = name if _is_package(path) else name.rpartition(".")[0]
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        typing_only = {id(n) for n in _type_checking_imports(tree)}
+        for node in ast.walk(tree):
+            if id(node) in typing_only:  # never runs: names for the annotations only
+                continue
             if isinstance(node, ast.Import):
                 targets = [a.name for a in node.names]
             elif isinstance(node, ast.ImportFrom):

@@ -1,13 +1,35 @@
-"""Small models through every assembly and solver path, so that the compiled path compiles (or
-loads) every specialisation holofold calls before a real run needs it
-(:func:`holofold.mechanics.kernels.compile_kernels`; tests/test_kernel_paths.py checks that a
-warm cache serves the scenarios without compiling)."""
+"""Compiling the compiled kernel path ahead: small models through every assembly and solver
+path, so that numba compiles (or loads) every specialisation holofold calls before a real run
+needs it (tests/test_kernel_paths.py checks that a warm cache serves the scenarios without
+compiling).
+
+:func:`compile_kernels` is what the background compile of ``HOLOFOLD_KERNELS=auto`` runs
+(:mod:`holofold.mechanics.kernels`), and what ``python -m holofold.mechanics.kernel_compile``
+does (``status``: the kernel path in use and the cache folder; ``compile``: compile now). This
+module sits above the kernel selector: it imports the models and solvers it exercises, none of
+them imports it.
+"""
 
 from __future__ import annotations
 
+import os
+import sys
+import time
+
 import numpy as np
 
-__all__ = ["run_warmup"]
+from holofold.geometry.errors import EnvironmentFault
+from holofold.mechanics.kernels import (
+    ENV,
+    _failed_marker,
+    _ready_marker,
+    _require_numba,
+    active,
+    cache_folder,
+    requested,
+)
+
+__all__ = ["run_warmup", "compile_kernels"]
 
 
 def _sheet(m: int, n: int, *, compliant: bool = False):
@@ -104,3 +126,52 @@ def run_warmup() -> None:
     _exercise([_sheet(2, 2, compliant=True)] * 2)
     _thermal()
     _supernodal()
+
+
+def compile_kernels(*, marker: bool = False) -> float:
+    """Compile (or load) every specialisation of the compiled kernels that holofold calls, by
+    running small models through each assembly and solver path; returns the seconds it took.
+    With ``marker``, records in the cache folder that they are ready (or why they failed)."""
+    t0 = time.perf_counter()
+    _require_numba()
+    try:
+        os.environ[ENV] = "compiled"
+        run_warmup()
+    except BaseException as exc:
+        if marker:
+            _failed_marker().write_text(f"{type(exc).__name__}: {exc}\n")
+            (cache_folder() / "compiling").unlink(missing_ok=True)
+        if isinstance(exc, Exception) and not isinstance(exc, EnvironmentFault):
+            raise EnvironmentFault(
+                f"the compiled kernels failed to compile ({type(exc).__name__}: {exc}); "
+                f"set {ENV}=numpy to run on the numpy kernels"
+            ) from exc
+        raise
+    if marker:
+        tmp = cache_folder() / f".ready-{os.getpid()}"
+        tmp.write_text(f"{time.perf_counter() - t0:.1f} s\n")
+        tmp.replace(_ready_marker())
+        (cache_folder() / "compiling").unlink(missing_ok=True)
+    return time.perf_counter() - t0
+
+
+def _main(argv: list[str]) -> int:
+    import argparse
+
+    parser = argparse.ArgumentParser(
+        prog="python -m holofold.mechanics.kernel_compile",
+        description="Show or compile holofold's kernel paths.",
+    )
+    parser.add_argument("action", choices=["status", "compile"], nargs="?", default="status")
+    parser.add_argument("--marker", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.action == "compile":
+        seconds = compile_kernels(marker=args.marker)
+        print(f"compiled kernels ready in {cache_folder()} ({seconds:.1f} s)")  # noqa: T201
+        return 0
+    print(f"{ENV}={requested()}; active path: {active().name}; cache: {cache_folder()}")  # noqa: T201
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_main(sys.argv[1:]))
