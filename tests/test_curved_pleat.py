@@ -173,6 +173,19 @@ def test_family_in_a_scenario_file(tmp_path):
     area2 = 0.5 * math.pi / 2 * (0.175**2 - 0.1**2) * math.sin(math.pi / 16) / (math.pi / 16)
     assert wider == pytest.approx(1270.0 * 3e-4 * area2, rel=1e-9)
     assert sc.check({**row, "fold_angle": math.radians(200)})  # outside the family's range
+    assert not sc.check(row)
+    import pickle
+
+    assert pickle.loads(pickle.dumps(sc)).evaluate(row)["tipstiff"] == out["tipstiff"]
+
+
+def test_example_scenario_reads():
+    from holofold.design import read_scenario
+
+    sc = read_scenario(ROOT / "examples" / "curved_pleat.toml")
+    assert sc.feature_names[-2:] == ["pleat_width", "fold_angle"]
+    fw = {c.name: c for c in sc.features}["fold_angle"]
+    assert (fw.low, fw.high, fw.unit) == (0.5, 1.2, "rad")
 
 
 def test_misspelled_family_parameter_refused_in_one_line(tmp_path):
