@@ -42,7 +42,7 @@ __all__ = [
     "PIECE_ANGLE",
 ]
 
-#: the default arc piece, rad: the coarsest mesh within 2 % of the converged shape (0.34 % of
+#: the default arc piece, rad: the coarsest mesh within 2 % of the converged shape (0.48 % of
 #: the sheet's size at 8 pieces over 90 deg, docs/curved-creases.md "Convergence")
 PIECE_ANGLE = math.radians(11.25)
 

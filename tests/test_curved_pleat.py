@@ -114,6 +114,9 @@ def test_shape_between_two_moderate_levels(sector_levels):
     assert fine["shape_pct"] == 0.0 or fine["shape_pct"] < 1e-9
     # the fold's energy falls towards the converged one as the mesh refines
     assert 0 < fine["energy"] < coarse["energy"]
+    # the opening stiffness (a force pair at the two ends): measured 84.6 and 89.9 N/m
+    assert coarse["opening"] == pytest.approx(fine["opening"], rel=0.1)
+    assert 50 < fine["opening"] < 150
 
 
 SCENARIO = """

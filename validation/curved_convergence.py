@@ -16,16 +16,19 @@ points in every level. Measured per level:
 * ``shape``: the largest distance of those points from the finest level's, after the best
   rigid alignment (Kabsch; the default support, the panel nearest the centre, differs between
   meshes), in % of the sheet's size (the flat layout's larger side);
-* ``energy``: the elastic energy at the full fold (J), the stiffness measure;
-* the analytic check along every crease (Fuchs & Tabachnikov, "Mathematical Omnibus" lecture
-  15; Duncan & Duncan 1982): in a fold of a curved crease, the crease's curvature in the flat
-  sheet ``kappa_g = 1 / rho`` equals its 3-D curvature ``kappa`` times ``cos(alpha)``,
-  ``alpha`` the angle between the crease's osculating plane and the tangent plane of the
-  surface on either side. ``kappa`` from the circle through three consecutive crease vertices
-  (binormal ``b`` from the same three), the tangent plane of a side spanned by the crease's
-  tangent and the radial ruling from the vertex to the next ring; ``cos(alpha) = |b . n|``.
-  Reported: the largest relative error ``|kappa cos(alpha) - 1/rho| rho`` over the middle half
-  of every crease (:func:`curvature_error`: the stencil and the sides' mean).
+* ``energy``: the elastic energy at the full fold (J);
+* ``opening``: the opening stiffness of the folded sector (N/m, :func:`opening_stiffness`: a
+  force pair at its two straight ends, linear from the folded state);
+* the analytic check along every crease (Fuchs & Tabachnikov, "More on paperfolding", Amer.
+  Math. Monthly 106, 1999; Duncan & Duncan, "Folded developables", Proc. R. Soc. A 383,
+  1982): in a fold of a curved crease, the crease's curvature in the flat sheet
+  ``kappa_g = 1 / rho`` equals its 3-D curvature ``kappa`` times ``cos(alpha)``, ``alpha`` the
+  angle between the crease's osculating plane and the tangent plane of the surface on either
+  side. ``kappa`` and the binormal ``b`` from the circle through three crease vertices
+  ``sector / 16`` apart, the tangent plane of a side spanned by the crease's tangent and the
+  radial ruling from the vertex to the next ring, ``cos(alpha) = |b . n|`` (the mean of the two
+  sides). Reported: the largest relative error ``|kappa cos(alpha) - 1/rho| rho`` over the
+  middle half of every crease (:func:`curvature_error`).
 
 The observed order between levels ``a`` and ``b`` is ``log2(e_a / e_b) / log2(h_a / h_b)``
 (``h`` the arc piece). Run::
@@ -61,7 +64,8 @@ LEVELS = ((8, 1), (16, 1), (32, 2), (64, 4))
 @dataclass(frozen=True)
 class Level:
     """One folded level: its geometry, folded coordinates (nv, 3), energy (J), seconds, the
-    fraction reached, the verdict, and the largest relative error of the curvature relation."""
+    fraction reached, the verdict, the largest relative error of the curvature relation and
+    the opening stiffness (N/m)."""
 
     geometry: CurvedPleat
     coords: np.ndarray
@@ -70,6 +74,7 @@ class Level:
     reached: float
     verdict: str
     curvature_error: float
+    opening: float
 
 
 def fold_level(case: str, pieces: int, across: int, time_limit: float | None = None) -> Level:
@@ -84,7 +89,32 @@ def fold_level(case: str, pieces: int, across: int, time_limit: float | None = N
     dt = time.perf_counter() - t0
     x = res.coords[-1]
     return Level(g, x, float(res.energy.total), dt, res.reached, res.verdict,
-                 curvature_error(g, x))  # fmt: skip
+                 curvature_error(g, x), opening_stiffness(g, res))  # fmt: skip
+
+
+def opening_stiffness(g: CurvedPleat, res) -> float:
+    """The folded sector's opening stiffness, N/m: a force pair (1 N each way, shared equally
+    by the vertices of each straight end) along the line between the two ends' centroids,
+    over the change of their distance, from the tangent at the folded state (linear; the
+    fold's supports, the panel nearest the centre, take no load from a balanced pair)."""
+    from holofold.mechanics.assembly import Assembler
+
+    st = res.structure
+    asm = Assembler(st)
+    _, _, solve = asm.evaluate_factorized(res.U[-1], res.rest)
+    rings = np.arange(len(g.radii))
+    a, b = st.vertex_nodes(g.vertex(rings, 0)), st.vertex_nodes(g.vertex(rings, g.pieces))
+    x = res.coords[-1]
+    d = x[g.vertex(rings, g.pieces)].mean(axis=0) - x[g.vertex(rings, 0)].mean(axis=0)
+    d /= np.linalg.norm(d)
+    f = np.zeros((st.n_nodes, 3))
+    f[a] -= d / len(a)
+    f[b] += d / len(b)
+    free = asm.free_dofs
+    u = np.zeros(3 * st.n_nodes)
+    u[free] = solve(f.ravel()[free])
+    u = u.reshape(-1, 3)
+    return float(1.0 / ((u[b].mean(axis=0) - u[a].mean(axis=0)) @ d))
 
 
 def curvature_error(g: CurvedPleat, x: np.ndarray, span: int = 16) -> float:
@@ -155,7 +185,8 @@ def study(case: str, levels=LEVELS, time_limit: float | None = None, say=print) 
             dict(case=case, pieces=lv.geometry.pieces, across=lv.geometry.across,
                  panels=2 * lv.geometry.pieces * (lv.geometry.creases + 1) * lv.geometry.across,
                  shape_pct=100.0 * float(d.max()) / size, energy=lv.energy,
-                 energy_pct=100.0 * abs(lv.energy / fine.energy - 1.0),
+                 energy_pct=100.0 * abs(lv.energy / fine.energy - 1.0), opening=lv.opening,
+                 opening_pct=100.0 * abs(lv.opening / fine.opening - 1.0),
                  curvature=lv.curvature_error, reached=lv.reached, verdict=lv.verdict,
                  seconds=lv.seconds)
         )  # fmt: skip
@@ -177,13 +208,15 @@ def table(rows: list[dict]) -> str:
     """A markdown table of :func:`study` rows."""
     lines = [
         "| case | pieces:across | panels | shape (% of size) | energy (mJ) | energy (%) "
-        "| curvature relation (rel.) | reached | verdict | fold (s) |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| opening (N/m) | opening (%) | curvature relation (rel.) | reached | verdict "
+        "| fold (s) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
             f"| {r['case']} | {r['pieces']}:{r['across']} | {r['panels']} | "
             f"{r['shape_pct']:.3g} | {1e3 * r['energy']:.4g} | {r['energy_pct']:.3g} | "
+            f"{r['opening']:.4g} | {r['opening_pct']:.3g} | "
             f"{r['curvature']:.2e} | {100 * r['reached']:.0f} % | {r['verdict']} | "
             f"{r['seconds']:.1f} |"
         )
@@ -201,7 +234,8 @@ def main(argv=None) -> None:
         rows = study(case, levels, args.time_limit)
         print(table(rows))
         print(f"observed order, shape: {[round(v, 2) for v in orders(rows, 'shape_pct')]}; "
-              f"energy: {[round(v, 2) for v in orders(rows, 'energy_pct')]}")  # fmt: skip
+              f"energy: {[round(v, 2) for v in orders(rows, 'energy_pct')]}; "
+              f"opening: {[round(v, 2) for v in orders(rows, 'opening_pct')]}")  # fmt: skip
         print()
 
 
