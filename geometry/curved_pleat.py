@@ -20,7 +20,7 @@ assignments (FOLD):
 
 :func:`facet_widths` gives each edge the length ``w`` of its bending spring ``k = E t^3 L /
 (12 w)`` (:func:`holofold.mechanics.fold_pattern`'s ``crease_width``, facets taking the panel
-thickness) so that the hinges add up to the plate's bending energy whatever the mesh.
+thickness) so that the hinges add up to the plate's bending energy as the mesh refines.
 Lengths in metres, angles in radians (fold angles in degrees in the pattern, FOLD's sign).
 """
 
@@ -211,9 +211,9 @@ def facet_widths(pattern: CreasePattern, crease_width: float) -> np.ndarray:
     """(ne,) the length ``w`` of every edge's bending spring ``k = E t^3 L / (12 w)``, m.
 
     ``M``/``V``: ``crease_width``. ``F`` (a radial line between radii ``ra < rb``, its
-    neighbours ``dphi`` away): ``L dphi / ln(rb / ra)``, so that ``k = D/dphi ln(rb/ra)`` is
-    the integral of the plate's ``D dr / (r dphi)`` along it and the hinges' energy
-    ``k theta^2 / 2`` sums to the plate's ``D kappa^2 / 2`` over the area. ``J`` (joins):
+    neighbours ``dphi`` away): ``L dphi / ln(rb / ra)``, so that ``k`` is the integral of the
+    plate's ``D dr / (r dphi)`` along it (``D = E t^3 / 12``, as the model's springs) and the
+    hinges' ``k theta^2 / 2`` tends to the plate's ``D kappa^2 / 2`` over the area. ``J`` (joins):
     the shorter of the quad's two sides meeting there (ring spacing, arc piece), the plate's
     own length scale. Borders: ``crease_width`` (no spring).
     """
