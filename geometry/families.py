@@ -8,7 +8,8 @@ shared by a whole class of designs (the sheets) also give ``faces(values)`` and
 ``nodes(values)`` so that models of many designs reuse one topology.
 
 Built in: ``miura`` and ``tmp`` (sheets), ``gripper`` (the paper's three grippers), ``file``
-(any crease-pattern file, :func:`~holofold.geometry.readers.read_pattern`). Other layers and
+(any crease-pattern file, :func:`~holofold.geometry.readers.read_pattern`), ``curved-pleat``
+(:mod:`~holofold.geometry.curved_pleat`). Other layers and
 packages add families through the entry-point group :data:`ENTRY_POINT_GROUP`
 (``holofold.pattern_families``; holofold's own ``strip``, the Miura strip over a curve, lives in
 the fitting layer and comes this way) or :func:`register_family`. ``holofold pattern`` offers
@@ -277,6 +278,36 @@ _BUILTIN = (
 )  # fmt: skip
 
 
+def _curved_pleat_build(v: dict, label) -> CreasePattern:
+    from holofold.geometry.curved_pleat import build_family
+
+    return build_family(v, label)
+
+
+def _curved_pleat_describe(v: dict) -> str:
+    from holofold.geometry.curved_pleat import describe
+
+    return describe(v)
+
+
+_CURVED_PLEAT = PatternFamily(
+    "curved-pleat",
+    "concentric circular creases on an annulus sector, meshed along the radial rulings",
+    (Parameter("inner_radius", "m", "radius of the inner rim (0.1)", low=0.0, open_low=True),
+     Parameter("pleat_width", "m", "distance between creases (0.02)", low=0.0, open_low=True),
+     Parameter("creases", "-", "number of circular creases, valley first (3)", low=1,
+               integer=True),
+     Parameter("sector", "rad", "sector angle (90 deg)", "deg", 0.0, 360.0, open_low=True,
+               open_high=True),
+     Parameter("fold_angle", "rad", "fold angle of every crease (60 deg)", "deg", 0.0, 179.0),
+     Parameter("pieces", "-", "pieces of every arc (one per 11.25 deg of sector)", low=2,
+               integer=True),
+     Parameter("across", "-", "rings of quads across each pleat (1)", low=1, integer=True)),
+    _curved_pleat_build, {"fixed": "side:-y"},
+    describe=_curved_pleat_describe,
+)  # fmt: skip
+
+
 def _check_family(name, fam) -> PatternFamily:
     if not isinstance(fam, PatternFamily):
         raise TypeError(f"expected a PatternFamily, got {type(fam).__name__}")
@@ -287,7 +318,7 @@ def _check_family(name, fam) -> PatternFamily:
 #: entry-point group :data:`ENTRY_POINT_GROUP`)
 FAMILIES: Registry[PatternFamily] = Registry(
     "pattern family",
-    {f.name: f for f in _BUILTIN},
+    {f.name: f for f in (*_BUILTIN, _CURVED_PLEAT)},
     group=ENTRY_POINT_GROUP,
     check=_check_family,
     error=ParameterError,

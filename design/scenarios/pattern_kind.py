@@ -100,6 +100,13 @@ class PatternScenarioSetting:
         Newton controls of the loads.
     collisions : bool
         Compute overlap and clearance (the folded thick panels).
+    family : str
+        A pattern family (:func:`holofold.geometry.get_family`) that makes every row's pattern
+        instead of ``pattern`` ("": the pattern as read).
+    given : tuple of (str, float)
+        The family's fixed parameters, in their ``given_in`` units (``[pattern]`` keys).
+    family_features : tuple of str
+        The family's parameters that are features (SI in the row).
     """
 
     pattern: CreasePattern
@@ -112,6 +119,43 @@ class PatternScenarioSetting:
     tol: float = 1e-9
     max_iter: int = 30
     collisions: bool = True
+    family: str = ""
+    given: tuple = ()
+    family_features: tuple[str, ...] = ()
+
+
+def family_columns(family) -> tuple[Column, ...]:
+    """A feature column for every number parameter of a pattern family (SI; a range
+    from the parameter's, where it has one)."""
+    out = []
+    for p in family.parameters:
+        if p.unit == "text":
+            continue
+        lo = None if p.low is None else p.low * p.factor
+        hi = None if p.high is None else p.high * p.factor
+        unit = "-" if p.unit == "-" else p.unit
+        out.append(Column(p.name, unit, f"{family.name}: {p.description}", lo, hi))
+    return tuple(out)
+
+
+def _family_given(setting: PatternScenarioSetting, row) -> dict:
+    """The family's parameters of a row, in their ``given_in`` units."""
+    from holofold.geometry import get_family
+
+    params = {p.name: p for p in get_family(setting.family).parameters}
+    given = dict(setting.given)
+    for name in setting.family_features:
+        v = float(row[name]) / params[name].factor
+        given[name] = round(v) if params[name].integer and round(v) == v else v
+    return given
+
+
+def family_pattern(setting: PatternScenarioSetting, row) -> CreasePattern:
+    """The row's pattern of the setting's family (its parameters checked), m."""
+    from holofold.geometry import get_family
+
+    p = get_family(setting.family).make(**_family_given(setting, row))
+    return replace(p, meta={**p.meta, "source": setting.source})
 
 
 def pattern_columns(setting: PatternScenarioSetting) -> tuple[Column, ...]:
@@ -144,7 +188,8 @@ def _setting_for(setting: PatternScenarioSetting, row) -> PatternSetting:
 
 def _pattern(setting: PatternScenarioSetting, row) -> CreasePattern:
     s = float(row["scale"])
-    return setting.pattern if s == 1.0 else scaled_pattern(setting.pattern, s)
+    base = family_pattern(setting, row) if setting.family else setting.pattern
+    return base if s == 1.0 else scaled_pattern(base, s)
 
 
 def check_pattern(setting: PatternScenarioSetting, row) -> list[str]:
@@ -152,6 +197,13 @@ def check_pattern(setting: PatternScenarioSetting, row) -> list[str]:
     f = row.get("fold")
     if f is None or not math.isfinite(f) or not 0 <= f <= 1:
         errs.append(f"fold = {f!r} must lie in [0, 1]")
+    if setting.family:
+        from holofold.geometry import ParameterError, get_family
+
+        try:
+            get_family(setting.family).values(_family_given(setting, row))
+        except (ParameterError, KeyError, TypeError, ValueError) as exc:
+            errs.append(str(exc))
     return errs
 
 
@@ -265,6 +317,31 @@ def pattern_scenario(
 _PATTERN_KEYS = ("file", "size", "unit", "tol", "frame", "split", "curves", "model")
 
 
+def _read_family(sec: Section, features: Section):
+    """``[pattern] family = NAME`` with the family's fixed parameters as keys (in their
+    ``given_in`` units); its parameters named in ``[features]`` vary by row (SI). Returns the
+    family, the fixed values and the feature names."""
+    from holofold.geometry import ParameterError, get_family
+
+    name = sec.string("family")
+    try:
+        family = get_family(name)
+    except ParameterError as exc:
+        raise sec.error(f"family = {name!r}: {exc}") from None
+    known = [p.name for p in family.parameters]
+    fixed = {k: sec.raw(k) for k in list(sec.data) if k in known}
+    sec.done(["family", "model", *known])
+    varied = tuple(p.name for p in family.parameters if features.has(p.name))
+    try:
+        family.values(fixed)  # each fixed value checked, an unknown name refused
+    except ParameterError as exc:
+        raise sec.error(str(exc)) from None
+    both = sorted(set(fixed) & set(varied))
+    if both:
+        raise sec.error(f"{both[0]} is fixed here and a feature in [features]; give it once")
+    return family, fixed, varied
+
+
 def _read_pattern(sec: Section) -> tuple[CreasePattern, str, str]:
     from holofold.geometry import read_pattern, reader_for
 
@@ -309,7 +386,27 @@ def _read_pattern(sec: Section) -> tuple[CreasePattern, str, str]:
 
 def from_config(doc: Section, name: str, description: str) -> Scenario:
     """The pattern scenario of a parsed scenario file (``kind = "pattern"``)."""
-    pattern, source, model = _read_pattern(doc.sub("pattern", required=True))
+    sec, fsec = doc.sub("pattern", required=True), doc.sub("features")
+    family, fixed, varied = None, {}, ()
+    if sec.has("family"):
+        family, fixed, varied = _read_family(sec, fsec)
+        model = sec.choice("model", ("concentrated", "compliant"), "concentrated")
+        cols = {c.name: c for c in family_columns(family)}
+        first = {
+            k: (min(fsec.raw(k)["choices"]) if isinstance(fsec.raw(k), dict)
+                else min(fsec.raw(k)) if isinstance(fsec.raw(k), list) else fsec.raw(k))
+            for k in varied
+        }  # fmt: skip
+        source = f"{family.name} family"
+        probe = PatternScenarioSetting(None, source, None, family=family.name,
+                                       given=tuple(fixed.items()),
+                                       family_features=varied)  # fmt: skip
+        try:  # the pattern at the features' low ends: vertex sets are checked on it
+            pattern = family_pattern(probe, {k: first[k] for k in varied})
+        except (TypeError, ValueError) as exc:
+            raise fsec.error(str(exc)) from None
+    else:
+        pattern, source, model = _read_pattern(sec)
     E, nu, density = read_material(doc)
     at, dofs, loads = read_supports_and_loads(doc, "'press'", pattern)
     if loads and dofs == "xyz":  # a mistake of the file: refused once, not stored as rows
@@ -325,13 +422,16 @@ def from_config(doc: Section, name: str, description: str) -> Scenario:
     setting = PatternScenarioSetting(
         pattern=pattern, source=source, material=Material("file", E, nu, density), model=model,
         supports=at, support_dofs=dofs, loads=loads, tol=tol, max_iter=max_iter,
+        family="" if family is None else family.name, given=tuple(fixed.items()),
+        family_features=varied,
     )  # fmt: skip
-    features = read_features(doc.sub("features"), PATTERN_FEATURES)
+    extra = tuple(c for c in cols.values() if c.name in varied) if family else ()
+    features = read_features(fsec, PATTERN_FEATURES + extra)
     for c in features:
         lo = min(c.choices) if c.choices else c.low
         hi = max(c.choices) if c.choices else c.high
         if c.name == "fold" and not (0 <= lo and hi <= 1):
             raise doc.error(f"[features] fold = [{lo:g}, {hi:g}] must lie in [0, 1]")
-        if c.name != "fold" and not lo > 0:
+        if c.name != "fold" and c.name not in varied and not lo > 0:
             raise doc.error(f"[features] {c.name} must be > 0, got {lo:g}")
     return pattern_scenario(name, description, setting, features)
