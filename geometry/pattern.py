@@ -8,6 +8,13 @@ A :class:`CreasePattern` is the plain data every other layer consumes::
     assignment  (ne,) str       FOLD codes: M V B F C J U
     fold_angle  (ne,) float     FOLD convention: degrees in [-180, 180], valley > 0, mountain < 0
     flat        (nv, 2) float or None   the flat crease-pattern layout, metres, where one exists
+    curves      tuple of Curve  curved creases as drawn (metres, the flat layout's frame), or ()
+    edge_curve  (ne,) int or None   the curve each edge is a straight piece of, -1 for a straight
+                                edge; None when there are no curves
+
+Curves are kept only while they match the edges and the flat layout: a copy whose edges change
+(``dataclasses.replace`` with new edges) or whose flat layout no longer meets the curves (a
+scaled copy) drops them with one warning line.
 
 Edge order matters: the reference simulator (SWOMPS) numbers creases by walking the panels in
 order and, within a panel with vertices C1..CN, the edges (C1, CN), (C1, C2), ..., (C_{N-1}, C_N)
@@ -335,6 +342,8 @@ class CreasePattern:
     fold_angle: np.ndarray
     flat: np.ndarray | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    curves: tuple = ()
+    edge_curve: np.ndarray | None = None
 
     # ------------------------------------------------------------------ construction
     def __post_init__(self):
@@ -389,6 +398,56 @@ class CreasePattern:
         object.__setattr__(self, "fold_angle", fold_angle)
         object.__setattr__(self, "meta", dict(self.meta))
         self._validate()
+        self._check_curves()
+
+    def _check_curves(self) -> None:
+        """Normalise ``curves``/``edge_curve``; drop them (one warning) where they no longer
+        match the edges or the flat layout."""
+        curves = tuple(self.curves)
+        if not curves:
+            object.__setattr__(self, "curves", ())
+            object.__setattr__(self, "edge_curve", None)
+            return
+        ec = None if self.edge_curve is None else np.asarray(self.edge_curve)
+        ne = len(self.edges)
+        why = ""
+        if ec is None or ec.shape != (ne,) or ec.dtype.kind not in "iu":
+            why = "the edges changed"
+        elif ne and (ec.min() < -1 or ec.max() >= len(curves)):
+            raise InvalidPatternError(
+                f"edge_curve has values outside -1..{len(curves) - 1} (one curve per edge)"
+            )
+        elif self.flat is not None and not self._curves_meet_flat(curves, ec):
+            why = "the flat layout no longer meets them (moved or scaled)"
+        if why:
+            import warnings
+
+            warnings.warn(f"{len(curves)} curve(s) dropped: {why}", UserWarning, stacklevel=4)
+            object.__setattr__(self, "curves", ())
+            object.__setattr__(self, "edge_curve", None)
+            return
+        ec = ec.astype(np.int64)
+        ec.flags.writeable = False
+        object.__setattr__(self, "curves", curves)
+        object.__setattr__(self, "edge_curve", ec)
+
+    def _curves_meet_flat(self, curves, ec) -> bool:
+        """Every flat vertex of a curve's pieces lies within 1 % of the sheet of the curve
+        (merging and contracting short pieces move vertices by about 0.2 %)."""
+        size = float(np.ptp(self.flat, axis=0).max()) if len(self.flat) else 0.0
+        for c, curve in enumerate(curves):
+            vs = np.unique(self.edges[ec == c])
+            if not vs.size:
+                continue
+            poly = curve.point(np.linspace(0.0, 1.0, 65))
+            a, d = poly[:-1], np.diff(poly, axis=0)
+            w = self.flat[vs][:, None, :] - a[None]
+            dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+            t = np.clip(np.einsum("vij,ij->vi", w, d) / dd, 0.0, 1.0)
+            gap = np.linalg.norm(w - t[..., None] * d[None], axis=2).min(axis=1)
+            if (gap > 1e-2 * size).any():
+                return False
+        return True
 
     def _validate(self) -> None:
         nv, ne = len(self.coords), len(self.edges)
