@@ -389,9 +389,9 @@ def _covered(curve, xy, E, t, p) -> list[tuple[float, float, list[float]]]:
 
 def _page_curves(pattern, wanted, shift, mirror, dash, gap, vgap) -> dict[str, tuple]:
     """role -> ((Curve on the page, edge ids), ...): every kept curve over the stretches its
-    pieces cover; creases dashed and kept ``vgap`` clear of the ends and of the vertices where
-    other lines meet them, as :func:`dashes` does for a straight crease (lengths along the
-    curve)."""
+    pieces cover; creases dashed and kept ``vgap`` clear of the vertices where other lines meet
+    them (not of a joint where the next curve of the same line goes on), as :func:`dashes` does
+    for a straight crease (lengths along the curve)."""
     xy = pattern.flat * 1000.0
     xy = np.column_stack([xy[:, 0] * (-1.0 if mirror else 1.0), -xy[:, 1]]) + np.asarray(shift)
     ec = pattern.edge_curve
@@ -419,9 +419,13 @@ def _page_curves(pattern, wanted, shift, mirror, dash, gap, vgap) -> dict[str, t
             # stretches between vertices where another line meets the curve
             cut = [u for u in inner if _vertex_degree_at(page, u, xy, deg, E) > 2]
             bounds = [t0, *cut, t1]
+            # no gap where the curve runs on into the next piece of its line (degree 2)
+            g0 = vgap if _vertex_degree_at(page, t0, xy, deg, E) > 2 else 0.0
+            g1 = vgap if _vertex_degree_at(page, t1, xy, deg, E) > 2 else 0.0
             for a, b in zip(bounds[:-1], bounds[1:], strict=True):
                 sa, sb = np.interp([a, b], t, s_of)
-                d = dashes(np.array([sa, 0.0]), np.array([sb, 0.0]), dash, gap, (vgap, vgap))
+                ends = (g0 if a == t0 else vgap, g1 if b == t1 else vgap)
+                d = dashes(np.array([sa, 0.0]), np.array([sb, 0.0]), dash, gap, ends)
                 for u0, u1 in np.interp(d[:, :, 0], s_of, t):
                     parts.append(page.sub(float(u0), float(u1)))
         out.setdefault(role, []).append(parts and (tuple(parts), ids))

@@ -178,6 +178,7 @@ def test_svg_cutter_file_draws_the_arc_as_an_arc(sheet, profile):
         assert math.hypot(x0 - 45, y0 - 105) == pytest.approx(1.0, rel=1e-3)
 
 
+@pytest.mark.processes
 def test_svg_cutter_file_renders(sheet, tmp_path):
     import shutil
     import subprocess
@@ -193,6 +194,47 @@ def test_svg_cutter_file_renders(sheet, tmp_path):
     subprocess.run([exe, "-w", "200", "-b", "white", str(f), "-o", str(png)], check=True,
                    timeout=60)  # fmt: skip
     assert png.stat().st_size > 0
+
+
+RABBIT_JS = r"""
+// The whole FOLD file (extension keys and all) through Rabbit Ear: valid, the keys kept.
+const ear = require("rabbit-ear");
+const fs = require("fs");
+const fold = JSON.parse(fs.readFileSync(process.argv[2], "utf8"));
+const g = JSON.parse(JSON.stringify(fold));
+delete g.file_frames;
+const graph = ear.graph(JSON.parse(JSON.stringify(fold)));
+process.stdout.write(JSON.stringify({
+  summary: ear.graph.validate(g).summary,
+  kept: Object.keys(JSON.parse(JSON.stringify(graph))).filter((k) => k.startsWith("holofold:")),
+}));
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.processes
+def test_rabbit_ear_accepts_the_fold_file_with_curves(sheet, tmp_path):
+    import os
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    from holofold.geometry.fold_io import export_fold
+
+    sys_cache = os.environ.get("HOLOFOLD_NODE_CACHE", Path.home() / ".cache" / "holofold-node")
+    mods = Path(sys_cache) / "node_modules"
+    if shutil.which("node") is None or not (mods / "rabbit-ear" / "package.json").is_file():
+        pytest.skip("Rabbit Ear is not installed (tests/test_real_clients.py installs it)")
+    f = tmp_path / "sheet.fold"
+    f.write_text(export_fold(sheet))
+    js = tmp_path / "check.js"
+    js.write_text(RABBIT_JS)
+    run = subprocess.run(["node", str(js), str(f)], capture_output=True, text=True, timeout=120,
+                         env={**os.environ, "NODE_PATH": str(mods)})  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    out = json.loads(run.stdout)
+    assert out["summary"] == "valid"
+    assert "holofold:curves" in out["kept"]
 
 
 def test_dxf_cutter_file_has_arc_and_spline(sheet):
