@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from holofold.geometry.curved import Curve
 from holofold.geometry.errors import FormatError
 from holofold.geometry.pattern import ASSIGNMENTS, MAX_PANELS, CreasePattern
 
@@ -177,8 +178,6 @@ def curves_to_fold(curves, edge_curve) -> list[dict]:
 def _curves_from_fold(raw, ne: int, scale: float):
     """(curves, edge_curve) of a ``holofold:curves`` value (see :func:`curves_to_fold`),
     lengths times ``scale`` (metres per file unit)."""
-    from holofold.geometry.curved import Curve
-
     key = "holofold:curves"
     if not isinstance(raw, list):
         _fail(f"{key} is {_kind(raw)}; expected a list of curves")

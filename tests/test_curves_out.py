@@ -309,3 +309,78 @@ def test_a_smaller_tolerance_keeps_the_curl_itself():
     assert not any("contracted" in str(w.message) for w in caught)
     # the curl's 12 pieces (no finer than the merge tolerance allows) are edges of the pattern
     assert (p.edge_curve >= 0).sum() >= 12 + 2
+
+
+def _dxf_sheet() -> bytes:
+    import io
+
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new("R2010", units=4)  # mm
+    msp = doc.modelspace()
+    for a, b in (((0, 0), (100, 0)), ((100, 0), (100, 100)), ((100, 100), (0, 100)),
+                 ((0, 100), (0, 0))):  # fmt: skip
+        msp.add_line(a, b, dxfattribs={"layer": "BOUNDARY"})
+    msp.add_arc((0, 0), 40, 0, 90, dxfattribs={"layer": "SCORE_M"})
+    msp.add_open_spline(CUBIC / MM, degree=3, dxfattribs={"layer": "SCORE_V"})
+    msp.add_ellipse((100, 0), (30, 0), 0.5, math.pi / 2, math.pi, dxfattribs={"layer": "SCORE_V"})
+    s = io.StringIO()
+    doc.write(s)
+    return s.getvalue().encode()
+
+
+def test_dxf_reader_keeps_arcs_ellipses_and_splines_as_curves():
+    from ezdxf import path as ezpath
+
+    from holofold.geometry.dxf_reader import dxf_drawing, read_dxf_pattern
+
+    data = _dxf_sheet()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PatternWarning)
+        p = read_dxf_pattern(data)
+    kinds = {(c.kind, c.assignment): c for c in p.curves}
+    arc, cub, ell = kinds[("arc", "M")], kinds[("bezier", "V")], kinds[("arc", "V")]
+    np.testing.assert_allclose(arc.centre, CENTRE, atol=1e-15)
+    np.testing.assert_allclose(arc.radii, [RADIUS, RADIUS], rtol=1e-12)
+    np.testing.assert_allclose(arc.point([0.0, 1.0]), [[0.04, 0.0], [0.0, 0.04]], atol=1e-15)
+    np.testing.assert_allclose(np.array(cub.points), CUBIC, rtol=1e-12)
+    np.testing.assert_allclose(ell.point([0.0, 1.0]), [[0.1, 0.015], [0.07, 0.0]], atol=1e-15)
+    for c in range(3):  # every curve has pieces; no straight crease is marked
+        assert (p.edge_curve == c).sum() > 4
+    assert not (p.edge_curve[p.assignment == "B"] >= 0).any()
+    # the pieces follow the old flattening (ezdxf's, 1e-3 of each curve's extent) within the
+    # two tolerances: 1e-3 of the drawing (0.1 mm) plus the old 1e-3 x extent
+    import ezdxf
+
+    doc = ezdxf.read(__import__("io").StringIO(data.decode()))
+    d = dxf_drawing(data)
+    for e in doc.modelspace():
+        if e.dxftype() == "LINE":
+            continue
+        pth = ezpath.make_path(e)
+        ext = float(np.ptp(np.array([(v.x, v.y) for v in pth.control_vertices()]), axis=0).max())
+        old = np.array([(v.x, v.y) for v in pth.flattening(distance=1e-3 * ext)])
+        S = d.segments[d.assignment == ("M" if e.dxftype() == "ARC" else "V")]
+        a, u = S[:, 0], S[:, 1] - S[:, 0]
+        w = old[:, None] - a[None]
+        t = np.clip(np.einsum("psj,sj->ps", w, u) / np.einsum("sj,sj->s", u, u), 0, 1)
+        near = np.linalg.norm(w - t[..., None] * u, axis=2).min(axis=1)  # to the pieces
+        mine = near[near < 5]  # the other valley curve's points are far away
+        assert mine.size > 0.9 * len(old) and mine.max() < 0.1 + 1e-3 * ext
+
+
+def test_dxf_cutter_file_reads_back_with_its_curves(sheet):
+    pytest.importorskip("ezdxf")
+    from holofold.geometry.dxf import export_dxf
+    from holofold.geometry.dxf_reader import read_dxf_pattern
+
+    text = export_dxf(sheet, margin_mm=5.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PatternWarning)
+        back = read_dxf_pattern(text.encode())
+    # the outline is on CUT (a cut on the outline is its border); lower-left at the origin
+    arc = next(c for c in back.curves if c.kind == "arc")
+    cub = next(c for c in back.curves if c.kind == "bezier")
+    np.testing.assert_allclose(arc.radii, [RADIUS, RADIUS], rtol=1e-9)
+    np.testing.assert_allclose(arc.centre, CENTRE, atol=1e-12)
+    np.testing.assert_allclose(np.array(cub.points), CUBIC, atol=1e-12)
+    assert back.n_faces == sheet.n_faces
