@@ -170,7 +170,7 @@ def discretise(
     return curve.point(np.array(ts))
 
 
-def curve_edges(xy, edges, assignment, curves, *, tol: float, samples: int = 129) -> np.ndarray:
+def curve_edges(xy, edges, assignment, curves, *, tol: float, samples: int = 65) -> np.ndarray:
     """The curve each edge is a straight piece of, (ne,) int, -1 for none.
 
     An edge is a piece of a curve when both its ends (``xy`` (nv, 2), the curves' units) lie
@@ -187,22 +187,28 @@ def curve_edges(xy, edges, assignment, curves, *, tol: float, samples: int = 129
         return out
     from scipy.spatial import cKDTree
 
+    codes = {c.assignment for c in curves} | (
+        {"B"} if any(c.assignment == "C" for c in curves) else set()
+    )
+    pick = np.flatnonzero(np.isin(asg, sorted(codes)))  # only edges of a curve's assignment
+    if not pick.size:
+        return out
     A, B = xy[E[:, 0]], xy[E[:, 1]]
     probes = np.stack([A, 0.5 * (A + B), B], axis=1)  # (ne, 3, 2)
     t = np.linspace(0.0, 1.0, samples)
     polys = [curve.point(t) for curve in curves]
     step = max(float(np.linalg.norm(np.diff(p, axis=0), axis=1).max()) for p in polys)
-    step += 0.3 * float(np.linalg.norm(B - A, axis=1).max())  # a midpoint off its curve
+    step += 0.3 * float(np.linalg.norm(B[pick] - A[pick], axis=1).max())  # midpoint off it
     # candidates: edges whose midpoint is near a sample of the curve
-    owner = np.repeat(np.arange(len(curves)), samples)
-    near = cKDTree(probes[:, 1]).query_ball_point(np.vstack(polys), tol + 0.5 * step)
-    cand: dict[int, set] = {}
-    for o, ks in zip(owner.tolist(), near, strict=True):
-        if ks:
-            cand.setdefault(o, set()).update(ks)
-    for c, ks in cand.items():
+    tree = cKDTree(probes[pick, 1])
+    cand: dict[int, np.ndarray] = {}
+    for c, poly in enumerate(polys):
+        hits = tree.query_ball_point(poly, tol + 0.5 * step, return_sorted=False)
+        ks = np.unique(np.concatenate([np.asarray(h, np.intp) for h in hits]))
+        if ks.size:
+            cand[c] = pick[ks]
+    for c, k in cand.items():
         curve, poly = curves[c], polys[c]
-        k = np.fromiter(ks, np.intp)
         ok = asg[k] == curve.assignment
         if curve.assignment == "C":
             ok |= asg[k] == "B"
