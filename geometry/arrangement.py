@@ -3,8 +3,9 @@
 A drawing (SVG, DXF, ORIPA, a FOLD file without faces) is a bag of line segments, each with a
 FOLD assignment and a fold angle. :func:`arrange_lines` turns it into a planar graph::
 
-    1. segments shorter than ``tol`` are contracted: their two ends join one vertex (a chain
-       of short pieces stays connected; points merged more than 2 ``tol`` apart are named);
+    1. segments shorter than ``tol`` are dropped, or, the pieces of a curve (``contract``),
+       contracted: their two ends join one vertex (a chain of short pieces stays connected;
+       points merged more than 2 ``tol`` apart are named in a note);
     2. every crossing of two segments, and every end point lying on another segment (a
        T-junction, a collinear overlap), splits the segment there;
     3. points closer than ``tol`` are merged (end points, crossings) into one vertex;
@@ -170,8 +171,8 @@ def _contraction_notes(points, label, ends, elab, tol) -> list[str]:
     """One line on the short lines contracted, naming the drawn length lost where a chain of
     them made one vertex of points farther apart than 2 ``tol`` (a feature no longer drawn)."""
     notes = [
-        f"{len(ends) // 2} line(s) shorter than the merge tolerance {tol:.3g} contracted (their "
-        "ends joined into one vertex)"
+        f"{len(ends) // 2} curve piece(s) shorter than the merge tolerance {tol:.3g} contracted "
+        "(their ends joined into one vertex)"
     ]
     k = int(label.max()) + 1
     lo = np.full((k, 2), np.inf)
@@ -199,7 +200,9 @@ def _rank(codes: np.ndarray) -> np.ndarray:
     return np.array([order.get(c, len(PRIORITY)) for c in codes], np.int64)
 
 
-def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None) -> Arrangement:
+def arrange_lines(
+    segments, assignment, fold_angle, *, tol: float | None = None, contract=None
+) -> Arrangement:
     """The planar arrangement of drawn segments (see the module docstring).
 
     Parameters
@@ -212,6 +215,10 @@ def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None)
         Degrees (valley > 0).
     tol : float, optional
         Merge distance, drawing units (default :func:`default_tolerance`).
+    contract : (n,) bool, optional
+        The lines that, when shorter than ``tol``, are contracted (their ends joined into one
+        vertex) instead of dropped: the straight pieces of a curve, so that a curve cut finer
+        than ``tol`` stays connected. Default: none (short lines dropped, with a note).
     """
     S = np.asarray(segments, float).reshape(-1, 2, 2)
     asg = np.asarray(assignment, dtype="<U1").reshape(-1)
@@ -230,10 +237,16 @@ def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None)
     # zero-length lines (a point drawn as a line) are dropped without a note: before, they
     # stayed when no other line was short and divided by their zero length in _splits
     tiny = short & (L > 1e-9 * tol / REL_TOL)
-    # a line shorter than the merge tolerance is contracted, not dropped: its two ends join the
-    # vertex clustering as one point, so a chain of short pieces (a finely cut curve) stays
-    # connected instead of breaking into dangling pieces (Origami Simulator's HexSpiralTess)
-    ends = S[tiny].reshape(-1, 2)
+    # a short piece of a curve is contracted, not dropped: its two ends join the vertex
+    # clustering as one point, so a chain of short pieces (a finely cut curve) stays connected
+    # instead of breaking into dangling pieces (Origami Simulator's HexSpiralTess)
+    pieces = np.zeros(len(S), bool) if contract is None else np.asarray(contract, bool)
+    if pieces.shape != (len(S),):
+        raise ValueError("contract must have one entry per line")
+    n_short = int((tiny & ~pieces).sum())
+    if n_short:
+        notes.append(f"{n_short} line(s) shorter than the merge tolerance {tol:.3g} dropped")
+    ends = S[tiny & pieces].reshape(-1, 2)
     S, asg, ang = S[~short], asg[~short], ang[~short]
     if not len(S):
         raise FormatError("no lines longer than the merge tolerance")

@@ -126,8 +126,9 @@ def pattern_from_lines(
             f"{name}: a line reaches {np.abs(S).max() * unit:.3g} m from the origin, beyond "
             f"{MAX_DRAWN_METRES:g} m; check the drawing's numbers and unit"
         )
+    pieces = _curve_pieces(S, assignment, curves, tol) if curves else None
     try:
-        arr = arrange_lines(segments, assignment, fold_angle, tol=tol)
+        arr = arrange_lines(segments, assignment, fold_angle, tol=tol, contract=pieces)
     except FormatError as exc:
         raise FormatError(f"{name}: {exc}") from None
     xy = (arr.vertices - arr.vertices.min(axis=0)) * unit  # lower-left corner at the origin
@@ -141,6 +142,20 @@ def pattern_from_lines(
         ec = curve_edges(pattern.flat, pattern.edges, pattern.assignment, curves, tol=reach)
         pattern = replace(pattern, curves=curves, edge_curve=ec)
     return pattern
+
+
+def _curve_pieces(S, assignment, curves, tol) -> np.ndarray:
+    """(n,) bool: the lines shorter than the merge tolerance that are pieces of a curve."""
+    tol = default_tolerance(S) if tol is None else tol
+    short = np.flatnonzero(np.linalg.norm(S[:, 1] - S[:, 0], axis=1) <= tol)
+    out = np.zeros(len(S), bool)
+    if short.size:
+        xy = S[short].reshape(-1, 2)
+        e = np.arange(2 * short.size).reshape(-1, 2)
+        size = float(np.ptp(S.reshape(-1, 2), axis=0).max())
+        asg = np.asarray(assignment)[short]
+        out[short] = curve_edges(xy, e, asg, curves, tol=1e-9 * size) >= 0
+    return out
 
 
 def check_unit(unit) -> float:
