@@ -384,3 +384,27 @@ def test_dxf_cutter_file_reads_back_with_its_curves(sheet):
     np.testing.assert_allclose(arc.centre, CENTRE, atol=1e-12)
     np.testing.assert_allclose(np.array(cub.points), CUBIC, atol=1e-12)
     assert back.n_faces == sheet.n_faces
+
+
+def test_short_straight_lines_are_dropped_as_before():
+    import re
+
+    # the curl drawn with straight lines: a straight file reads as it always did (dropped,
+    # with the note; the pieces that hung from them dangle and go, named too)
+    text = _curl_sheet().decode()
+    text = text.replace(" c 0.3 0.2 0.9 0.2 1.2 0", " l 1.2 0").replace(
+        " c 0.3 -0.2 0.9 -0.2 1.2 0", " l 1.2 0"
+    )
+    text = text.replace("C 150 450 350 550 494 500", "L 494 500").replace(
+        "C 600 400 800 600 1000 500", "L 1000 500"
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        p = read_svg_pattern(text.encode(), split="none")
+    notes = [str(w.message) for w in caught]
+    assert any(
+        re.search(r"12 line\(s\) shorter than the merge tolerance .* dropped", n) for n in notes
+    )
+    assert not any("contracted" in n for n in notes)
+    assert any("dangling" in n for n in notes)
+    assert p.n_faces == 1  # the creases all dangle: the sheet is one panel (as on main)
