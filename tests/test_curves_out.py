@@ -408,3 +408,53 @@ def test_short_straight_lines_are_dropped_as_before():
     assert not any("contracted" in n for n in notes)
     assert any("dangling" in n for n in notes)
     assert p.n_faces == 1  # the creases all dangle: the sheet is one panel (as on main)
+
+
+@pytest.mark.parametrize(
+    "profile, side, bound",
+    [("origami-simulator", "both", 0.11), ("origami-simulator", "back", 0.11),
+     ("laser", "both", 1.6), ("laser", "front", 1.6)],
+)  # fmt: skip
+def test_page_curves_follow_their_chords(sheet, profile, side, bound):
+    """Each drawn part of a curve (whole, dashed, or on the mirrored back face) lies on the
+    chords of the pieces it stands for: within the discretisation's chord deviation (0.1 mm
+    here) when whole; dashed, within a dash gap (1.5 mm) of the nearest chord dash."""
+    from holofold.geometry.cutter import FACE_ROLES, cutter_drawing
+
+    draw = cutter_drawing(sheet, profile, side=side)
+    assert set(draw.curves) == {"mountain", "valley"} & set(FACE_ROLES[side])
+    for role, entries in draw.curves.items():
+        segs, owner = draw.lines[role], draw.edges[role]
+        for parts, ids in entries:
+            S = segs[np.isin(owner, ids)]
+            a, u = S[:, 0], S[:, 1] - S[:, 0]
+            for cv in parts:
+                q = cv.point(np.linspace(0, 1, 33))
+                w = q[:, None] - a[None]
+                t = np.clip(np.einsum("psj,sj->ps", w, u) / np.einsum("sj,sj->s", u, u), 0, 1)
+                gap = np.linalg.norm(w - t[..., None] * u, axis=2).min(axis=1)
+                assert gap.max() < bound
+
+
+def test_an_elliptic_arc_goes_to_dxf_as_an_ellipse_and_back():
+    pytest.importorskip("ezdxf")
+    import io
+
+    from ezdxf import recover
+
+    from holofold.geometry.dxf import export_dxf
+    from holofold.geometry.dxf_reader import read_dxf_pattern
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PatternWarning)
+        p = read_dxf_pattern(_dxf_sheet())
+        text = export_dxf(p, margin_mm=5.0)
+        back = read_dxf_pattern(text.encode())
+    doc, auditor = recover.read(io.BytesIO(text.encode()))
+    assert not auditor.has_errors
+    assert len(doc.modelspace().query("ELLIPSE")) == 1
+    ell = next(c for c in back.curves if c.kind == "arc" and c.radii[0] != c.radii[1])
+    np.testing.assert_allclose(ell.radii, [0.03, 0.015], rtol=1e-9)
+    # the same quarter of the ellipse, whichever way it runs
+    ends = sorted(map(tuple, np.round(ell.point([0.0, 1.0]), 12).tolist()))
+    assert ends == [(0.07, 0.0), (0.1, 0.015)]
