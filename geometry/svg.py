@@ -22,6 +22,7 @@ the origami-simulator files back (with :mod:`xml.etree`, nothing evaluated).
 
 from __future__ import annotations
 
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -338,7 +339,8 @@ def _code_of(el) -> str:
 
 
 def load_svg(text: str | bytes) -> SvgLines:
-    """Read the ``<line>`` elements of an SVG crease pattern written by :func:`export_svg`.
+    """Read the ``<line>`` elements of an SVG crease pattern written by :func:`export_svg`
+    (a kept curve's ``<path>`` is not read: one warning line says how many).
 
     Coordinates are converted back from millimetres with y flipped up, relative to the
     drawing's lower-left corner (the margin removed only if the file is one of ours, i.e. all
@@ -379,8 +381,18 @@ def load_svg(text: str | bytes) -> SvgLines:
                 angles.append(float(ang))
                 groups.append(group)
                 ids.append(int(child.get("data-edge", "-1")))
+            elif tag == "path" and child.get("data-edges") is not None:
+                curved.append(child)
 
+    curved: list = []
     walk(root, "")
+    if curved:
+        warnings.warn(
+            f"SVG: {len(curved)} curved crease path(s) (data-edges) not read: load_svg reads "
+            "<line>s; read_svg_pattern reads the curves",
+            UserWarning,
+            stacklevel=2,
+        )
     if not segs:
         raise FormatError("SVG: no <line> elements found")
     return SvgLines(

@@ -458,3 +458,13 @@ def test_an_elliptic_arc_goes_to_dxf_as_an_ellipse_and_back():
     # the same quarter of the ellipse, whichever way it runs
     ends = sorted(map(tuple, np.round(ell.point([0.0, 1.0]), 12).tolist()))
     assert ends == [(0.07, 0.0), (0.1, 0.015)]
+
+
+def test_load_svg_says_it_leaves_the_curve_paths_out(sheet):
+    from holofold.geometry.svg import export_svg, load_svg
+
+    with pytest.warns(UserWarning, match="2 curved crease path\\(s\\) .* not read"):
+        lines = load_svg(export_svg(sheet))
+    assert len(lines.segments) == int(
+        (sheet.assignment != "J").sum() - (sheet.edge_curve >= 0).sum()
+    )
