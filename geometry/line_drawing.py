@@ -193,7 +193,8 @@ class LineDrawing:
         What the reader assumed or left out, each a :class:`PatternWarning` line once the
         pattern is made.
     curves : tuple of :class:`~holofold.geometry.curved.Curve`
-        The curves kept, already cut into straight pieces among ``segments`` (drawing units).
+        The curves kept, already cut into straight pieces among ``segments`` (drawing units,
+        y up as the segments); :func:`pattern_from_drawing` keeps them on the pattern.
     unit_note : str
         The note (one of ``notes``) saying the unit was assumed; :meth:`with_unit` drops it.
     """
