@@ -3,7 +3,9 @@
 A drawing (SVG, DXF, ORIPA, a FOLD file without faces) is a bag of line segments, each with a
 FOLD assignment and a fold angle. :func:`arrange_lines` turns it into a planar graph::
 
-    1. segments shorter than ``tol`` are dropped;
+    1. segments shorter than ``tol`` are dropped, or, the pieces of a curve (``contract``),
+       contracted: their two ends join one vertex (a chain of short pieces stays connected;
+       points merged more than 2 ``tol`` apart are named in a note);
     2. every crossing of two segments, and every end point lying on another segment (a
        T-junction, a collinear overlap), splits the segment there;
     3. points closer than ``tol`` are merged (end points, crossings) into one vertex;
@@ -36,7 +38,7 @@ import numpy as np
 
 from holofold.geometry.errors import FormatError
 
-__all__ = ["Arrangement", "arrange_lines", "PRIORITY", "default_tolerance"]
+__all__ = ["Arrangement", "arrange_lines", "PRIORITY", "REL_TOL", "default_tolerance"]
 
 #: which assignment an edge drawn twice keeps: the first of these among its drawings
 PRIORITY = ("C", "B", "M", "V", "U", "F", "J")
@@ -135,19 +137,62 @@ def _splits(P: np.ndarray, Q: np.ndarray, tol: float):
     return np.concatenate(seg), np.concatenate(par), np.vstack(pts)
 
 
-def _cluster(points: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
-    """Merge points closer than ``tol``: (label per point, mean point per label)."""
+def _cluster(points: np.ndarray, tol: float, extra=None, extra_labels: bool = False):
+    """Merge points closer than ``tol``: (label per point, mean point per label[, label per
+    extra point, -1 where it joins no point]).
+
+    ``extra`` (2m, 2): the ends of contracted short lines, pairs (2j, 2j + 1); they link the
+    clusters they touch (each pair is one point) but do not move the means."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
-    n = len(points)
-    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray") if n else np.zeros((0, 2))
+    n0 = len(points)
+    extra = np.zeros((0, 2)) if extra is None else np.asarray(extra, float).reshape(-1, 2)
+    allp = np.vstack([points, extra])
+    n = len(allp)
+    pairs = cKDTree(allp).query_pairs(tol, output_type="ndarray") if n else np.zeros((0, 2))
+    link = n0 + np.arange(0, len(extra), 2)
+    pairs = np.vstack([np.asarray(pairs, np.intp).reshape(-1, 2), np.stack([link, link + 1], 1)])
     g = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
     k, label = connected_components(g, directed=False)
-    cnt = np.bincount(label, minlength=k).astype(float)
-    mean = np.stack([np.bincount(label, weights=points[:, c], minlength=k) for c in (0, 1)], 1)
-    return label, mean / cnt[:, None]
+    used, label0 = np.unique(label[:n0], return_inverse=True)  # clusters of extras only: gone
+    k = len(used)
+    remap = np.full(int(label.max()) + 1 if n else 0, -1, np.intp)
+    remap[used] = np.arange(k)
+    cnt = np.bincount(label0, minlength=k).astype(float)
+    mean = np.stack([np.bincount(label0, weights=points[:, c], minlength=k) for c in (0, 1)], 1)
+    if extra_labels:
+        return label0, mean / cnt[:, None], remap[label[n0:]]
+    return label0, mean / cnt[:, None]
+
+
+def _contraction_notes(points, label, ends, elab, tol) -> list[str]:
+    """One line on the short lines contracted, naming the drawn length lost where a chain of
+    them made one vertex of points farther apart than 2 ``tol`` (a feature no longer drawn)."""
+    notes = [
+        f"{len(ends) // 2} curve piece(s) shorter than the merge tolerance {tol:.3g} contracted "
+        "(their ends joined into one vertex)"
+    ]
+    k = int(label.max()) + 1
+    lo = np.full((k, 2), np.inf)
+    hi = np.full((k, 2), -np.inf)
+    ok = elab >= 0
+    for lab, pts in ((label, points), (elab[ok], ends[ok])):
+        np.minimum.at(lo, lab, pts)
+        np.maximum.at(hi, lab, pts)
+    span = np.linalg.norm(hi - lo, axis=1)
+    touched = np.zeros(k, bool)
+    touched[elab[ok]] = True
+    big = touched & (span > 2 * tol)
+    if big.any():
+        k = int(np.argmax(np.where(big, span, -1.0)))
+        notes.append(
+            f"{int(big.sum())} vertex(es) each merge drawn points up to {span[k]:.3g} apart "
+            f"(more than twice the merge tolerance; the largest near ({lo[k, 0]:.4g}, "
+            f"{lo[k, 1]:.4g})): a drawn feature that small is not kept; pass a smaller tol"
+        )
+    return notes
 
 
 def _rank(codes: np.ndarray) -> np.ndarray:
@@ -155,7 +200,9 @@ def _rank(codes: np.ndarray) -> np.ndarray:
     return np.array([order.get(c, len(PRIORITY)) for c in codes], np.int64)
 
 
-def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None) -> Arrangement:
+def arrange_lines(
+    segments, assignment, fold_angle, *, tol: float | None = None, contract=None
+) -> Arrangement:
     """The planar arrangement of drawn segments (see the module docstring).
 
     Parameters
@@ -168,6 +215,10 @@ def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None)
         Degrees (valley > 0).
     tol : float, optional
         Merge distance, drawing units (default :func:`default_tolerance`).
+    contract : (n,) bool, optional
+        The lines that, when shorter than ``tol``, are contracted (their ends joined into one
+        vertex) instead of dropped: the straight pieces of a curve, so that a curve cut finer
+        than ``tol`` stays connected. Default: none (short lines dropped, with a note).
     """
     S = np.asarray(segments, float).reshape(-1, 2, 2)
     asg = np.asarray(assignment, dtype="<U1").reshape(-1)
@@ -183,11 +234,19 @@ def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None)
         raise FormatError("no lines of length > 0 to make a crease pattern of")
     L = np.linalg.norm(S[:, 1] - S[:, 0], axis=1)
     short = L <= tol
-    n_short = int((L > 1e-9 * tol / REL_TOL).sum() - (~short).sum())  # zero-length ones: silent
+    # zero-length lines (a point drawn as a line) are dropped without a note: before, they
+    # stayed when no other line was short and divided by their zero length in _splits
+    tiny = short & (L > 1e-9 * tol / REL_TOL)
+    # a short piece of a curve is contracted, not dropped: its two ends join the vertex
+    # clustering as one point, so a chain of short pieces (a finely cut curve) stays connected
+    # instead of breaking into dangling pieces (Origami Simulator's HexSpiralTess)
+    pieces = np.zeros(len(S), bool) if contract is None else np.asarray(contract, bool)
+    if pieces.shape != (len(S),):
+        raise ValueError("contract must have one entry per line")
+    n_short = int((tiny & ~pieces).sum())
     if n_short:
         notes.append(f"{n_short} line(s) shorter than the merge tolerance {tol:.3g} dropped")
-    # zero-length lines (a point drawn as a line) are dropped too, without a note: before, they
-    # stayed when no other line was short and divided by their zero length in _splits
+    ends = S[tiny & pieces].reshape(-1, 2)
     S, asg, ang = S[~short], asg[~short], ang[~short]
     if not len(S):
         raise FormatError("no lines longer than the merge tolerance")
@@ -195,7 +254,9 @@ def arrange_lines(segments, assignment, fold_angle, *, tol: float | None = None)
     n = len(S)
     sid, spar, spts = _splits(P, Q, tol)
     points = np.vstack([P, Q, spts])
-    label, verts = _cluster(points, tol)
+    label, verts, elab = _cluster(points, tol, extra=ends, extra_labels=True)
+    if len(ends):
+        notes += _contraction_notes(points, label, ends, elab, tol)
     # every segment: its vertices in order along it
     seg = np.concatenate([np.arange(n), np.arange(n), sid])
     par = np.concatenate([np.zeros(n), np.ones(n), spar])

@@ -230,6 +230,12 @@ class CutterDrawing:
         "both", "front" or "back" (mirrored).
     top : float
         Room above the pattern left for a legend, mm.
+    curves : mapping role -> tuple of (tuple of Curve, (k,) int)
+        The pattern's kept curves of each role on the page (mm, y down): per curve the parts
+        drawn (the whole curve, its dashes, or the stretches between vertex gaps), each a
+        :class:`~holofold.geometry.curved.Curve`, and the pattern edges (its straight pieces)
+        it stands for; ``lines`` still holds those edges' chords, which a writer drawing
+        curves leaves out (:attr:`curve_edges`).
     """
 
     profile: CutterProfile
@@ -242,6 +248,12 @@ class CutterDrawing:
     hole_radius: float
     side: str
     top: float = 0.0
+    curves: Mapping[str, tuple] = field(default_factory=dict)
+
+    @property
+    def curve_edges(self) -> set[int]:
+        """The pattern edges drawn as parts of curves (their chords are not drawn)."""
+        return {int(e) for parts in self.curves.values() for _, ids in parts for e in ids}
 
 
 #: the roles scored on each face of a two-pass job (a score opens on the outside of its fold)
@@ -262,13 +274,15 @@ def cutter_drawing(
     side: str = "both",
     margin: float = 5.0,
     top: float = 0.0,
+    curves: bool = True,
 ) -> CutterDrawing:
     """The pattern's flat layout on a page for ``profile`` (mm; see :class:`CutterDrawing`).
 
     ``dash``, ``gap`` and ``vertex_gap`` (mm) override the profile's; ``side`` is "both" (one
     file), "front" or "back" (a two-pass job, with registration holes; the back mirrored);
     ``margin`` (mm) surrounds the pattern (at least 8 mm on a two-pass job, for the holes);
-    ``top`` (mm) is extra room above it.
+    ``top`` (mm) is extra room above it; ``curves``: lay out the pattern's kept curves as
+    curves (``CutterDrawing.curves``; False: their chords only).
     """
     prof = get_profile(profile)
     if pattern.flat is None:
@@ -333,7 +347,96 @@ def cutter_drawing(
                           [w / 2, h - margin / 2]])  # fmt: skip
     else:
         r = 0.0
-    return CutterDrawing(prof, float(w), float(h), lines, edges, angles, holes, r, side, top)
+    page_curves = {}
+    if curves and pattern.curves:
+        if side == "back":
+            shift = (lo[0] - margin + w, hi[1] + margin + top)
+        else:
+            shift = (-lo[0] + margin, hi[1] + margin + top)
+        page_curves = _page_curves(pattern, wanted, shift, side == "back", dash, gap, vgap)
+    return CutterDrawing(
+        prof, float(w), float(h), lines, edges, angles, holes, r, side, top, page_curves
+    )
+
+
+def _covered(curve, xy, E, t, p) -> list[tuple[float, float, list[float]]]:
+    """The parameter intervals of ``curve`` its pieces ``E`` (vertex pairs; ``xy`` page mm)
+    cover, merged: (t0, t1, the parameters of the piece ends inside)."""
+    from scipy.optimize import minimize_scalar
+
+    def param(q):
+        k = int(np.argmin(np.linalg.norm(p - q, axis=1)))
+        if k in (0, len(t) - 1):
+            return float(t[k])
+        lo_, hi_ = t[max(k - 1, 0)], t[min(k + 1, len(t) - 1)]
+        r = minimize_scalar(
+            lambda u: float(np.sum((curve.point(u)[0] - q) ** 2)),
+            bounds=(lo_, hi_), method="bounded", options={"xatol": 1e-13},
+        )  # fmt: skip
+        return float(r.x)
+
+    tv = {int(v): param(xy[v]) for v in np.unique(E)}
+    spans = sorted((min(tv[a], tv[b]), max(tv[a], tv[b])) for a, b in E.tolist())
+    out: list[list] = []
+    for a, b in spans:
+        if out and a <= out[-1][1] + 1e-9:
+            out[-1][1] = max(out[-1][1], b)
+            out[-1][2].append(a)
+        else:
+            out.append([a, b, []])
+    return [(a, b, sorted(set(inner))) for a, b, inner in out]
+
+
+def _page_curves(pattern, wanted, shift, mirror, dash, gap, vgap) -> dict[str, tuple]:
+    """role -> ((Curve on the page, edge ids), ...): every kept curve over the stretches its
+    pieces cover; creases dashed and kept ``vgap`` clear of the vertices where other lines meet
+    them (not of a joint where the next curve of the same line goes on), as :func:`dashes` does
+    for a straight crease (lengths along the curve)."""
+    xy = pattern.flat * 1000.0
+    xy = np.column_stack([xy[:, 0] * (-1.0 if mirror else 1.0), -xy[:, 1]]) + np.asarray(shift)
+    ec = pattern.edge_curve
+    drawn = pattern.assignment != "J"
+    deg = np.bincount(pattern.edges[drawn].ravel(), minlength=pattern.n_vertices)
+    out: dict[str, list] = {}
+    for c, curve in enumerate(pattern.curves):
+        ids = np.flatnonzero(ec == c)
+        if not ids.size:
+            continue
+        code = str(pattern.assignment[ids[0]])
+        role = ROLE_OF.get(code)
+        if role not in wanted or (pattern.assignment[ids] != code).any():
+            continue
+        page = curve.mapped(1000.0, shift, flip_y=True, flip_x=mirror)
+        E = pattern.edges[ids]
+        t, s_of = page.lengths()
+        p = page.point(t)
+        creased = role not in ("boundary", "cut")
+        parts = []
+        for t0, t1, inner in _covered(page, xy, E, t, p):
+            if not creased or (dash <= 0 and vgap <= 0):
+                parts.append(page.sub(t0, t1) if (t0, t1) != (0.0, 1.0) else page)
+                continue
+            # stretches between vertices where another line meets the curve
+            cut = [u for u in inner if _vertex_degree_at(page, u, xy, deg, E) > 2]
+            bounds = [t0, *cut, t1]
+            # no gap where the curve runs on into the next piece of its line (degree 2)
+            g0 = vgap if _vertex_degree_at(page, t0, xy, deg, E) > 2 else 0.0
+            g1 = vgap if _vertex_degree_at(page, t1, xy, deg, E) > 2 else 0.0
+            for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+                sa, sb = np.interp([a, b], t, s_of)
+                ends = (g0 if a == t0 else vgap, g1 if b == t1 else vgap)
+                d = dashes(np.array([sa, 0.0]), np.array([sb, 0.0]), dash, gap, ends)
+                for u0, u1 in np.interp(d[:, :, 0], s_of, t):
+                    parts.append(page.sub(float(u0), float(u1)))
+        out.setdefault(role, []).append(parts and (tuple(parts), ids))
+    return {r: tuple(x for x in v if x) for r, v in out.items()}
+
+
+def _vertex_degree_at(page, u, xy, deg, E) -> int:
+    """The number of drawn lines at the piece vertex nearest the curve's point at ``u``."""
+    vs = np.unique(E)
+    q = page.point(u)[0]
+    return int(deg[vs[int(np.argmin(np.linalg.norm(xy[vs] - q, axis=1)))]])
 
 
 def hole_points(centre: np.ndarray, radius: float, n: int = 24) -> np.ndarray:

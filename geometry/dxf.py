@@ -1,7 +1,9 @@
 """DXF crease patterns with named layers, for CAD and laser software (written with ezdxf).
 
 The flat layout in millimetres (``$INSUNITS`` = 4, y up as the pattern has it), one ``LINE``
-per drawn segment on the layer of its role (:data:`DXF_LAYERS`; the outline is cut, so it goes
+per drawn segment on the layer of its role (a kept curve, :attr:`CreasePattern.curves
+<holofold.geometry.pattern.CreasePattern>`, as one ``ARC``, ``ELLIPSE`` or ``SPLINE`` in
+place of its straight pieces: :func:`add_curve`) (:data:`DXF_LAYERS`; the outline is cut, so it goes
 on ``CUT`` with the cuts, and ``BOUNDARY`` stays empty for other software's use): ``CUT``,
 ``SCORE_M`` (mountains), ``SCORE_V`` (valleys), ``SCORE_F`` (flat creases), ``SCORE_U``
 (unassigned), ``REGISTRATION``. Each layer has the profile's colour (as a true colour and the
@@ -19,6 +21,7 @@ bytes, in every process.
 from __future__ import annotations
 
 import io
+import math
 
 import numpy as np
 
@@ -32,7 +35,7 @@ from holofold.geometry.cutter import (
 )
 from holofold.geometry.pattern import CreasePattern
 
-__all__ = ["DXF_LAYERS", "export_dxf"]
+__all__ = ["DXF_LAYERS", "export_dxf", "add_curve"]
 
 #: role -> DXF layer name (readers map these back to FOLD assignments B, C, M, V, F, U)
 DXF_LAYERS = {
@@ -103,12 +106,18 @@ def _dxf_text(ezdxf, prof: CutterProfile, draw) -> str:
         layer.dxf.lineweight = lw
     flip = np.array([1.0, -1.0])
     shift = np.array([0.0, draw.height])
+    on_curves = draw.curve_edges
     for role, segs in draw.lines.items():
         # the outline is cut: on CUT, which the laser and cutter software cut (a reader takes
         # a cut on the outline for the border it is)
         name = DXF_LAYERS["cut" if role == "boundary" else role]
+        if on_curves:
+            segs = segs[~np.isin(draw.edges[role], list(on_curves))]
         for a, b in segs * flip + shift:
             msp.add_line(tuple(a), tuple(b), dxfattribs={"layer": name})
+        for parts, _ in draw.curves.get(role, ()):
+            for cv in parts:
+                add_curve(msp, cv.mapped(1.0, shift, flip_y=True), name)
     for c in draw.holes:
         pts = hole_points(c, draw.hole_radius) * flip + shift
         msp.add_lwpolyline(pts[:-1].tolist(), close=True, dxfattribs={"layer": "REGISTRATION"})
@@ -116,6 +125,38 @@ def _dxf_text(ezdxf, prof: CutterProfile, draw) -> str:
     stream = io.StringIO()
     doc.write(stream)
     return stream.getvalue()
+
+
+def add_curve(msp, cv, layer: str) -> None:
+    """One curve (drawing units, y up) into a modelspace: a circular arc as ``ARC``, an
+    elliptical one as ``ELLIPSE`` (DXF arcs run counter-clockwise: a clockwise one is written
+    from its end), a Bezier of degree 2 or 3 as a clamped ``SPLINE`` with its control points
+    (the Bezier itself), of degree 1 as ``LINE``."""
+    at = {"layer": layer}
+    if cv.kind == "bezier":
+        P = [tuple(map(float, p)) for p in cv.points]
+        if len(P) == 2:
+            msp.add_line(P[0], P[1], dxfattribs=at)
+        else:
+            msp.add_open_spline(P, degree=len(P) - 1, dxfattribs=at)
+        return
+    rx, ry = cv.radii
+    a0, a1 = cv.start, cv.start + cv.sweep
+    if a1 < a0:
+        a0, a1 = a1, a0
+    if math.isclose(rx, ry, rel_tol=1e-12):
+        rot = math.degrees(cv.rotation)
+        msp.add_arc(
+            tuple(cv.centre), rx, rot + math.degrees(a0), rot + math.degrees(a1), dxfattribs=at
+        )
+        return
+    c, s = math.cos(cv.rotation), math.sin(cv.rotation)
+    if rx >= ry:
+        major, ratio = (rx * c, rx * s), ry / rx
+    else:  # the major axis along the curve's y: parameters a quarter turn back
+        major, ratio = (-ry * s, ry * c), rx / ry
+        a0, a1 = a0 - math.pi / 2, a1 - math.pi / 2
+    msp.add_ellipse(tuple(cv.centre), major, ratio, a0, a1, dxfattribs=at)
 
 
 def _fix_class_order(doc) -> None:

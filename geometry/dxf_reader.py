@@ -13,8 +13,12 @@ Origami Simulator's SVG).
 
 Entities: ``LINE``, ``LWPOLYLINE`` and ``POLYLINE`` (straight pieces; bulges are arcs),
 ``ARC``, ``CIRCLE``, ``ELLIPSE``, ``SPLINE`` and polyline bulges (curves: by default,
-``curves="keep"``, cut by ezdxf's adaptive flattening to a chord deviation of 1e-3 of the
-curve's extent; ``"refuse"`` refuses curved creases) and ``INSERT`` (block references, exploded
+``curves="keep"``, kept as :class:`~holofold.geometry.curved.Curve` (arcs; a spline's Bezier
+pieces; the Bezier curves ezdxf makes of bulges) and cut by
+:func:`~holofold.geometry.curved.discretise` as the SVG reader cuts its curves (the drawing's
+``curves``); a rational or higher-degree spline, or a curve out of the drawing's plane, by
+ezdxf's adaptive flattening to 1e-3 of its extent, as ``"flatten"`` does every curve;
+``"refuse"`` refuses curved creases) and ``INSERT`` (block references, exploded
 with their transformation). Units from ``$INSUNITS`` (unitless drawings are read as
 millimetres, with a warning); ``unit`` (metres per drawing unit) overrides.
 
@@ -27,11 +31,14 @@ millimetres, with a warning); ``unit`` (metres per drawing unit) overrides.
 from __future__ import annotations
 
 import io
+import math
 from collections import Counter
 
 import numpy as np
 
+from holofold.geometry.arrangement import REL_TOL
 from holofold.geometry.bounded import check_dxf_pattern, read_source, source_name
+from holofold.geometry.curved import CHORD_DEFAULT, LENGTH_DEFAULT, Curve, discretise
 from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
 from holofold.geometry.line_drawing import LineDrawing, pattern_from_drawing
 
@@ -168,6 +175,7 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
     skipped: Counter = Counter()
     curved_creases = 0
     flattened = 0
+    kept: list = []
     ents = list(_entities(doc.modelspace()))
     pts_all = []
     for e in ents:
@@ -194,6 +202,18 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
             if curved and code not in ("B", "C") and curves == "refuse":
                 curved_creases += 1
                 continue
+            if curved and curves == "keep":
+                got = _kept_curves(e, p, code, ang)
+                if got is not None:  # curves, and the straight pieces between them
+                    kept += got[0]
+                    pieces = got[1]
+                    for P in pieces:
+                        pts_all.append(P)
+                        for a, b in zip(P[:-1], P[1:], strict=True):
+                            segs.append([a, b])
+                            codes.append(code)
+                            angles.append(ang)
+                    continue
             pieces = []
             for sub in p.sub_paths():
                 if sub.has_curves:
@@ -231,6 +251,12 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
         )
     if flattened:
         notes.append(f"{flattened} curved piece(s) flattened into segments")
+    if kept:
+        n_pieces, chord, length = _cut_curves(kept, segs, codes, angles)
+        notes.append(
+            f"{len(kept)} curve(s) kept, cut into {n_pieces} piece(s) (chord deviation "
+            f"{chord:.3g}, piece length {length:.3g} drawing units)"
+        )
     if not segs:
         raise FormatError(
             f"{name}: no crease-pattern lines (LINE/LWPOLYLINE/POLYLINE on crease layers or in "
@@ -238,8 +264,92 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
         )
     unit_note = next((n for n in notes if "$INSUNITS" in n), "")
     return LineDrawing(np.array(segs, float), np.array(codes, dtype="<U1"), np.array(angles),
-                       unit, name=name, kind="dxf", notes=tuple(notes),
+                       unit, name=name, kind="dxf", notes=tuple(notes), curves=tuple(kept),
                        unit_note=unit_note)  # fmt: skip
+
+
+def _kept_curves(e, p, code: str, ang: float):
+    """(curves, straight polylines) of a curved entity, drawing units: ``ARC``, ``CIRCLE`` and
+    ``ELLIPSE`` as arcs, a non-rational ``SPLINE`` of degree <= 3 as its Bezier pieces, a
+    polyline as its lines and the Bezier curves ezdxf makes of its bulges; None where the
+    entity is not flat in the drawing's plane or is a rational or higher-degree spline (then
+    it is flattened as before)."""
+    t = e.dxftype()
+    ex = e.dxf.get("extrusion", (0.0, 0.0, 1.0))
+    if t in _CURVES and not (abs(ex[0]) < 1e-12 and abs(ex[1]) < 1e-12 and ex[2] > 0):
+        return None  # mirrored or tilted (OCS): ezdxf's flattening handles it
+    if t in ("ARC", "CIRCLE"):
+        c, r = e.dxf.center, float(e.dxf.radius)
+        if t == "CIRCLE":
+            a0, sweep = 0.0, 2 * math.pi
+        else:
+            a0 = math.radians(e.dxf.start_angle)
+            sweep = math.radians((e.dxf.end_angle - e.dxf.start_angle) % 360.0) or 2 * math.pi
+        arc = Curve("arc", code, ang, centre=(c.x, c.y), radii=(r, r), start=a0, sweep=sweep)
+        return [arc], []
+    if t == "ELLIPSE":
+        c, m = e.dxf.center, e.dxf.major_axis
+        rx = math.hypot(m.x, m.y)
+        s0, s1 = float(e.dxf.start_param), float(e.dxf.end_param)
+        sweep = (s1 - s0) % (2 * math.pi) or 2 * math.pi
+        arc = Curve("arc", code, ang, centre=(c.x, c.y), radii=(rx, rx * float(e.dxf.ratio)),
+                    rotation=math.atan2(m.y, m.x), start=s0, sweep=sweep)  # fmt: skip
+        return [arc], []
+    if t == "SPLINE":
+        try:
+            bs = e.construction_tool()
+        except Exception:  # noqa: BLE001 - a spline ezdxf cannot build: flatten it
+            return None
+        if bs.is_rational or bs.degree > 3:
+            return None
+        out = [
+            Curve("bezier", code, ang, points=tuple((float(v.x), float(v.y)) for v in cps))
+            for cps in bs.bezier_decomposition()
+        ]
+        return out, []
+    # a polyline with bulges: lines stay lines, ezdxf's Bezier curves of the bulges are kept
+    from ezdxf.path import Command
+
+    curves_out, lines, cur = [], [], [(p.start.x, p.start.y)]
+    start = p.start
+    for cmd in p.commands():
+        end = (cmd.end.x, cmd.end.y)
+        if cmd.type == Command.LINE_TO:
+            cur.append(end)
+        elif cmd.type == Command.MOVE_TO:
+            if len(cur) >= 2:
+                lines.append(np.array(cur))
+            cur = [end]
+        else:
+            if len(cur) >= 2:
+                lines.append(np.array(cur))
+            ctrl = [cmd.ctrl] if cmd.type == Command.CURVE3_TO else [cmd.ctrl1, cmd.ctrl2]
+            pts = ((start.x, start.y), *((v.x, v.y) for v in ctrl), end)
+            curves_out.append(Curve("bezier", code, ang, points=tuple(map(tuple, pts))))
+            cur = [end]
+        start = cmd.end
+    if len(cur) >= 2:
+        lines.append(np.array(cur))
+    return curves_out, lines
+
+
+def _cut_curves(kept, segs, codes, angles) -> tuple[int, float, float]:
+    """Cut the kept curves into pieces appended to ``segs`` (as the SVG reader does: chord
+    deviation and piece length relative to the drawing's larger side, no piece finer than the
+    merge tolerance); (pieces, chord, length)."""
+    pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
+    pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
+    size = float(np.ptp(np.concatenate(pts), axis=0).max()) or 1.0
+    chord, length = CHORD_DEFAULT * size, LENGTH_DEFAULT * size
+    n = 0
+    for c in kept:
+        cp = discretise(c, chord=chord, length=length, shortest=REL_TOL * size)
+        n += len(cp) - 1
+        for a, b in zip(cp[:-1], cp[1:], strict=True):
+            segs.append([a, b])
+            codes.append(c.assignment)
+            angles.append(c.fold_angle)
+    return n, chord, length
 
 
 def dxf_lines(path, *, curves: str = "keep"):

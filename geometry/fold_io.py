@@ -7,7 +7,9 @@ present). Where the pattern has a flat layout, the key frame is the flat crease 
 (``creasePattern``, 2-D coordinates) and ``file_frames[0]`` the folded form (3-D coordinates,
 inheriting the topology); otherwise the key frame is the 3-D ``foldedForm``. Physical data go
 under namespaced keys: ``edges_holofold:creaseWidth`` (m), ``edges_holofold:creaseThickness``
-(m), ``faces_holofold:thickness`` (m) and ``holofold:meta`` (the pattern's parameters).
+(m), ``faces_holofold:thickness`` (m), ``holofold:meta`` (the pattern's parameters) and
+``holofold:curves`` (curved creases as drawn, the edges that are their straight pieces:
+:func:`curves_to_fold`).
 
 Reading checks the list of docs/bar-and-hinge.md §1.2 and raises :class:`FormatError` naming the
 first problem; soft problems (no ``file_spec``, custom keys without a colon, clockwise faces,
@@ -24,11 +26,13 @@ from typing import Any
 
 import numpy as np
 
+from holofold.geometry.curved import Curve
 from holofold.geometry.errors import FormatError
 from holofold.geometry.pattern import ASSIGNMENTS, MAX_PANELS, CreasePattern
 
 __all__ = [
     "fold_dict",
+    "curves_to_fold",
     "export_fold",
     "load_fold",
     "read_fold",
@@ -143,7 +147,91 @@ def fold_dict(
             out[key] = np.broadcast_to(np.asarray(val, float), (n,)).tolist()
     if pattern.meta:
         out["holofold:meta"] = _jsonable(pattern.meta)
+    if pattern.curves:
+        out["holofold:curves"] = curves_to_fold(pattern.curves, pattern.edge_curve)
     return out
+
+
+def curves_to_fold(curves, edge_curve) -> list[dict]:
+    """The ``holofold:curves`` value: per curve its ``kind``, ``assignment``, ``foldAngle``
+    (degrees), ``edges`` (the indices of its straight pieces) and either ``points`` (Bezier
+    control points, m) or ``centre`` (m), ``radii`` (m), ``rotation``, ``start`` and ``sweep``
+    (degrees, counter-clockwise) of an elliptical arc."""
+    ec = np.asarray(edge_curve)
+    out = []
+    for c, cv in enumerate(curves):
+        d: dict[str, Any] = {"kind": cv.kind, "assignment": cv.assignment,
+                             "foldAngle": float(cv.fold_angle)}  # fmt: skip
+        if cv.kind == "bezier":
+            d["points"] = [[float(x), float(y)] for x, y in cv.points]
+        else:
+            d.update(
+                centre=[float(v) for v in cv.centre], radii=[float(v) for v in cv.radii],
+                rotation=math.degrees(cv.rotation), start=math.degrees(cv.start),
+                sweep=math.degrees(cv.sweep),
+            )  # fmt: skip
+        d["edges"] = np.flatnonzero(ec == c).tolist()
+        out.append(d)
+    return out
+
+
+def _curves_from_fold(raw, ne: int, scale: float):
+    """(curves, edge_curve) of a ``holofold:curves`` value (see :func:`curves_to_fold`),
+    lengths times ``scale`` (metres per file unit)."""
+    key = "holofold:curves"
+    if not isinstance(raw, list):
+        _fail(f"{key} is {_kind(raw)}; expected a list of curves")
+    curves, ec = [], np.full(ne, -1, np.int64)
+
+    def nums(d, k, n, c):
+        v = d.get(k)
+        flat = v if isinstance(v, list) else [v] if n == 1 else None
+        flat = np.asarray(flat, dtype=object).ravel() if flat is not None else None
+        if flat is None or not all(_is_number(x) for x in flat) or len(flat) != n:
+            _fail(f"{key}[{c}].{k} = {_show(v)}; expected {n} number(s)")
+        a = np.asarray(flat, float)
+        if not np.isfinite(a).all():
+            _fail(f"{key}[{c}].{k} has a number that is not finite")
+        return a
+
+    for c, d in enumerate(raw):
+        if not isinstance(d, dict):
+            _fail(f"{key}[{c}] is {_kind(d)}; expected an object")
+        kind, asg = d.get("kind"), d.get("assignment", "U")
+        if asg not in ASSIGNMENTS:
+            _fail(f"{key}[{c}].assignment = {_show(asg)}; allowed: {' '.join(ASSIGNMENTS)}")
+        ang = d.get("foldAngle", 0.0)
+        if not _is_number(ang) or not math.isfinite(ang):
+            _fail(f"{key}[{c}].foldAngle = {_show(ang)}; expected degrees")
+        ang = float(ang)
+        if kind == "bezier":
+            pts = d.get("points")
+            n = len(pts) if isinstance(pts, list) else 0
+            if not 2 <= n <= 4:
+                _fail(f"{key}[{c}].points: expected 2 to 4 control points [x, y]")
+            P = nums(d, "points", 2 * n, c).reshape(n, 2) * scale
+            cv = Curve("bezier", asg, ang, points=tuple(map(tuple, P.tolist())))
+        elif kind == "arc":
+            ctr, rad = nums(d, "centre", 2, c) * scale, nums(d, "radii", 2, c) * scale
+            if not (rad > 0).all():
+                _fail(f"{key}[{c}].radii = {_show(d.get('radii'))}; expected lengths > 0")
+            rot, st, sw = (
+                math.radians(nums(d, k, 1, c)[0]) for k in ("rotation", "start", "sweep")
+            )  # noqa: E501
+            cv = Curve("arc", asg, ang, centre=tuple(ctr.tolist()), radii=tuple(rad.tolist()),
+                       rotation=rot, start=st, sweep=sw)  # fmt: skip
+        else:
+            _fail(f"{key}[{c}].kind = {_show(kind)}; allowed: bezier, arc")
+        edges = d.get("edges", [])
+        if not isinstance(edges, list) or not all(
+            isinstance(k, int) and not isinstance(k, bool) and 0 <= k < ne for k in edges
+        ):
+            _fail(f"{key}[{c}].edges: expected edge indices in 0..{ne - 1}")
+        if (ec[edges] >= 0).any():
+            _fail(f"{key}[{c}].edges: an edge is listed under two curves")
+        ec[edges] = c
+        curves.append(cv)
+    return tuple(curves), ec
 
 
 def export_fold(pattern: CreasePattern, **kw) -> str:
@@ -554,7 +642,12 @@ def _read(source) -> CreasePattern:
     if not reach <= 1e4:  # 10 km: beyond any sheet, and 1e300 overflowed the face checks
         _fail(f"a vertex lies {reach:.3g} m from the origin, beyond 1e4 m; check the "
               "coordinates and frame_unit")  # fmt: skip
+    curves, ec = (), None
+    if "holofold:curves" in d:
+        curves, ec = _curves_from_fold(d["holofold:curves"], ne, scale)
     try:
-        return CreasePattern(coords3, faces, edges, asg, ang, flat=flat, meta=meta)
+        return CreasePattern(
+            coords3, faces, edges, asg, ang, flat=flat, meta=meta, curves=curves, edge_curve=ec
+        )
     except ValueError as exc:
         _fail(str(exc))

@@ -25,11 +25,13 @@ from __future__ import annotations
 import math
 import os
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from holofold.geometry.bounded import read_source, source_name
+from holofold.geometry.curved import curve_edges
 from holofold.geometry.errors import FormatError
 from holofold.geometry.fold_io import _UNITS, MAX_FOLD_BYTES, _Bad, _parse, load_fold
 from holofold.geometry.line_drawing import (
@@ -214,11 +216,18 @@ def read_fold_pattern(source, *, frame: int | None = None, unit: float | None = 
         return pattern  # a 3-D pattern only: cuts and splits need a flat layout
     _check_creases_on_faces(pattern, where)
     coords3 = pattern.coords if folded is not None else None
-    return finish_pattern(
+    done = finish_pattern(
         pattern.flat, pattern.faces, pattern.edges, pattern.assignment, pattern.fold_angle,
         name=name, notes=notes, split=split, meta={**pattern.meta, "kind": "fold", "source": name},
         coords3=coords3,
     )  # fmt: skip
+    if not pattern.curves:
+        return done
+    # curves (holofold:curves): onto the finished edges (cuts separated, faces split)
+    curves = tuple(c.mapped(scale) for c in pattern.curves)
+    size = float(np.ptp(done.flat, axis=0).max())
+    ec = curve_edges(done.flat, done.edges, done.assignment, curves, tol=1e-9 * size)
+    return replace(done, curves=curves, edge_curve=ec)
 
 
 def _check_creases_on_faces(pattern, where: str) -> None:

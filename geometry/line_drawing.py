@@ -17,7 +17,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from holofold.geometry.arrangement import arrange_lines
+from holofold.geometry.arrangement import arrange_lines, default_tolerance
+from holofold.geometry.curved import curve_edges
 from holofold.geometry.cuts import separate_cuts
 from holofold.geometry.errors import FormatError, ParameterError
 from holofold.geometry.facets import SPLIT_MODES, split_faces
@@ -107,11 +108,12 @@ MAX_DRAWN_METRES = 1e4
 
 def pattern_from_lines(
     segments, assignment, fold_angle, *, name: str, unit: float, tol: float | None = None,
-    split: str = "as-needed", meta: dict | None = None, notes=(),
+    split: str = "as-needed", meta: dict | None = None, notes=(), curves=(),
 ) -> CreasePattern:  # fmt: skip
     """The crease pattern of drawn lines (drawing units; ``unit`` metres per drawing unit;
     ``tol`` the merge distance in drawing units, default 2e-3 of the drawing's larger side),
-    placed with the lower-left corner of its extent at the origin."""
+    placed with the lower-left corner of its extent at the origin; ``curves`` (drawing units,
+    y up) are kept as the pattern's ``curves`` with the edges that are their pieces."""
     if not (np.isfinite(unit) and unit > 0):
         raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
     if tol is not None and not (np.isfinite(tol) and tol > 0):
@@ -124,15 +126,36 @@ def pattern_from_lines(
             f"{name}: a line reaches {np.abs(S).max() * unit:.3g} m from the origin, beyond "
             f"{MAX_DRAWN_METRES:g} m; check the drawing's numbers and unit"
         )
+    pieces = _curve_pieces(S, assignment, curves, tol) if curves else None
     try:
-        arr = arrange_lines(segments, assignment, fold_angle, tol=tol)
+        arr = arrange_lines(segments, assignment, fold_angle, tol=tol, contract=pieces)
     except FormatError as exc:
         raise FormatError(f"{name}: {exc}") from None
     xy = (arr.vertices - arr.vertices.min(axis=0)) * unit  # lower-left corner at the origin
-    return finish_pattern(
+    pattern = finish_pattern(
         xy, arr.faces, arr.edges, arr.assignment, arr.fold_angle,
         name=name, notes=[*notes, *arr.notes], split=split, meta=meta,
     )  # fmt: skip
+    if curves:  # curved creases kept for output (metres, the pattern's frame)
+        curves = tuple(c.mapped(unit, -arr.vertices.min(axis=0) * unit) for c in curves)
+        reach = 2.0 * unit * (default_tolerance(S) if tol is None else tol)
+        ec = curve_edges(pattern.flat, pattern.edges, pattern.assignment, curves, tol=reach)
+        pattern = replace(pattern, curves=curves, edge_curve=ec)
+    return pattern
+
+
+def _curve_pieces(S, assignment, curves, tol) -> np.ndarray:
+    """(n,) bool: the lines shorter than the merge tolerance that are pieces of a curve."""
+    tol = default_tolerance(S) if tol is None else tol
+    short = np.flatnonzero(np.linalg.norm(S[:, 1] - S[:, 0], axis=1) <= tol)
+    out = np.zeros(len(S), bool)
+    if short.size:
+        xy = S[short].reshape(-1, 2)
+        e = np.arange(2 * short.size).reshape(-1, 2)
+        size = float(np.ptp(S.reshape(-1, 2), axis=0).max())
+        asg = np.asarray(assignment)[short]
+        out[short] = curve_edges(xy, e, asg, curves, tol=1e-9 * size) >= 0
+    return out
 
 
 def check_unit(unit) -> float:
@@ -170,7 +193,8 @@ class LineDrawing:
         What the reader assumed or left out, each a :class:`PatternWarning` line once the
         pattern is made.
     curves : tuple of :class:`~holofold.geometry.curved.Curve`
-        The curves kept, already cut into straight pieces among ``segments`` (drawing units).
+        The curves kept, already cut into straight pieces among ``segments`` (drawing units,
+        y up as the segments); :func:`pattern_from_drawing` keeps them on the pattern.
     unit_note : str
         The note (one of ``notes``) saying the unit was assumed; :meth:`with_unit` drops it.
     """
@@ -229,5 +253,5 @@ def pattern_from_drawing(
     d = drawing.with_unit(unit)
     return pattern_from_lines(
         d.segments, d.assignment, d.fold_angle, name=d.name, unit=d.unit, tol=tol, split=split,
-        meta={"kind": d.kind, "source": d.name}, notes=d.notes,
+        meta={"kind": d.kind, "source": d.name}, notes=d.notes, curves=d.curves,
     )  # fmt: skip

@@ -8,6 +8,13 @@ A :class:`CreasePattern` is the plain data every other layer consumes::
     assignment  (ne,) str       FOLD codes: M V B F C J U
     fold_angle  (ne,) float     FOLD convention: degrees in [-180, 180], valley > 0, mountain < 0
     flat        (nv, 2) float or None   the flat crease-pattern layout, metres, where one exists
+    curves      tuple of Curve  curved creases as drawn (metres, the flat layout's frame), or ()
+    edge_curve  (ne,) int or None   the curve each edge is a straight piece of, -1 for a straight
+                                edge; None when there are no curves
+
+Curves are kept only while they match the edges and the flat layout: a copy whose edges change
+(``dataclasses.replace`` with new edges) or whose flat layout no longer meets the curves (a
+scaled copy) drops them with one warning line.
 
 Edge order matters: the reference simulator (SWOMPS) numbers creases by walking the panels in
 order and, within a panel with vertices C1..CN, the edges (C1, CN), (C1, C2), ..., (C_{N-1}, C_N)
@@ -23,6 +30,7 @@ oriented; :func:`orient_faces` gives a consistently oriented copy where one is n
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -54,6 +62,8 @@ ASSIGNMENTS = ("M", "V", "B", "F", "C", "J", "U")
 MAX_PANELS = 10_000
 
 _REL_TOL = 1e-12  # relative tolerance for zero lengths and areas
+#: (flat, curves, edge_curve) object ids already found to meet -> the flat array (weakly held)
+_CURVES_MET: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
 
 
 def _as_faces(faces) -> tuple[np.ndarray, ...]:
@@ -335,6 +345,8 @@ class CreasePattern:
     fold_angle: np.ndarray
     flat: np.ndarray | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    curves: tuple = ()
+    edge_curve: np.ndarray | None = None
 
     # ------------------------------------------------------------------ construction
     def __post_init__(self):
@@ -389,6 +401,65 @@ class CreasePattern:
         object.__setattr__(self, "fold_angle", fold_angle)
         object.__setattr__(self, "meta", dict(self.meta))
         self._validate()
+        self._check_curves()
+
+    def _check_curves(self) -> None:
+        """Normalise ``curves``/``edge_curve``; drop them (one warning) where they no longer
+        match the edges or the flat layout."""
+        curves = tuple(self.curves)
+        if not curves:
+            object.__setattr__(self, "curves", ())
+            object.__setattr__(self, "edge_curve", None)
+            return
+        ec = None if self.edge_curve is None else np.asarray(self.edge_curve)
+        ne = len(self.edges)
+        why = ""
+        if ec is None or ec.shape != (ne,) or ec.dtype.kind not in "iu":
+            why = "the edges changed"
+        elif ne and (ec.min() < -1 or ec.max() >= len(curves)):
+            raise InvalidPatternError(
+                f"edge_curve has values outside -1..{len(curves) - 1} (one curve per edge)"
+            )
+        elif self.flat is not None and not self._curves_meet_flat(curves, ec):
+            why = "the flat layout no longer meets them (moved or scaled)"
+        if why:
+            import warnings
+
+            warnings.warn(f"{len(curves)} curve(s) dropped: {why}", UserWarning, stacklevel=4)
+            object.__setattr__(self, "curves", ())
+            object.__setattr__(self, "edge_curve", None)
+            return
+        ec = ec.astype(np.int64)
+        ec.flags.writeable = False
+        object.__setattr__(self, "curves", curves)
+        object.__setattr__(self, "edge_curve", ec)
+
+    def _curves_meet_flat(self, curves, ec) -> bool:
+        """The two ends of every curve's first piece lie within 1 % of the sheet of the curve
+        (merging and contracting short pieces move vertices by about 0.2 %; a scaled or moved
+        layout misses). Checked once per (flat layout, curves) pair of objects."""
+        key = (id(self.flat), id(curves), id(self.edge_curve))
+        if _CURVES_MET.get(key) is self.flat:
+            return True
+        size = float(np.ptp(self.flat, axis=0).max()) if len(self.flat) else 0.0
+        first = np.full(len(curves), -1, np.int64)
+        k = np.flatnonzero(ec >= 0)
+        first[ec[k[::-1]]] = k[::-1]  # the first piece of each curve
+        has = np.flatnonzero(first >= 0)
+        if has.size:
+            t = np.linspace(0.0, 1.0, 65)
+            poly = np.stack([curves[c].point(t) for c in has])  # (m, 65, 2)
+            a, d = poly[:, :-1], np.diff(poly, axis=1)
+            dd = np.maximum(np.einsum("msj,msj->ms", d, d), 1e-300)
+            for end in (0, 1):
+                q = self.flat[self.edges[first[has], end]]
+                w = q[:, None, :] - a
+                u = np.clip(np.einsum("msj,msj->ms", w, d) / dd, 0.0, 1.0)
+                gap = np.linalg.norm(w - u[..., None] * d, axis=2).min(axis=1)
+                if (gap > 1e-2 * size).any():
+                    return False
+        _CURVES_MET[key] = self.flat
+        return True
 
     def _validate(self) -> None:
         nv, ne = len(self.coords), len(self.edges)

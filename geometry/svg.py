@@ -22,6 +22,7 @@ the origami-simulator files back (with :mod:`xml.etree`, nothing evaluated).
 
 from __future__ import annotations
 
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -38,7 +39,7 @@ from holofold.geometry.cutter import (
 from holofold.geometry.errors import FormatError, ParameterError, check_range
 from holofold.geometry.pattern import CreasePattern
 
-__all__ = ["COLOURS", "export_svg", "polylines_svg", "load_svg", "SvgLines"]
+__all__ = ["COLOURS", "export_svg", "polylines_svg", "load_svg", "SvgLines", "curve_path"]
 
 COLOURS = {
     "M": "#ff0000",
@@ -167,9 +168,21 @@ def _simulator_groups(pattern, draw, width, min_opacity, show_facets) -> list[st
     groups: dict[str, list[str]] = {"cut": [], "score": []}
     P = {int(e): seg for role, segs in draw.lines.items()
          for e, seg in zip(draw.edges[role], segs, strict=True)}  # fmt: skip
+    on_curves = draw.curve_edges
+    for parts_ids in draw.curves.values():
+        for parts, ids in parts_ids:
+            i = int(ids[0])
+            code = str(pattern.assignment[i])
+            ang = float(pattern.fold_angle[i])
+            opacity = max(abs(ang) / 180.0, min_opacity) if code in ("M", "V") and ang != 0 else 1.0
+            groups["cut" if code in _CUT else "score"].append(
+                f'<path d="{curve_path(parts)}" stroke="{COLOURS[code]}" '
+                f'stroke-opacity="{opacity:.6g}" data-assignment="{code}" '
+                f'data-foldAngle="{ang:.12g}" data-edges="{" ".join(map(str, ids.tolist()))}"/>'
+            )
     for i in range(pattern.n_edges):
         code = str(pattern.assignment[i])
-        if code == "J" and not show_facets:
+        if (code == "J" and not show_facets) or i in on_curves:
             continue
         if code == "J":
             a, b = pattern.edges[i]
@@ -191,6 +204,29 @@ def _simulator_groups(pattern, draw, width, min_opacity, show_facets) -> list[st
         + "\n</g>"
         for gid, lines in groups.items()
     ]
+
+
+def curve_path(parts) -> str:
+    """SVG path data of curves (page units): per part ``M`` then ``L`` / ``Q`` / ``C`` (a Bezier
+    of degree 1 / 2 / 3) or ``A`` (an elliptical arc; two when it sweeps 1.9 pi or more)."""
+    out = []
+    for cv in parts:
+        p0 = cv.point(0.0)[0]
+        d = [f"M {p0[0]:.9f} {p0[1]:.9f}"]
+        if cv.kind == "bezier":
+            cmd = {2: "L", 3: "Q", 4: "C"}[len(cv.points)]
+            d.append(cmd + " " + " ".join(f"{x:.9f} {y:.9f}" for x, y in cv.points[1:]))
+        else:
+            n = 1 if abs(cv.sweep) < 1.9 * np.pi else 2
+            rx, ry = cv.radii
+            rot = np.degrees(cv.rotation)
+            for k in range(n):
+                q = cv.point((k + 1) / n)[0]
+                large = int(abs(cv.sweep) / n > np.pi)
+                sweep = int(cv.sweep > 0)
+                d.append(f"A {rx:.9f} {ry:.9f} {rot:.9f} {large} {sweep} {q[0]:.9f} {q[1]:.9f}")
+        out.append(" ".join(d))
+    return " ".join(out)
 
 
 def _page_segment(pattern, draw, a, b) -> np.ndarray:
@@ -222,7 +258,16 @@ def _cutter_layers(draw, width) -> list[str]:
                         f'<path d="{d}" stroke="{st.colour}" stroke-width="{width[role]}"/>'
                     )
                 continue
+            for parts, ids in draw.curves.get(role, ()):
+                items.append(
+                    f'<path d="{curve_path(parts)}" stroke="{st.colour}" '
+                    f'stroke-width="{width[role]}" data-role="{role}" '
+                    f'data-edges="{" ".join(map(str, ids.tolist()))}"/>'
+                )
             segs, owner = draw.lines.get(role), draw.edges.get(role)
+            if segs is not None and len(segs) and draw.curves:
+                keep = ~np.isin(owner, list(draw.curve_edges))
+                segs, owner = segs[keep], owner[keep]
             if segs is None or not len(segs):
                 continue
             cuts = np.flatnonzero(np.diff(owner)) + 1
@@ -294,7 +339,8 @@ def _code_of(el) -> str:
 
 
 def load_svg(text: str | bytes) -> SvgLines:
-    """Read the ``<line>`` elements of an SVG crease pattern written by :func:`export_svg`.
+    """Read the ``<line>`` elements of an SVG crease pattern written by :func:`export_svg`
+    (a kept curve's ``<path>`` is not read: one warning line says how many).
 
     Coordinates are converted back from millimetres with y flipped up, relative to the
     drawing's lower-left corner (the margin removed only if the file is one of ours, i.e. all
@@ -335,8 +381,18 @@ def load_svg(text: str | bytes) -> SvgLines:
                 angles.append(float(ang))
                 groups.append(group)
                 ids.append(int(child.get("data-edge", "-1")))
+            elif tag == "path" and child.get("data-edges") is not None:
+                curved.append(child)
 
+    curved: list = []
     walk(root, "")
+    if curved:
+        warnings.warn(
+            f"SVG: {len(curved)} curved crease path(s) (data-edges) not read: load_svg reads "
+            "<line>s; read_svg_pattern reads the curves",
+            UserWarning,
+            stacklevel=2,
+        )
     if not segs:
         raise FormatError("SVG: no <line> elements found")
     return SvgLines(

@@ -32,6 +32,7 @@ from collections import Counter
 
 import numpy as np
 
+from holofold.geometry.arrangement import REL_TOL
 from holofold.geometry.bounded import check_svg_pattern, read_source, source_name
 from holofold.geometry.curved import (
     CHORD_DEFAULT,
@@ -261,7 +262,7 @@ def svg_drawing(
         length = LENGTH_DEFAULT * size if curve_length is None else curve_length
         n_pieces = 0
         for c in kept:
-            cp = discretise(c, chord=chord, length=length)
+            cp = discretise(c, chord=chord, length=length, shortest=REL_TOL * size)
             n_pieces += len(cp) - 1
             for a, b in zip(cp[:-1], cp[1:], strict=True):
                 segs.append([a, b])
@@ -297,7 +298,8 @@ def svg_drawing(
     S[..., 1] *= -1.0  # y up
     mpp = _metres_per_px(svg, name)
     return LineDrawing(S, np.array(codes, dtype="<U1"), np.array(angles, float), mpp,
-                       name=name, kind="svg", notes=tuple(notes), curves=tuple(kept))  # fmt: skip
+                       name=name, kind="svg", notes=tuple(notes),
+                       curves=tuple(c.mapped(flip_y=True) for c in kept))  # fmt: skip
 
 
 def svg_lines(path, *, curves: str = "keep", curve_chord=None, curve_length=None):
