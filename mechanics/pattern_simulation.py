@@ -268,10 +268,11 @@ class PatternSimulation:
 
 
 def scaled_pattern(pattern: CreasePattern, factor: float) -> CreasePattern:
-    """``pattern`` with every length multiplied by ``factor``."""
+    """``pattern`` with every length multiplied by ``factor`` (its curved creases too)."""
     check_range("scale factor", factor, 0.0, None, low_open=True)
     flat = None if pattern.flat is None else pattern.flat * factor
-    return replace(pattern, coords=pattern.coords * factor, flat=flat)
+    curves = tuple(c.mapped(factor) for c in pattern.curves)
+    return replace(pattern, coords=pattern.coords * factor, flat=flat, curves=curves)
 
 
 def pattern_mass(pattern: CreasePattern, setting: PatternSetting) -> float:

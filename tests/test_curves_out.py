@@ -468,3 +468,16 @@ def test_load_svg_says_it_leaves_the_curve_paths_out(sheet):
     assert len(lines.segments) == int(
         (sheet.assignment != "J").sum() - (sheet.edge_curve >= 0).sum()
     )
+
+
+def test_a_scaled_pattern_keeps_its_curves_scaled(sheet):
+    from holofold.mechanics import scaled_pattern
+
+    p = sheet
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no 'curves dropped' warning
+        q = scaled_pattern(p, 0.5)
+    assert len(q.curves) == len(p.curves) and q.edge_curve.tolist() == p.edge_curve.tolist()
+    for a, b in zip(p.curves, q.curves, strict=True):
+        for t in (0.0, 0.3, 1.0):
+            assert np.allclose(b.point(t), 0.5 * np.asarray(a.point(t)), rtol=1e-12, atol=0)
