@@ -36,6 +36,10 @@ CCD_SAFETY = 0.9  # fraction of the collision-free step taken
 #: Levenberg-Marquardt shift of the barrier solve where the tangent gives no descent (a snap
 #: with panels in contact), from MU_MIN to MU_MAX x the tangent's mean diagonal
 MU_MIN, MU_MAX = 1e-8, 1e8
+#: the farthest one barrier-Newton update moves a node, as a fraction of the sheet's size (a
+#: trust region: a near-singular tangent gave updates of 1e10 m, whose continuous collision
+#: check asked ipctk's spatial hash for gigabytes)
+MAX_MOVE = 0.1
 
 
 def has_ipctk() -> bool:
@@ -97,6 +101,11 @@ class PanelContact:
         self.kappa = float(kappa)
         self.barrier = ipc.BarrierPotential(self.dhat, self.kappa)
         self.n_dof = self.X0.size
+        self.size = float(np.ptp(self.X0, axis=0).max()) if len(self.X0) else 0.0
+        # additive CCD (Li, Kaufman, Jiang 2021: the CCD of codimensional IPC, made for a
+        # minimum distance); ipctk's default tight-inclusion CCD ran out of memory (> 13 GB)
+        # on two parallel layers 1.4 mm apart with a 1 mm minimum distance (a z-fold)
+        self.ccd = ipc.AdditiveCCD()
         self._panels_of_node = _panels_of_node(structure)
         self.last_active = 0
         self.touched = (0, (-1, -1))  # the most pairs within reach in the last solve, where
@@ -194,10 +203,18 @@ class PanelContact:
 
     def free_step(self, U0, U1) -> float:
         """Largest fraction in [0, 1] of the straight path ``U0 -> U1`` on which no two
-        primitives come closer than ``dmin`` (CCD)."""
-        return float(
+        primitives come closer than ``dmin`` (CCD). A path moving a node farther than the
+        sheet's size is checked over its first sheet size only (0 for a non-finite one)."""
+        U0 = np.asarray(U0, float)
+        move = np.asarray(U1, float) - U0
+        far = float(np.abs(move).max()) if move.size else 0.0
+        if not math.isfinite(far):
+            return 0.0
+        reach = min(1.0, self.size / far) if far > 0 and self.size > 0 else 1.0
+        X1 = self._pos(U0 + reach * move)
+        return reach * float(
             self.ipc.compute_collision_free_stepsize(
-                self.mesh, self._pos(U0), self._pos(U1), self.dmin
+                self.mesh, self._pos(U0), X1, self.dmin, None, self.ccd
             )
         )
 
@@ -247,6 +264,9 @@ class PanelContact:
             if d is None:
                 return None
             d, mu = d
+            far = float(np.abs(d).max())
+            if far > MAX_MOVE * self.size > 0:  # a trust region for near-singular tangents
+                d = d * (MAX_MOVE * self.size / far)
             self.newton_steps += 1
             trial = U.copy()
             trial[free] += d

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -93,10 +94,15 @@ def test_self_intersecting_fold_is_kept_clean_by_contact():
     checked = fold_pattern(p, 1.0, **SECTION)
     assert checked.verdict == "folds until panels touch"
     assert 0.7 < checked.touch_at < 0.85
-    on = fold_pattern(p, 1.0, contact=True, time_limit=4.0, **SECTION)
+    # with contact the flaps' edges meet (76 %) and one slides over the other, as a letter
+    # folds in three: both fold on, every state clean, the upper flap held on the lower one
+    on = fold_pattern(p, 1.0, contact=True, **SECTION)
     assert not any(intersects(on.structure, U) for U in on.U)
-    assert on.reached < 0.95  # the outer panels stop where they touch (about 76 %)
-    assert on.fold_angles[-1][p.interior] == pytest.approx([133.0, 133.0], abs=3.0)
+    assert on.reached == 1.0 and "held a panel thickness apart" in on.note
+    assert 74.0 < float(re.search(r"touch from ([0-9.]+) %", on.note).group(1)) < 78.0
+    low, high = sorted(on.fold_angles[-1][p.interior])
+    assert 172.0 < high < 176.0  # the lower flap: within a few degrees of its 175 deg target
+    assert 150.0 < low < 170.0  # the upper flap rests on the lower one
 
 
 def test_contact_without_active_pairs_changes_nothing():
