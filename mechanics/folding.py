@@ -67,6 +67,7 @@ __all__ = [
     "fold_targets",
     "crease_classes",
     "default_supports",
+    "vertex_closure",
     "MAX_FOLD_DEG",
     "RIGID_BEND_DEG",
     "RIGID_STRAIN",
@@ -85,6 +86,9 @@ RIGID_STRAIN = 1e-3
 BEND_NOTE_DEG = 5.0
 #: a driven crease counts as folded the wrong way beyond this angle of the wrong sign, degrees
 WRONG_WAY_DEG = 10.0
+#: a vertex whose full targets miss closing by more than this (degrees) has no rigid folded
+#: state with those fold angles (:func:`vertex_closure`)
+CLOSURE_DEG = 0.5
 #: the bar-and-hinge models a pattern can be folded with
 MODELS = ("concentrated", "compliant")
 #: a driven crease that turns less than this share of its actuated target is stuck
@@ -118,6 +122,59 @@ def fold_targets(pattern: CreasePattern, target=None) -> np.ndarray:
         )
     cls = crease_classes(pattern)
     return np.where(cls == DRIVEN, np.clip(t, -MAX_FOLD_DEG, MAX_FOLD_DEG), 0.0)
+
+
+def vertex_closure(pattern: CreasePattern, target=None) -> np.ndarray:
+    """(nv,) degrees: how far the fold angles miss closing around every interior vertex.
+
+    Going round a vertex of the flat layout through its sectors and creases, a rigid folded
+    state needs ``R = prod_i Rx(rho_i) Rz(alpha_i) = I`` (``alpha_i`` the sector from crease
+    ``i`` to the next, ``rho_i`` its fold angle; the loop-closure condition of rigid origami,
+    necessary at every vertex). Returns the rotation angle of ``R``: 0 where the angles close,
+    more where no rigid state has them (the panels must bend). ``target`` (ne,) degrees
+    (FOLD sign), default ``pattern.fold_angle``, counted on driven creases (M, V) only, not
+    capped; facets and passive creases stay flat. For targets of +-180 degrees it is the
+    Kawasaki error (the alternating sector sum's distance from 180 degrees). NaN at border
+    vertices and where no driven crease meets the vertex. Needs a flat layout."""
+    if pattern.flat is None:
+        raise ParameterError("vertex_closure needs a pattern with a flat layout")
+    t = pattern.fold_angle if target is None else np.asarray(target, float)
+    if t.shape != (pattern.n_edges,):
+        raise ParameterError(f"target must be {pattern.n_edges} fold angles (degrees)")
+    cls = crease_classes(pattern)
+    rho = np.radians(np.where(cls == DRIVEN, t, 0.0))
+    xy = pattern.flat
+    nv = pattern.n_vertices
+    out = np.full(nv, np.nan)
+    border = np.zeros(nv, bool)
+    border[pattern.edges[cls < 0].ravel()] = True
+    E = pattern.edges
+    ends = np.concatenate([E[:, 0], E[:, 1]])
+    other = np.concatenate([E[:, 1], E[:, 0]])
+    eid = np.concatenate([np.arange(len(E)), np.arange(len(E))])
+    keep = (cls[eid] == DRIVEN) | (cls[eid] == FACET) | (cls[eid] == PASSIVE)
+    ends, other, eid = ends[keep], other[keep], eid[keep]
+    d = xy[other] - xy[ends]
+    ang = np.arctan2(d[:, 1], d[:, 0])
+    order = np.lexsort((ang, ends))
+    ends, eid, ang = ends[order], eid[order], ang[order]
+    cut = np.flatnonzero(np.diff(ends)) + 1
+    for lo, hi in zip(np.concatenate([[0], cut]), np.concatenate([cut, [len(ends)]]), strict=True):
+        v = int(ends[lo])
+        es = eid[lo:hi]
+        if border[v] or not (cls[es] == DRIVEN).any():
+            continue
+        a = ang[lo:hi]
+        sect = np.diff(np.concatenate([a, [a[0] + 2 * math.pi]]))
+        R = np.eye(3)
+        for r, al in zip(rho[es], sect, strict=True):
+            c, s_ = math.cos(r), math.sin(r)
+            Rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s_], [0.0, s_, c]])
+            c, s_ = math.cos(al), math.sin(al)
+            Rz = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+            R = R @ Rx @ Rz
+        out[v] = math.degrees(math.acos(min(1.0, max(-1.0, (np.trace(R) - 1.0) / 2.0))))
+    return out
 
 
 def _components(pattern: CreasePattern) -> np.ndarray:
@@ -602,7 +659,7 @@ def fold_pattern(
                 f"{wrong.size} of {int(driven.sum())} driven creases folded against their "
                 f"assignment, the first at {100 * wrong_at:.1f} % (edge {first}): the fold "
                 "took another branch"
-            )
+            ) + _wrong_way_cause(base, tgt, angles, wrong)
             if touched:
                 note += f"; then {touched}"
         elif touched:
@@ -667,6 +724,30 @@ def fold_pattern(
         snaps=np.array(snaps), elapsed=np.array(clock), wrong_at=wrong_at,
         touch_at=touch_at, touch_where=touch_where,
     )  # fmt: skip
+
+
+def _wrong_way_cause(pattern: CreasePattern, tgt, angles, wrong) -> str:
+    """The part of the wrong-way note that says why: whether the wrong creases already stood
+    against their assignment after the first step (the branch taken at flat), and whether the
+    targets close at the interior vertices (:func:`vertex_closure`)."""
+    out = ""
+    if len(angles) > 1 and wrong.size:
+        early = int((np.sign(angles[1, wrong]) == -np.sign(tgt[wrong])).sum())
+        out += f"; {early} of them stood against it from the first step"
+    if pattern.flat is None:
+        return out
+    cl = vertex_closure(pattern)
+    inner = np.isfinite(cl)
+    bad = inner & (cl > CLOSURE_DEG)
+    if bad.any():
+        out += (
+            f"; the targets do not close at {int(bad.sum())} of {int(inner.sum())} interior "
+            f"vertices (by up to {float(cl[bad].max()):.1f} deg): no rigid folded state has "
+            "these fold angles"
+        )
+    elif inner.any():
+        out += "; the targets close at every interior vertex"
+    return out
 
 
 def _first_intersecting(pattern: CreasePattern, coords: np.ndarray):
