@@ -261,6 +261,12 @@ class FoldResult:
         barrier stopped the fold were within its reach (NaN: neither).
     touch_where : (int, int)
         Two faces that pass through each other there ((-1, -1): none, or not located).
+    hinge_angles : (k, ne) float
+        Every crease's fold angle at the crease itself, degrees (FOLD sign), unwrapped along
+        the path: the dihedral angle of its hinge spring (the sum over its strip's springs in
+        a compliant model), 0 for edges that are not creases. ``fold_angles`` reads the angle
+        between the mean normals of the two panels, which differs where panels bend; whether a
+        crease turns against its assignment is judged on this reading.
     halvings : int
         Steps retried at a smaller size.
     snaps : (n,) float
@@ -290,6 +296,7 @@ class FoldResult:
     wrong_at: float = float("nan")
     touch_at: float = float("nan")
     touch_where: tuple[int, int] = (-1, -1)
+    hinge_angles: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
     def reached(self) -> float:
@@ -617,8 +624,9 @@ def fold_pattern(
     energy = model_energy(structure, Uh[-1], final_rest, n_edges=ne)
     driven = (cls == DRIVEN) & (tgt != 0)
     last = angles[-1]
+    hinges = _hinge_angles(structure, Uh, ne)
     against_path = (
-        driven[None] & (np.sign(angles) != np.sign(tgt)[None]) & (np.abs(angles) > WRONG_WAY_DEG)
+        driven[None] & (np.sign(hinges) != np.sign(tgt)[None]) & (np.abs(hinges) > WRONG_WAY_DEG)
     )
     wrong = np.flatnonzero(against_path[-1])
     went = np.flatnonzero(against_path.any(axis=1))
@@ -659,7 +667,7 @@ def fold_pattern(
                 f"{wrong.size} of {int(driven.sum())} driven creases folded against their "
                 f"assignment, the first at {100 * wrong_at:.1f} % (edge {first}): the fold "
                 "took another branch"
-            ) + _wrong_way_cause(base, tgt, angles, wrong)
+            ) + _wrong_way_cause(base, tgt, hinges, wrong)
             if touched:
                 note += f"; then {touched}"
         elif touched:
@@ -722,14 +730,15 @@ def fold_pattern(
         U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
         verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
         snaps=np.array(snaps), elapsed=np.array(clock), wrong_at=wrong_at,
-        touch_at=touch_at, touch_where=touch_where,
+        touch_at=touch_at, touch_where=touch_where, hinge_angles=hinges,
     )  # fmt: skip
 
 
 def _wrong_way_cause(pattern: CreasePattern, tgt, angles, wrong) -> str:
     """The part of the wrong-way note that says why: whether the wrong creases already stood
-    against their assignment after the first step (the branch taken at flat), and whether the
-    targets close at the interior vertices (:func:`vertex_closure`)."""
+    against their assignment after the first step (``angles`` (k, ne) degrees, the hinge
+    reading: the branch taken at flat), and whether the targets close at the interior
+    vertices (:func:`vertex_closure`)."""
     out = ""
     if len(angles) > 1 and wrong.size:
         early = int((np.sign(angles[1, wrong]) == -np.sign(tgt[wrong])).sum())
@@ -851,6 +860,26 @@ def _fold_angles(pattern: CreasePattern, structure: Structure, Uh: np.ndarray) -
     out = np.zeros((len(Uh), pattern.n_edges))
     # unwrapped along the states (axis 0): a crease passing +-180 deg keeps its side
     out[:, e] = np.degrees(np.unwrap(np.arctan2(s, c), axis=0))
+    return out
+
+
+def _hinge_angles(structure: Structure, Uh: np.ndarray, ne: int) -> np.ndarray:
+    """(k, ne) fold angle of every crease at its hinge, degrees (FOLD sign), unwrapped along
+    the k states: the hinge spring's dihedral angle less pi (concentrated), or the sum over
+    the strip's two edge lines and its centre line (compliant); 0 for other edges."""
+    from holofold.mechanics.springs import dihedral_angle
+
+    out = np.zeros((len(Uh), ne))
+    cm = structure.creases
+    if cm is None or not len(cm.ids):
+        return out
+    th = np.unwrap(dihedral_angle(structure.nodes[None] + Uh, structure.springs), axis=0) - np.pi
+    cs = cm.springs
+    if cm.compliant:
+        a = th[:, cs[:, 0]] + th[:, cs[:, 1]] + 0.5 * (th[:, cs[:, 4]] + th[:, cs[:, 5]])
+    else:
+        a = th[:, cs[:, 0]]
+    out[:, cm.ids] = np.degrees(a)
     return out
 
 

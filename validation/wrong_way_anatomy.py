@@ -134,6 +134,14 @@ def anatomy(path: Path, limit: float, **settings) -> dict:
         for v in r.pattern.edges[e]:
             inc.setdefault(int(v), []).append(int(e))
     first = A[1] if len(A) > 1 else A[0]
+    # the crease springs' own dihedral angles in the last state (the hinge, not the panels'
+    # mean normals): a second reading of every fold angle
+    from holofold.mechanics.springs import dihedral_angle
+
+    cm = r.structure.creases
+    th = dihedral_angle(r.structure.nodes + r.U[-1], r.structure.springs)
+    hinge = np.zeros(r.pattern.n_edges)
+    hinge[cm.ids] = np.degrees(th[cm.springs[:, 0]] - np.pi)
     side1 = np.sign(first) * np.sign(tgt)
     creases = []
     for e in ever:
@@ -147,6 +155,7 @@ def anatomy(path: Path, limit: float, **settings) -> dict:
                 target_deg=round(float(tgt[e]), 2),
                 against_max_deg=round(float(against[:, e].max()), 2),
                 against_end_deg=round(float(against[-1, e]), 2),
+                hinge_against_end_deg=round(float(-np.sign(tgt[e]) * hinge[e]), 2),
                 first_at=round(float(r.fractions[np.flatnonzero(bad[:, e])[0]]), 4),
                 step1_deg=round(float(first[e] * np.sign(tgt[e])), 4),
                 step1_side=int(side1[e]),
@@ -200,7 +209,9 @@ def report(rec: dict) -> str:
         )
         lines.append(
             f"  e{c['edge']} {c['assignment']} tgt {c['target_deg']} against max "
-            f"{c['against_max_deg']} end {c['against_end_deg']} from {c['first_at']} "
+            f"{c['against_max_deg']} end {c['against_end_deg']} "
+            f"(hinge {c['hinge_against_end_deg']}) "
+            f"from {c['first_at']} "
             f"step1 {c['step1_deg']} k/nb {c['stiffness_rel']} L {c['length_mm']} mm "
             f"small {c['small_target']} unwrapped {c['unwrapped']} jump {c['max_jump_deg']} "
             f"| {ends}"
