@@ -32,7 +32,9 @@ stretches by more than :data:`RIGID_STRAIN`), ``folds off target`` (panels stay 
 driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the targets are
 not those of a rigid folding),
 ``turns against its assignment`` (driven creases folded more than :data:`WRONG_WAY_DEG` the
-wrong way in the last state; the note gives the fraction at which the first one did) or
+wrong way at their hinges in the last state; the note gives the fraction at which the first
+one did, how many stood against their assignment from the first step, and whether the
+targets close at every interior vertex, :func:`vertex_closure`) or
 ``stalls`` (a step would not converge, and neither the energy minimisation nor the
 pseudo-transient flow of :mod:`holofold.mechanics.leave_flat` found an equilibrium beyond),
 or ``folds until panels touch`` (a state had panels passing through each other: the fold
