@@ -875,12 +875,19 @@ def _hinge_angles(structure: Structure, Uh: np.ndarray, ne: int) -> np.ndarray:
     cm = structure.creases
     if cm is None or not len(cm.ids):
         return out
-    th = np.unwrap(dihedral_angle(structure.nodes[None] + Uh, structure.springs), axis=0) - np.pi
     cs = cm.springs
+    cols = [0, 1, 4, 5] if cm.compliant else [0]
+    used = cs[:, cols]  # (nci, 1 or 4) spring ids, read in chunks of states (memory)
+    sp = structure.springs[used.ravel()]
+    th = np.empty((len(Uh), sp.shape[0]))
+    for k0 in range(0, len(Uh), 16):
+        X = structure.nodes[None] + Uh[k0 : k0 + 16]
+        th[k0 : k0 + 16] = dihedral_angle(X, sp)
+    th = (np.unwrap(th, axis=0) - np.pi).reshape(len(Uh), *used.shape)
     if cm.compliant:
-        a = th[:, cs[:, 0]] + th[:, cs[:, 1]] + 0.5 * (th[:, cs[:, 4]] + th[:, cs[:, 5]])
+        a = th[..., 0] + th[..., 1] + 0.5 * (th[..., 2] + th[..., 3])
     else:
-        a = th[:, cs[:, 0]]
+        a = th[..., 0]
     out[:, cm.ids] = np.degrees(a)
     return out
 
