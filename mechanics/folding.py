@@ -32,7 +32,9 @@ stretches by more than :data:`RIGID_STRAIN`), ``folds off target`` (panels stay 
 driven creases turn less than :data:`STUCK_RATIO` of their actuated target: the targets are
 not those of a rigid folding),
 ``turns against its assignment`` (driven creases folded more than :data:`WRONG_WAY_DEG` the
-wrong way in the last state; the note gives the fraction at which the first one did) or
+wrong way at their hinges in the last state; the note gives the fraction at which the first
+one did, how many stood against their assignment from the first step, and whether the
+targets close at every interior vertex, :func:`vertex_closure`) or
 ``stalls`` (a step would not converge, and neither the energy minimisation nor the
 pseudo-transient flow of :mod:`holofold.mechanics.leave_flat` found an equilibrium beyond),
 or ``folds until panels touch`` (a state had panels passing through each other: the fold
@@ -67,6 +69,7 @@ __all__ = [
     "fold_targets",
     "crease_classes",
     "default_supports",
+    "vertex_closure",
     "MAX_FOLD_DEG",
     "RIGID_BEND_DEG",
     "RIGID_STRAIN",
@@ -85,6 +88,9 @@ RIGID_STRAIN = 1e-3
 BEND_NOTE_DEG = 5.0
 #: a driven crease counts as folded the wrong way beyond this angle of the wrong sign, degrees
 WRONG_WAY_DEG = 10.0
+#: a vertex whose full targets miss closing by more than this (degrees) has no rigid folded
+#: state with those fold angles (:func:`vertex_closure`)
+CLOSURE_DEG = 0.5
 #: the bar-and-hinge models a pattern can be folded with
 MODELS = ("concentrated", "compliant")
 #: a driven crease that turns less than this share of its actuated target is stuck
@@ -118,6 +124,59 @@ def fold_targets(pattern: CreasePattern, target=None) -> np.ndarray:
         )
     cls = crease_classes(pattern)
     return np.where(cls == DRIVEN, np.clip(t, -MAX_FOLD_DEG, MAX_FOLD_DEG), 0.0)
+
+
+def vertex_closure(pattern: CreasePattern, target=None) -> np.ndarray:
+    """(nv,) degrees: how far the fold angles miss closing around every interior vertex.
+
+    Going round a vertex of the flat layout through its sectors and creases, a rigid folded
+    state needs ``R = prod_i Rx(rho_i) Rz(alpha_i) = I`` (``alpha_i`` the sector from crease
+    ``i`` to the next, ``rho_i`` its fold angle; the loop-closure condition of rigid origami,
+    necessary at every vertex). Returns the rotation angle of ``R``: 0 where the angles close,
+    more where no rigid state has them (the panels must bend). ``target`` (ne,) degrees
+    (FOLD sign), default ``pattern.fold_angle``, counted on driven creases (M, V) only, not
+    capped; facets and passive creases stay flat. For targets of +-180 degrees it is the
+    Kawasaki error (the alternating sector sum's distance from 180 degrees). NaN at border
+    vertices and where no driven crease meets the vertex. Needs a flat layout."""
+    if pattern.flat is None:
+        raise ParameterError("vertex_closure needs a pattern with a flat layout")
+    t = pattern.fold_angle if target is None else np.asarray(target, float)
+    if t.shape != (pattern.n_edges,):
+        raise ParameterError(f"target must be {pattern.n_edges} fold angles (degrees)")
+    cls = crease_classes(pattern)
+    rho = np.radians(np.where(cls == DRIVEN, t, 0.0))
+    xy = pattern.flat
+    nv = pattern.n_vertices
+    out = np.full(nv, np.nan)
+    border = np.zeros(nv, bool)
+    border[pattern.edges[cls < 0].ravel()] = True
+    E = pattern.edges
+    ends = np.concatenate([E[:, 0], E[:, 1]])
+    other = np.concatenate([E[:, 1], E[:, 0]])
+    eid = np.concatenate([np.arange(len(E)), np.arange(len(E))])
+    keep = (cls[eid] == DRIVEN) | (cls[eid] == FACET) | (cls[eid] == PASSIVE)
+    ends, other, eid = ends[keep], other[keep], eid[keep]
+    d = xy[other] - xy[ends]
+    ang = np.arctan2(d[:, 1], d[:, 0])
+    order = np.lexsort((ang, ends))
+    ends, eid, ang = ends[order], eid[order], ang[order]
+    cut = np.flatnonzero(np.diff(ends)) + 1
+    for lo, hi in zip(np.concatenate([[0], cut]), np.concatenate([cut, [len(ends)]]), strict=True):
+        v = int(ends[lo])
+        es = eid[lo:hi]
+        if border[v] or not (cls[es] == DRIVEN).any():
+            continue
+        a = ang[lo:hi]
+        sect = np.diff(np.concatenate([a, [a[0] + 2 * math.pi]]))
+        R = np.eye(3)
+        for r, al in zip(rho[es], sect, strict=True):
+            c, s_ = math.cos(r), math.sin(r)
+            Rx = np.array([[1.0, 0.0, 0.0], [0.0, c, -s_], [0.0, s_, c]])
+            c, s_ = math.cos(al), math.sin(al)
+            Rz = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+            R = R @ Rx @ Rz
+        out[v] = math.degrees(math.acos(min(1.0, max(-1.0, (np.trace(R) - 1.0) / 2.0))))
+    return out
 
 
 def _components(pattern: CreasePattern) -> np.ndarray:
@@ -204,6 +263,12 @@ class FoldResult:
         barrier stopped the fold were within its reach (NaN: neither).
     touch_where : (int, int)
         Two faces that pass through each other there ((-1, -1): none, or not located).
+    hinge_angles : (k, ne) float
+        Every crease's fold angle at the crease itself, degrees (FOLD sign), unwrapped along
+        the path: the dihedral angle of its hinge spring (the sum over its strip's springs in
+        a compliant model), 0 for edges that are not creases. ``fold_angles`` reads the angle
+        between the mean normals of the two panels, which differs where panels bend; whether a
+        crease turns against its assignment is judged on this reading.
     halvings : int
         Steps retried at a smaller size.
     snaps : (n,) float
@@ -233,6 +298,7 @@ class FoldResult:
     wrong_at: float = float("nan")
     touch_at: float = float("nan")
     touch_where: tuple[int, int] = (-1, -1)
+    hinge_angles: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
     def reached(self) -> float:
@@ -560,8 +626,9 @@ def fold_pattern(
     energy = model_energy(structure, Uh[-1], final_rest, n_edges=ne)
     driven = (cls == DRIVEN) & (tgt != 0)
     last = angles[-1]
+    hinges = _hinge_angles(structure, Uh, ne)
     against_path = (
-        driven[None] & (np.sign(angles) != np.sign(tgt)[None]) & (np.abs(angles) > WRONG_WAY_DEG)
+        driven[None] & (np.sign(hinges) != np.sign(tgt)[None]) & (np.abs(hinges) > WRONG_WAY_DEG)
     )
     wrong = np.flatnonzero(against_path[-1])
     went = np.flatnonzero(against_path.any(axis=1))
@@ -602,7 +669,7 @@ def fold_pattern(
                 f"{wrong.size} of {int(driven.sum())} driven creases folded against their "
                 f"assignment, the first at {100 * wrong_at:.1f} % (edge {first}): the fold "
                 "took another branch"
-            )
+            ) + _wrong_way_cause(base, tgt, hinges, wrong)
             if touched:
                 note += f"; then {touched}"
         elif touched:
@@ -665,8 +732,33 @@ def fold_pattern(
         U=Uh, coords=coords, fold_angles=angles, rest=final_rest, status=status,
         verdict=verdict, note=note, energy=energy, wrong_way=wrong, halvings=halvings,
         snaps=np.array(snaps), elapsed=np.array(clock), wrong_at=wrong_at,
-        touch_at=touch_at, touch_where=touch_where,
+        touch_at=touch_at, touch_where=touch_where, hinge_angles=hinges,
     )  # fmt: skip
+
+
+def _wrong_way_cause(pattern: CreasePattern, tgt, angles, wrong) -> str:
+    """The part of the wrong-way note that says why: whether the wrong creases already stood
+    against their assignment after the first step (``angles`` (k, ne) degrees, the hinge
+    reading: the branch taken at flat), and whether the targets close at the interior
+    vertices (:func:`vertex_closure`)."""
+    out = ""
+    if len(angles) > 1 and wrong.size:
+        early = int((np.sign(angles[1, wrong]) == -np.sign(tgt[wrong])).sum())
+        out += f"; {early} of them stood against it from the first step"
+    if pattern.flat is None:
+        return out
+    cl = vertex_closure(pattern)
+    inner = np.isfinite(cl)
+    bad = inner & (cl > CLOSURE_DEG)
+    if bad.any():
+        out += (
+            f"; the targets do not close at {int(bad.sum())} of {int(inner.sum())} interior "
+            f"vertices (by up to {float(cl[bad].max()):.1f} deg): no rigid folded state has "
+            "these fold angles"
+        )
+    elif inner.any():
+        out += "; the targets close at every interior vertex"
+    return out
 
 
 def _first_intersecting(pattern: CreasePattern, coords: np.ndarray):
@@ -770,6 +862,33 @@ def _fold_angles(pattern: CreasePattern, structure: Structure, Uh: np.ndarray) -
     out = np.zeros((len(Uh), pattern.n_edges))
     # unwrapped along the states (axis 0): a crease passing +-180 deg keeps its side
     out[:, e] = np.degrees(np.unwrap(np.arctan2(s, c), axis=0))
+    return out
+
+
+def _hinge_angles(structure: Structure, Uh: np.ndarray, ne: int) -> np.ndarray:
+    """(k, ne) fold angle of every crease at its hinge, degrees (FOLD sign), unwrapped along
+    the k states: the hinge spring's dihedral angle less pi (concentrated), or the sum over
+    the strip's two edge lines and its centre line (compliant); 0 for other edges."""
+    from holofold.mechanics.springs import dihedral_angle
+
+    out = np.zeros((len(Uh), ne))
+    cm = structure.creases
+    if cm is None or not len(cm.ids):
+        return out
+    cs = cm.springs
+    cols = [0, 1, 4, 5] if cm.compliant else [0]
+    used = cs[:, cols]  # (nci, 1 or 4) spring ids, read in chunks of states (memory)
+    sp = structure.springs[used.ravel()]
+    th = np.empty((len(Uh), sp.shape[0]))
+    for k0 in range(0, len(Uh), 16):
+        X = structure.nodes[None] + Uh[k0 : k0 + 16]
+        th[k0 : k0 + 16] = dihedral_angle(X, sp)
+    th = (np.unwrap(th, axis=0) - np.pi).reshape(len(Uh), *used.shape)
+    if cm.compliant:
+        a = th[..., 0] + th[..., 1] + 0.5 * (th[..., 2] + th[..., 3])
+    else:
+        a = th[..., 0]
+    out[:, cm.ids] = np.degrees(a)
     return out
 
 
