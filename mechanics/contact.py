@@ -111,13 +111,41 @@ class PanelContact:
         self.touched = (0, (-1, -1))  # the most pairs within reach in the last solve, where
         self.newton_steps = 0
         X = self.X0
-        if ipc.has_intersections(self.mesh, X):
+        if ipc.has_intersections(self.mesh, X) and _crossing(X, tri):
             raise ParameterError("panel contact: the panels intersect in the starting state")
+        self.excluded = self._exclude_neighbours(X)
         c = self._collisions(X)
         if len(c) and not np.isfinite(self.barrier(c, self.mesh, X)):
             raise ParameterError(
                 f"panel contact: panels closer than the thickness {thickness:g} m at the start"
             )
+
+    def _exclude_neighbours(self, X) -> int:
+        """Primitives within the barrier's reach in the starting state never collide with each
+        other: neighbours of a flat sheet closer than the thickness in its plane (thin
+        triangles round a vertex, the two coincident sides of a cut), which a barrier
+        infinite below the thickness could not start from (the exclusion of rest-state
+        neighbours of cloth simulators). Sets the mesh's collision filter; returns the number
+        of vertex pairs excluded. Their crossing is still caught by the intersection check."""
+        if not len(self._collisions(X)):
+            return 0
+        reach = self.dmin + self.dhat
+        cand = self.ipc.Candidates()
+        cand.build(self.mesh, X, 0.5 * reach)
+        E, F = self.mesh.edges, self.mesh.faces
+        pairs = {}
+        for group in (cand.vv_candidates, cand.ev_candidates, cand.ee_candidates,
+                      cand.fv_candidates):  # fmt: skip
+            for k in range(len(group)):
+                near = group[k]
+                if near.compute_distance(near.dof(X, E, F)) >= reach * reach:
+                    continue
+                ids = sorted({int(v) for v in near.vertex_ids(E, F) if v >= 0})
+                for i, u in enumerate(ids):  # every pair across the two primitives
+                    for w in ids[i + 1 :]:
+                        pairs[(u, w)] = False
+        self.mesh.can_collide = self.ipc.make_sparse_filter(pairs, True)
+        return len(pairs)
 
     # ----------------------------------------------------------------- evaluation
     def _pos(self, U) -> np.ndarray:
@@ -227,12 +255,20 @@ class PanelContact:
         """The accepted state of one fold step: ``U_trial`` (the contact-free equilibrium, or
         None) itself if the path ``U_prev -> U_trial`` is collision free and no pair is active
         at ``U_trial``; else the equilibrium with the barrier from ``U_prev`` (Newton with
-        CCD-limited, energy-decreasing updates), or None if that does not reach ``tol``."""
+        CCD-limited, energy-decreasing updates), or None if that does not reach ``tol``. Where
+        the contact-free solve found no equilibrium (``U_trial`` None) and no pair is within
+        reach at ``U_prev``, contact is not why: None, and the fold shortens its step as it
+        does without contact (the barrier solve there cost 50 of 86 s on a 2304-panel Miura
+        sheet that never touches)."""
         if U_trial is not None and np.isfinite(U_trial).all():
             if self.free_step(U_prev, U_trial) >= 1.0 and self.active(U_trial) == 0:
                 self.last_active = 0
                 self.touched = (0, (-1, -1))
                 return U_trial
+        elif self.active(U_prev) == 0:
+            self.last_active = 0
+            self.touched = (0, (-1, -1))
+            return None
         return self._solve(asm, np.asarray(U_prev, float).reshape(-1, 3), rest, tol, max_iter)
 
     def _solve(self, asm, U, rest, tol, max_iter):
@@ -308,6 +344,14 @@ class PanelContact:
             mu = max(4.0 * mu, MU_MIN * scale)
             if mu > MU_MAX * scale:
                 return None
+
+
+def _crossing(X, triangles) -> bool:
+    """True where holofold's own test finds two panel triangles crossing (IPC Toolkit's test
+    also flags coincident coplanar edges, as the two sides of a cut in a flat sheet)."""
+    from holofold.mechanics.intersection import has_intersections
+
+    return bool(has_intersections(np.asarray(X), np.asarray(triangles), backend="numpy"))
 
 
 def _panels_of_node(structure) -> list[set]:

@@ -63,7 +63,7 @@ def test_the_wrong_way_verdict_says_why():
     against it (0.21 deg), edge 11 still on its side (0.25 deg): one branch taken at flat,
     one later turn. Its targets do not close at 10 of 14 interior vertices. The note says
     both."""
-    from holofold.design import scaled_pattern
+    from holofold.mechanics import scaled_pattern
 
     r = fold_pattern(scaled_pattern(read_pattern(_OS / "flappingBird.svg"), 0.2), 1.0, **_PP)
     assert r.verdict == "turns against its assignment"
@@ -91,7 +91,7 @@ def test_a_crease_is_judged_at_its_hinge_not_by_its_panels_mean_normals():
     because those panels bend (up to 59 deg): their hinges stand 0.3-0.4 deg on their side.
     Two others (edges 91 and 97) stand 10.2 deg against at their hinges (9.5 deg by the
     normals, under the 10 deg threshold)."""
-    from holofold.design import scaled_pattern
+    from holofold.mechanics import scaled_pattern
 
     p = read_pattern(_OS / "flat_crane.svg")
     r = fold_pattern(scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max())), 1.0, **_PP)

@@ -42,9 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
-from holofold.design import scaled_pattern
 from holofold.geometry import read_pattern
-from holofold.mechanics import fold_pattern
+from holofold.mechanics import fold_pattern, scaled_pattern
 from holofold.mechanics.folding import DRIVEN, WRONG_WAY_DEG, crease_classes, vertex_closure
 
 SECTION = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9, nu=0.42)
