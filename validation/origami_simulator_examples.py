@@ -41,49 +41,80 @@ def _files(root: Path) -> list[Path]:
     return sorted(p for p in assets.rglob("*") if p.suffix.lower() in (".svg", ".fold"))
 
 
-def run(root: Path, limit: float, check: bool = True, only: str = "") -> list[dict]:
-    rows = []
+#: the columns of a row, in the CSV's order
+COLUMNS = ("file", "imported", "panels", "reached", "verdict", "t50", "t100", "touch_at",
+           "wrong_at", "intersecting", "note", "read_s", "cpu_s", "contact")  # fmt: skip
+
+
+def run(
+    root: Path, limit: float, check: bool = True, only: str = "", contact: bool = False,
+    csv_path: Path | None = None,
+) -> list[dict]:  # fmt: skip
+    """Fold every file (``contact``: with panel contact); each row appended to ``csv_path``
+    as soon as it is done, and the files already there skipped (a killed run resumes)."""
+    rows, done = [], set()
+    if csv_path is not None and csv_path.exists():
+        with open(csv_path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.DictReader(fh))
+        done = {r["file"] for r in rows}
     for path in _files(root):
         if only not in path.as_posix():
             continue
         rel = path.relative_to(path.parents[1]).as_posix()
-        row = {"file": rel, "imported": "", "panels": "", "reached": "", "verdict": "",
-               "t50": "", "t100": "", "touch_at": "", "wrong_at": "", "intersecting": "",
-               "note": ""}  # fmt: skip
-        t0 = time.perf_counter()
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                p = read_pattern(path)
-        except ValueError as exc:
-            row["imported"] = "no: " + str(exc).split(": ", 1)[-1]
-            rows.append(row)
-            print(f"{rel}: {row['imported']}", file=sys.stderr, flush=True)
+        if rel in done:
             continue
-        t_read = time.perf_counter() - t0
-        p = scaled_pattern(p, SIZE / float(np.ptp(p.flat, axis=0).max()))
-        row.update(imported="yes", panels=p.n_faces, read_s=round(t_read, 2))
-        try:
-            r = fold_pattern(p, 1.0, time_limit=limit, check_intersections=check, **SECTION)
-        except (ValueError, RuntimeError, ArithmeticError) as exc:
-            row.update(verdict="error", note=f"{type(exc).__name__}: {exc}")
-            rows.append(row)
-            continue
-        k50 = np.flatnonzero(r.fractions >= 0.5 - 1e-12)
-        row.update(
-            reached=round(r.reached, 3),
-            verdict=r.verdict,
-            t50=round(float(r.elapsed[k50[0]]), 1) if k50.size else "",
-            t100=round(float(r.elapsed[-1]), 1) if r.complete else "",
-            touch_at=round(r.touch_at, 3) if np.isfinite(r.touch_at) else "",
-            wrong_at=round(r.wrong_at, 3) if np.isfinite(r.wrong_at) else "",
-            # checked independently of the fold's own check: the numpy test on every state
-            intersecting=_intersecting(p, r.coords),
-            note=r.note,
-        )
-        rows.append(row)
-        print(f"{rel}: {r.summary()} [{r.elapsed[-1]:.1f} s]", file=sys.stderr, flush=True)
+        row = dict.fromkeys(COLUMNS, "")
+        row.update(file=rel, contact="yes" if contact else "no")
+        rows.append(_row(path, row, limit, check, contact))
+        if csv_path is not None:
+            new = not csv_path.exists()
+            with open(csv_path, "a", newline="", encoding="utf-8") as fh:
+                w = csv.DictWriter(fh, fieldnames=COLUMNS)
+                if new:
+                    w.writeheader()
+                w.writerow(rows[-1])
     return rows
+
+
+def _row(path: Path, row: dict, limit: float, check: bool, contact: bool) -> dict:
+    """One file folded: ``row`` filled in."""
+    rel = row["file"]
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            p = read_pattern(path)
+    except ValueError as exc:
+        row["imported"] = "no: " + str(exc).split(": ", 1)[-1]
+        print(f"{rel}: {row['imported']}", file=sys.stderr, flush=True)
+        return row
+    t_read = time.perf_counter() - t0
+    p = scaled_pattern(p, SIZE / float(np.ptp(p.flat, axis=0).max()))
+    row.update(imported="yes", panels=p.n_faces, read_s=round(t_read, 2))
+    cpu = time.process_time()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = fold_pattern(p, 1.0, time_limit=limit, check_intersections=check,
+                             contact=contact or None, **SECTION)  # fmt: skip
+    except (ValueError, RuntimeError, ArithmeticError) as exc:
+        row.update(verdict="error", note=f"{type(exc).__name__}: {exc}")
+        return row
+    row["cpu_s"] = round(time.process_time() - cpu, 2)
+    k50 = np.flatnonzero(r.fractions >= 0.5 - 1e-12)
+    row.update(
+        reached=round(r.reached, 3),
+        verdict=r.verdict,
+        t50=round(float(r.elapsed[k50[0]]), 1) if k50.size else "",
+        t100=round(float(r.elapsed[-1]), 1) if r.complete else "",
+        touch_at=round(r.touch_at, 3) if np.isfinite(r.touch_at) else "",
+        wrong_at=round(r.wrong_at, 3) if np.isfinite(r.wrong_at) else "",
+        # checked independently of the fold's own check: the numpy test on every state
+        intersecting=_intersecting(p, r.coords),
+        note=r.note,
+    )
+    print(f"{rel}: {r.summary()} [{r.elapsed[-1]:.1f} s]", file=sys.stderr, flush=True)
+    return row
 
 
 def _intersecting(p, coords) -> str:
@@ -146,24 +177,22 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("root", type=Path, help="Origami Simulator checkout or its assets folder")
     ap.add_argument("--limit", type=float, default=300.0, help="seconds per fold (default 300)")
-    ap.add_argument("--csv", type=Path, help="write the rows to this CSV file too")
+    ap.add_argument(
+        "--csv", type=Path,
+        help="append each row to this CSV file as it is done; files already in it are skipped",
+    )  # fmt: skip
+    ap.add_argument("--contact", action="store_true", help="fold with panel contact (ipctk)")
     ap.add_argument("--only", default="", help="only files whose path contains this")
     ap.add_argument(
         "--no-intersections", action="store_true",
         help="fold without stopping where panels pass through each other (the old behaviour)",
     )  # fmt: skip
     args = ap.parse_args(argv)
-    rows = run(args.root, args.limit, not args.no_intersections, args.only)
+    rows = run(args.root, args.limit, not args.no_intersections, args.only, args.contact,
+               args.csv)  # fmt: skip
     print(table(rows))
     print()
     print(summary(rows))
-    if args.csv:
-        keys = list(rows[0]) if rows else []
-        keys += [k for r in rows for k in r if k not in keys]
-        with open(args.csv, "w", newline="", encoding="utf-8") as fh:
-            w = csv.DictWriter(fh, fieldnames=keys)
-            w.writeheader()
-            w.writerows(rows)
     return 0
 
 
