@@ -5,19 +5,22 @@ triangulated without new vertices so that its added edges (``J`` facets, bent by
 plate stiffness in :mod:`holofold.mechanics.hinges`) run along the rulings of the developable
 surface the panel bends into:
 
-* **Strip** (the face's boundary has curve pieces): the boundary is cut into two chains that
-  start at the first vertex of the longest run of curve pieces and end at the first vertex of
-  the second longest run (or at the end of the only run). Each chain's vertices are placed at
-  their relative arc length along the chain's own curve run (the other vertices of a chain, its
-  straight caps, at 0 or 1; a chain without curve pieces along its whole length), and the two
-  chains are stitched: each step adds the triangle that advances the chain whose next vertex has
-  the smaller relative arc length. The rulings are thus approximated in the flat state by
-  joining points of **equal relative arc length** of the two curves (exact for concentric
-  circles, whose rulings are radial); where both next vertices have the same relative arc length
-  (a quad of matched points) the quad is split along its **shorter diagonal**.
-* **Otherwise** (or where the stitched strip would have a triangle of area <= 0: a strip too
-  curved for its rulings to join its two sides inside it): ear clipping (manifold3d) followed by
-  Lawson flips of the added diagonals to the constrained Delaunay triangulation of the polygon.
+* **Strip** (the face's boundary has two or more runs of curve pieces): the boundary is cut
+  into two chains that start at the first vertex of the longest run of curve pieces and end at
+  the first vertex of the second longest run. Each chain's vertices are placed at their
+  relative arc length along the chain's own curve run (the other vertices of a chain, its
+  straight caps, at 0 or 1), and the two chains are stitched: each step adds the triangle
+  that advances the chain whose next vertex has the smaller relative arc length. The rulings
+  are thus approximated in the flat state by joining points of **equal relative arc length**
+  of the two curves (exact for concentric circles, whose rulings are radial); where both next
+  vertices have the same relative arc length (a quad of matched points) the quad is split
+  along its **shorter diagonal**.
+* **Otherwise** (one curve run only: stitching it to straight sides fanned rulings from their
+  corners, and Origami Simulator's scale.svg then diverged on its first step, folding to 7 %
+  in 30 s with this instead; or where the stitched strip would have a triangle of area <= 0:
+  a strip too curved for its rulings to join its two sides inside it): ear clipping
+  (manifold3d) followed by Lawson flips of the added diagonals to the constrained Delaunay
+  triangulation of the polygon.
 
 Either way every triangle turns counter-clockwise with area > 0, the triangles tile the face
 exactly (no vertex is added inside), and a face of n corners gives n - 2 triangles and n - 3
@@ -150,28 +153,20 @@ def strip_triangles(xy, face, on_curve) -> np.ndarray | None:
     on = np.asarray(on_curve, bool)
     if n == 3:
         return f[None].copy()
-    if not on.any():
+    runs = _runs(on) if on.any() else []
+    if len(runs) < 2:  # one curve (or none): no second curve for the rulings to reach
         return None
     p = np.asarray(xy, float)[f]
     seg = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
-    runs = sorted(_runs(on), key=lambda r: -seg[[(r[0] + k) % n for k in range(r[1])]].sum())
-    a0, na = runs[0]
-    if len(runs) >= 2:
-        b0, nb = runs[1]
-        e = b0
-    else:
-        b0, nb, e = -1, 0, (a0 + na) % n
-    if e == a0:  # one run round the whole loop: cut it in two halves
-        e = (a0 + n // 2) % n
-    m_l = (e - a0) % n  # sides of the forward chain
+    runs = sorted(runs, key=lambda r: -seg[[(r[0] + k) % n for k in range(r[1])]].sum())
+    (a0, na), (b0, nb) = runs[0], runs[1]
+    m_l = (b0 - a0) % n  # sides of the forward chain, from a0 to b0
     L = [(a0 + k) % n for k in range(m_l + 1)]
     R = [(a0 - k) % n for k in range(n - m_l + 1)]
     run_a = {(a0 + k) % n for k in range(na)}
-    run_b = {(b0 + k) % n for k in range(nb)} if nb else set()
+    run_b = {(b0 + k) % n for k in range(nb)}
     sides_l = np.array([L[k] in run_a for k in range(m_l)])  # side L[k] -> L[k+1] is side L[k]
     sides_r = np.array([R[k + 1] in run_b for k in range(n - m_l)])  # R[k] -> R[k+1]: side R[k+1]
-    if na == n:  # a closed curve: both halves on it
-        sides_r = np.ones(n - m_l, bool)
     sl = _chain_params(p[L], sides_l)
     sr = _chain_params(p[R], sides_r)
     tris = [(L[0], L[1], R[1])]

@@ -77,6 +77,13 @@ def test_annulus_strip_is_a_valid_triangulation_along_the_radii(n_in, n_out):
         assert np.sort(off)[: n_in - 1].max() < 1e-5  # arccos near 1: ~1e-6 degrees
 
 
+def test_a_face_with_one_curve_is_not_stitched():
+    t = np.linspace(0, np.pi, 17)
+    xy = np.c_[np.cos(t), np.sin(t)]  # a half disc: the arc, then its diameter back
+    on = np.r_[np.ones(16, bool), False]
+    assert strip_triangles(xy, np.arange(17), on) is None
+
+
 def test_delaunay_fallback_tiles_a_non_convex_face():
     t = np.linspace(0, np.pi, 20)
     xy = np.concatenate(
