@@ -9,6 +9,10 @@ manifold3d, no new vertices) and marks every added edge ``J`` (a join: a facet t
 Origami Simulator's yellow triangulation line). A panel whose corner is a hair off straight
 (1e-5 of its size) is fanned, not split into a sliver. ``mode="all"`` triangulates every face
 with more than three vertices, as Origami Simulator does; ``"none"`` leaves them.
+``mode="rulings"`` (given ``curve_edges``, the edges that are pieces of curved creases) meshes
+every face with a curve piece on its boundary along its rulings
+(:func:`~holofold.geometry.ruling_mesh.ruling_triangles`, no new vertices) and the others as
+``"as-needed"``.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ from typing import NamedTuple
 import numpy as np
 
 from holofold.geometry.errors import ParameterError
+from holofold.geometry.ruling_mesh import ruling_triangles
 
 __all__ = ["SplitFaces", "split_faces", "nonconvex_faces", "unfannable_faces", "SPLIT_MODES"]
 
@@ -35,7 +40,7 @@ class SplitFaces(NamedTuple):
 
 
 #: which faces :func:`split_faces` triangulates
-SPLIT_MODES = ("as-needed", "all", "none")
+SPLIT_MODES = ("as-needed", "all", "none", "rulings")
 
 
 def _cross(a, b):
@@ -77,7 +82,9 @@ def unfannable_faces(xy, faces, rel_area: float = 1e-3) -> np.ndarray:
     return np.array(bad, np.intp)
 
 
-def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed") -> SplitFaces:
+def split_faces(
+    xy, faces, edges, assignment, fold_angle, mode: str = "as-needed", curve_edges=None
+) -> SplitFaces:
     """Triangulate faces (see the module docstring).
 
     Parameters
@@ -88,7 +95,9 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
     edges : (ne, 2) int
     assignment : (ne,) str
     fold_angle : (ne,) float
-    mode : {"as-needed", "all", "none"}
+    mode : {"as-needed", "all", "none", "rulings"}
+    curve_edges : (ne,) bool, optional
+        The edges that are pieces of curves (``mode="rulings"``; none if not given).
 
     Returns
     -------
@@ -110,6 +119,16 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
         todo = {k for k, f in enumerate(faces) if len(f) > 3}
     else:
         todo = set(unfannable_faces(xy, faces).tolist())
+    curved: dict = {}
+    if mode == "rulings" and curve_edges is not None and np.any(curve_edges):
+        keys = {tuple(e) for e in np.sort(edges, axis=1)[np.asarray(curve_edges, bool)].tolist()}
+        for k, f in enumerate(faces):
+            on = np.array(
+                [(min(a, b), max(a, b)) in keys for a, b in zip(f, np.roll(f, -1), strict=True)]
+            )
+            if len(f) > 3 and on.any():
+                curved[k] = on
+        todo |= set(curved)
     if not todo:
         return SplitFaces(faces, edges, asg, ang, 0)
     import manifold3d
@@ -121,8 +140,11 @@ def split_faces(xy, faces, edges, assignment, fold_angle, mode: str = "as-needed
         if k not in todo:
             out.append(f)
             continue
-        tris = np.asarray(manifold3d.triangulate([xy[f]]), np.int64)
-        for t in f[tris]:
+        if k in curved:
+            ft = ruling_triangles(xy, f, curved[k])
+        else:
+            ft = f[np.asarray(manifold3d.triangulate([xy[f]]), np.int64)]
+        for t in ft:
             out.append(t)
             for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
                 key = (min(a, b), max(a, b))

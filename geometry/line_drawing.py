@@ -23,6 +23,7 @@ from holofold.geometry.cuts import separate_cuts
 from holofold.geometry.errors import FormatError, ParameterError
 from holofold.geometry.facets import SPLIT_MODES, split_faces
 from holofold.geometry.pattern import MAX_PANELS, CreasePattern
+from holofold.geometry.ruling_mesh import curve_edge_mask, curve_points_on
 
 __all__ = [
     "PatternWarning",
@@ -64,10 +65,12 @@ def _outline_cuts_as_border(faces, edges, assignment) -> np.ndarray:
 
 def finish_pattern(
     xy, faces, edges, assignment, fold_angle, *, name: str, notes=(), split: str = "as-needed",
-    meta: dict | None = None, coords3=None,
+    meta: dict | None = None, coords3=None, curve_points=None, curve_tol: float = 0.0,
 ) -> CreasePattern:  # fmt: skip
     """A :class:`CreasePattern` from a flat layout (metres) and its faces: cuts separated,
-    faces split as the model needs (``split``), each repair warned about in one line."""
+    faces split as the model needs (``split``), each repair warned about in one line.
+    ``curve_points`` (k, 2) m: points along the drawing's curves, at most ``curve_tol`` / 2
+    apart; the edges within ``curve_tol`` of them are curve pieces (``split="rulings"``)."""
     split = _check_split(split)
     notes = list(notes)
     xy = np.asarray(xy, float)
@@ -79,10 +82,14 @@ def finish_pattern(
     n_cut = len(origin) - len(np.unique(origin))
     if n_cut:
         notes.append(f"cuts separated: {n_cut} vertex copies made along them")
-    faces, edges, asg, ang, n_split = split_faces(xy, faces, edges, asg, ang, split)
+    on_curve = None
+    if split == "rulings" and curve_points is not None and len(curve_points):
+        on_curve = curve_edge_mask(xy, edges, curve_points, curve_tol)
+    faces, edges, asg, ang, n_split = split_faces(xy, faces, edges, asg, ang, split, on_curve)
     if n_split:
         why = "non-convex" if split == "as-needed" else "with more than 3 vertices"
         why = "non-convex (not fanned whole from their centre)" if split == "as-needed" else why
+        why = "with curve pieces (along their rulings) or non-convex" if split == "rulings" else why
         notes.append(f"{n_split} {why} face(s) split into triangles (added edges J)")
     if len(faces) > MAX_PANELS:
         raise FormatError(f"{name}: {len(faces)} panels; at most {MAX_PANELS} are read")
@@ -113,7 +120,8 @@ def pattern_from_lines(
     """The crease pattern of drawn lines (drawing units; ``unit`` metres per drawing unit;
     ``tol`` the merge distance in drawing units, default 2e-3 of the drawing's larger side),
     placed with the lower-left corner of its extent at the origin; ``curves`` (drawing units,
-    y up) are kept as the pattern's ``curves`` with the edges that are their pieces."""
+    y up) are kept as the pattern's ``curves`` with the edges that are their pieces, and their
+    pieces are meshed along their rulings with ``split="rulings"``."""
     if not (np.isfinite(unit) and unit > 0):
         raise ParameterError(f"unit = {unit!r} must be a length in metres > 0")
     if tol is not None and not (np.isfinite(tol) and tol > 0):
@@ -132,9 +140,14 @@ def pattern_from_lines(
     except FormatError as exc:
         raise FormatError(f"{name}: {exc}") from None
     xy = (arr.vertices - arr.vertices.min(axis=0)) * unit  # lower-left corner at the origin
+    pts, ctol = None, 0.0
+    if curves and split == "rulings":
+        pts, ctol = curve_points_on(arr.vertices, curves, tol)
+        pts, ctol = (pts - arr.vertices.min(axis=0)) * unit, ctol * unit
     pattern = finish_pattern(
         xy, arr.faces, arr.edges, arr.assignment, arr.fold_angle,
-        name=name, notes=[*notes, *arr.notes], split=split, meta=meta,
+        name=name, notes=[*notes, *arr.notes], split=split, meta=meta, curve_points=pts,
+        curve_tol=ctol,
     )  # fmt: skip
     if curves:  # curved creases kept for output (metres, the pattern's frame)
         curves = tuple(c.mapped(unit, -arr.vertices.min(axis=0) * unit) for c in curves)
@@ -249,8 +262,10 @@ def pattern_from_drawing(
     (drawing units; default 2e-3 of the drawing's larger side), crossings split, faces found,
     cuts separated, faces split as ``split`` asks (:data:`~holofold.geometry.facets.SPLIT_MODES`);
     ``unit`` (metres per drawing unit) overrides the drawing's. Each note and repair is one
-    :class:`PatternWarning` line naming ``drawing.name``; ``meta`` holds its kind and name."""
+    :class:`PatternWarning` line naming ``drawing.name``; ``meta`` holds its kind and name.
+    A drawing with curves is split ``"rulings"`` where ``split`` is ``"as-needed"``."""
     d = drawing.with_unit(unit)
+    split = "rulings" if d.curves and split == "as-needed" else split
     return pattern_from_lines(
         d.segments, d.assignment, d.fold_angle, name=d.name, unit=d.unit, tol=tol, split=split,
         meta={"kind": d.kind, "source": d.name}, notes=d.notes, curves=d.curves,

@@ -250,7 +250,10 @@ def test_svg_curves_and_attributes(tmp_path):
     assert any(
         "flattened" in n for n in _read(_svg(tmp_path, border + straight), curves="refuse")[1]
     )
-    assert p.n_faces == 2 and np.allclose(p.fold_angle[p.assignment == "V"], 33.0)
+    assert np.allclose(p.fold_angle[p.assignment == "V"], 33.0)
+    # two half discs, meshed along their rulings (issue 36): triangles, no vertex added
+    halves = read_pattern(_svg(tmp_path, border + straight), split="none")
+    assert halves.n_faces == 2 and p.n_faces == sum(len(f) - 2 for f in halves.faces)
     with pytest.raises(FormatError, match="data-assignment 'X'"):
         read_pattern(_svg(tmp_path, border + straight.replace('"V"', '"X"')))
     with pytest.raises(FormatError, match="no crease-pattern lines"):

@@ -1,0 +1,241 @@
+"""The ruling-aware mesh of the panels between curved creases, and its plate bending (issue 36)."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from holofold.geometry import read_pattern
+from holofold.geometry.pattern import CreasePattern
+from holofold.geometry.ruling_mesh import delaunay_triangles, strip_triangles
+from holofold.mechanics.assembly import Assembler
+from holofold.mechanics.hinges import build_concentrated
+
+DATA = Path(__file__).parent / "data" / "origami-simulator"
+
+
+def _shoelace(p):
+    q = np.roll(p, -1, axis=0)
+    return 0.5 * float(np.sum(p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]))
+
+
+def _areas(xy, tris):
+    a, b, c = xy[tris[:, 0]], xy[tris[:, 1]], xy[tris[:, 2]]
+    return 0.5 * (
+        (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    )
+
+
+def _annulus_strip(n_in, n_out, r_in=1.0, r_out=2.0, sweep=np.pi / 2):
+    """A counter-clockwise annulus sector: outer arc (n_out pieces) anticlockwise, inner arc
+    (n_in pieces) back; the sides on the arcs are curve pieces, the two radial ends not."""
+    to = np.linspace(0.0, sweep, n_out + 1)
+    ti = np.linspace(sweep, 0.0, n_in + 1)
+    xy = np.concatenate(
+        [r_out * np.c_[np.cos(to), np.sin(to)], r_in * np.c_[np.cos(ti), np.sin(ti)]]
+    )
+    n = len(xy)
+    on = np.ones(n, bool)
+    on[n_out] = on[n - 1] = False  # outer end -> inner start, inner end -> outer start
+    return xy, np.arange(n), on
+
+
+def _added(face, tris):
+    n = len(face)
+    side = {frozenset((face[k], face[(k + 1) % n])) for k in range(n)}
+    edges = {frozenset(e) for t in tris for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))}
+    return [tuple(e) for e in edges - side]
+
+
+def _off_radial_deg(xy, edges):
+    e = np.array(edges)
+    d = xy[e[:, 1]] - xy[e[:, 0]]
+    m = 0.5 * (xy[e[:, 1]] + xy[e[:, 0]])
+    cos = np.abs(np.sum(d * m, axis=1)) / (np.linalg.norm(d, axis=1) * np.linalg.norm(m, axis=1))
+    return np.degrees(np.arccos(np.clip(cos, 0.0, 1.0)))
+
+
+@pytest.mark.parametrize("n_in, n_out", [(16, 16), (16, 32), (24, 16)])
+def test_annulus_strip_is_a_valid_triangulation_along_the_radii(n_in, n_out):
+    xy, face, on = _annulus_strip(n_in, n_out)
+    T = strip_triangles(xy, face, on)
+    assert T is not None and T.shape == (len(face) - 2, 3)  # no vertex added
+    a = _areas(xy, T)
+    assert (a > 0).all()
+    assert a.sum() == pytest.approx(_shoelace(xy), rel=1e-9)
+    added = _added(face, T)
+    assert len(added) == len(face) - 3
+    off = _off_radial_deg(xy, added)
+    # equal relative arc length joins points of equal angle: the rulings (radii) of the
+    # rotationally symmetric fold; a diagonal leans by at most about one angular step
+    step = np.degrees(np.pi / 2 / min(n_in, n_out))
+    assert off.max() < 1.5 * step and off.max() < 10.0
+    if n_in == n_out:  # matched points: half the added edges are exact radii
+        assert np.sort(off)[: n_in - 1].max() < 1e-5  # arccos near 1: ~1e-6 degrees
+
+
+def test_a_face_with_one_curve_is_not_stitched():
+    t = np.linspace(0, np.pi, 17)
+    xy = np.c_[np.cos(t), np.sin(t)]  # a half disc: the arc, then its diameter back
+    on = np.r_[np.ones(16, bool), False]
+    assert strip_triangles(xy, np.arange(17), on) is None
+
+
+def test_delaunay_fallback_tiles_a_non_convex_face():
+    t = np.linspace(0, np.pi, 20)
+    xy = np.concatenate(
+        [np.c_[2 * np.cos(t), 2 * np.sin(t)], np.c_[np.cos(t[::-1]), np.sin(t[::-1])]]
+    )
+    T = delaunay_triangles(xy, np.arange(len(xy)))
+    a = _areas(xy, T)
+    assert len(T) == len(xy) - 2 and (a > 0).all()
+    assert a.sum() == pytest.approx(_shoelace(xy), rel=1e-9)
+
+
+def _annulus_svg(tmp_path):
+    # centre (0, 0); radii 40 (border), 70 (valley), 100 (border); quarter annulus, y down
+    def arc(r, colour):
+        return f'<path d="M {r} 0 A {r} {r} 0 0 1 0 {r}" stroke="{colour}" fill="none"/>'
+
+    body = arc(40, "#000000") + arc(70, "#0000ff") + arc(100, "#000000")
+    body += '<path d="M 40 0 L 100 0 M 0 40 L 0 100" stroke="#000000" fill="none"/>'
+    f = tmp_path / "annulus.svg"
+    f.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" '
+        f'viewBox="0 0 100 100">{body}</svg>',
+        encoding="utf-8",
+    )
+    return f
+
+
+def test_annulus_read_meshes_both_strips_along_the_radii(tmp_path):
+    f = _annulus_svg(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = read_pattern(f)
+        q = read_pattern(f, split="none")  # the two strips as drawn
+    assert q.n_faces == 2 and p.n_vertices == q.n_vertices  # no vertex added
+    assert p.n_faces == sum(len(g) - 2 for g in q.faces)
+    xy = p.flat
+    tris = np.array([list(t) for t in p.faces])
+    a = _areas(xy, tris)
+    assert (a > 0).all()
+    whole = sum(_shoelace(xy[g]) for g in q.faces)
+    assert a.sum() == pytest.approx(whole, rel=1e-9)
+    # the centre of the circles, fitted to the valley arc's points
+    v = xy[p.edges[p.assignment == "V"]].reshape(-1, 2)
+    sol = np.linalg.lstsq(np.c_[2 * v, np.ones(len(v))], (v**2).sum(axis=1), rcond=None)[0]
+    c = sol[:2]
+    r = np.linalg.norm(xy - c, axis=1)
+    assert np.allclose(np.sort(np.unique(np.round(r, 6))), [0.04, 0.07, 0.1], atol=1e-6)
+    J = p.edges[p.assignment == "J"]
+    assert len(J) == sum(len(g) - 3 for g in q.faces)
+    off = _off_radial_deg(xy - c, [tuple(e) for e in J])
+    assert off.max() < 8.0
+    # every arc piece is a curve edge: no J edge runs along an arc (same radius at both ends)
+    assert (np.abs(r[J[:, 0]] - r[J[:, 1]]) > 0.02).all()
+
+
+@pytest.mark.parametrize("name", ["birdBase.svg", "miura-ori.svg", "squaretwistManyAngles.svg"])
+def test_straight_crease_files_read_as_before(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = read_pattern(DATA / name)
+        q = read_pattern(DATA / name, split="as-needed")
+    assert p.n_faces == q.n_faces and np.array_equal(p.edges, q.edges)
+    assert np.array_equal(p.assignment, q.assignment)
+    assert all(np.array_equal(a, b) for a, b in zip(p.faces, q.faces, strict=True))
+
+
+# --------------------------------------------------------------------------- plate bending
+def _strip(xs, ny, width=0.03):
+    """A flat strip with rungs at ``xs`` and ny pieces across, each quad split along one
+    diagonal (the direction alternating per column); interior edges J, the outline B."""
+    nx = len(xs) - 1
+    x, y = np.meshgrid(xs, np.linspace(0, width, ny + 1), indexing="ij")
+    xy = np.c_[x.ravel(), y.ravel()]
+    vid = np.arange(len(xy)).reshape(nx + 1, ny + 1)
+    faces = []
+    for i in range(nx):
+        for j in range(ny):
+            a, b, c, d = vid[i, j], vid[i + 1, j], vid[i + 1, j + 1], vid[i, j + 1]
+            faces += [[a, b, c], [a, c, d]] if i % 2 == 0 else [[a, b, d], [b, c, d]]
+    sides = {}
+    for f in faces:
+        for k in range(3):
+            key = (min(f[k], f[(k + 1) % 3]), max(f[k], f[(k + 1) % 3]))
+            sides[key] = sides.get(key, 0) + 1
+    edges = np.array(sorted(sides))
+    asg = np.array(["J" if sides[tuple(e)] == 2 else "B" for e in edges.tolist()])
+    z = np.zeros(len(edges))
+    return CreasePattern(np.c_[xy, np.zeros(len(xy))], faces, edges, asg, z, flat=xy), vid
+
+
+@pytest.mark.parametrize(
+    "xs, ny",
+    [
+        (np.linspace(0.0, 0.1, 9), 2),  # 8 rungs' spacing
+        (np.linspace(0.0, 0.1, 33), 5),  # 4 x finer
+        (0.1 * np.sort(np.r_[0.0, 1.0, np.random.default_rng(3).uniform(0.05, 0.95, 14)]), 3),
+    ],
+)  # fmt: skip
+def test_plate_strip_bent_to_a_cylinder_stores_the_plate_energy(xs, ny):
+    """A strip of width b bent about its rungs to curvature kappa stores D b L kappa^2 / 2:
+    the moment M = D b kappa, i.e. the curvature M / (D b) of a plate under a moment M, for any
+    rung spacing (the facet hinges' k = 2 D L / (h1 + h2) makes the sum exact)."""
+    E, nu, t, width, kappa = 1.5e9, 0.42, 1e-3, 0.03, 0.5  # 1/m: 2 m radius
+    p, vid = _strip(xs, ny, width)
+    s = build_concentrated(
+        p, crease_width=1e-3, crease_thickness=t, panel_thickness=t, E_panel=E, E_crease=E,
+        nu_panel=nu,
+    )  # fmt: skip
+    X = s.nodes.copy()
+    x, y = X[:, 0], X[:, 1]  # panel centres are the means of their corners: on the cylinder
+    bent = np.c_[np.sin(kappa * x) / kappa, y, (1 - np.cos(kappa * x)) / kappa]
+    nv = p.n_vertices
+    tri = np.array([list(f) for f in p.faces])
+    bent[nv:] = bent[tri].mean(axis=1)
+    energy = Assembler(s).evaluate(bent - X)[0]
+    D = E * t**3 / (12 * (1 - nu**2))
+    # the curvature lives between the first and the last rung's neighbours (half a spacing in)
+    length = xs[-1] - xs[0] - 0.5 * (xs[1] - xs[0]) - 0.5 * (xs[-1] - xs[-2])
+    M = np.sqrt(2.0 * energy * D * width / length)  # from U = M^2 L / (2 D b)
+    assert M / (D * width) == pytest.approx(kappa, rel=0.01)
+
+
+def test_a_sliver_facet_is_no_stiffer_than_a_facet_over_the_crease_width():
+    E, nu, t, W = 1.5e9, 0.42, 1e-3, 1e-3
+    xs = np.r_[0.0, 0.0002, 0.0004, 0.0006]  # rungs 0.2 mm apart: half distance 0.2 mm < W
+    p, vid = _strip(xs, 1)
+    s = build_concentrated(
+        p, crease_width=W, crease_thickness=t, panel_thickness=t, E_panel=E, E_crease=E,
+        nu_panel=nu,
+    )  # fmt: skip
+    D = E * t**3 / (12 * (1 - nu**2))
+    e = p.edges[s.creases.ids]
+    L = np.linalg.norm(p.flat[e[:, 0]] - p.flat[e[:, 1]], axis=1)
+    k = s.spring_k[: len(e)]
+    assert np.allclose(k, D * L / W, rtol=1e-12)  # capped: 2 D L / (h1 + h2) would be larger
+    assert (2 * D * L / (2 * 0.0002) > 1.5 * k).all()
+
+
+@pytest.mark.slow
+def test_wavy_pleats_fold_past_where_the_fanned_panels_stalled():
+    """Origami Simulator's wavy pleats (acceptance settings: 200 mm, PP, 1 mm panels): the
+    fanned panels stalled at 0 % (Newton does not converge); meshed along their rulings they
+    fold to 20 % (26 % measured before the stall, 60 s, 2026-12-07)."""
+    from holofold.design import scaled_pattern
+    from holofold.mechanics import fold_pattern
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = read_pattern(DATA / "wavy_pleats.svg")
+    p = scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))
+    r = fold_pattern(
+        p, 0.2, panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9,
+        nu=0.42, time_limit=600.0, check_intersections=True,
+    )  # fmt: skip
+    assert r.reached >= 0.2 - 1e-9, r.summary()
