@@ -14,13 +14,12 @@ diagonal into two triangles (the diagonal's direction alternating like a chequer
 assignments (FOLD):
 
 * ``M``/``V`` the crease arcs, ``B`` rims and ends;
-* ``F`` the radial lines inside the sheet: facet hinges along the rulings, where the panels bend;
-* ``J`` the quad diagonals and the rings inside a pleat: joins that keep the panel flat across
-  the rulings.
-
-:func:`facet_widths` gives each edge the length ``w`` of its bending spring ``k = E t^3 L /
-(12 w)`` (:func:`holofold.mechanics.fold_pattern`'s ``crease_width``, facets taking the panel
-thickness) so that the hinges add up to the plate's bending energy as the mesh refines.
+* ``J`` every mesh edge inside a pleat: the radial lines along the rulings (where the panels
+  bend), the quad diagonals and the rings. The bar-and-hinge model gives them the plate's
+  bending stiffness (:func:`holofold.mechanics.build_concentrated`: ``D L`` over half the
+  distance between the two opposite corners, ``D = E t^3 / (12 (1 - nu^2))``), as it does the
+  ruling mesh of a drawn curved crease, so the hinges add up to the plate's bending energy as
+  the mesh refines, whatever the crease width.
 Lengths in metres, angles in radians (fold angles in degrees in the pattern, FOLD's sign).
 """
 
@@ -37,7 +36,6 @@ from holofold.geometry.pattern import MAX_PANELS, CreasePattern
 __all__ = [
     "CurvedPleat",
     "curved_pleat",
-    "facet_widths",
     "DEFAULTS",
     "PIECE_ANGLE",
 ]
@@ -140,11 +138,9 @@ class CurvedPleat:
         )  # fmt: skip
         e = base.edges
         ring, line = np.divmod(e, nl)
-        radial = line[:, 0] == line[:, 1]
         circ = ring[:, 0] == ring[:, 1]
         asg = np.full(len(e), "J", dtype="<U1")
         ang = np.zeros(len(e))
-        asg[radial] = "F"
         asg[~base.interior] = "B"
         deg = math.degrees(self.fold_angle)
         for i, cr in enumerate(self.crease_rings()):
@@ -205,39 +201,6 @@ def geometry_of(values: dict, label=str) -> CurvedPleat:
     v = {k: (DEFAULTS[k] if values.get(k) is None else values[k]) for k in DEFAULTS}
     return _checked(v["inner_radius"], v["pleat_width"], v["creases"], v["sector"],
                     v["fold_angle"], v["pieces"], v["across"], label)  # fmt: skip
-
-
-def facet_widths(pattern: CreasePattern, crease_width: float) -> np.ndarray:
-    """(ne,) the length ``w`` of every edge's bending spring ``k = E t^3 L / (12 w)``, m.
-
-    ``M``/``V``: ``crease_width``. ``F`` (a radial line between radii ``ra < rb``, its
-    neighbours ``dphi`` away): ``L dphi / ln(rb / ra)``, so that ``k`` is the integral of the
-    plate's ``D dr / (r dphi)`` along it (``D = E t^3 / 12``, as the model's springs) and the
-    hinges' ``k theta^2 / 2`` tends to the plate's ``D kappa^2 / 2`` over the area. ``J`` (joins):
-    the shorter of the quad's two sides meeting there (ring spacing, arc piece), the plate's
-    own length scale. Borders: ``crease_width`` (no spring).
-    """
-    xy = pattern.flat
-    if xy is None:
-        raise ParameterError("facet_widths needs the flat layout of a curved pleat")
-    nl = int(pattern.meta.get("pieces", 0)) + 1
-    across = int(pattern.meta.get("across", 0))
-    if nl < 3 or across < 1:
-        raise ParameterError("facet_widths takes a curved-pleat pattern (meta pieces, across)")
-    r = np.hypot(xy[:, 0], xy[:, 1])
-    th = np.arctan2(xy[:, 1], xy[:, 0])
-    dphi = float(np.ptp(th[:nl])) / (nl - 1)
-    e = pattern.edges
-    a, b = r[e[:, 0]], r[e[:, 1]]
-    L = np.linalg.norm(xy[e[:, 0]] - xy[e[:, 1]], axis=1)
-    out = np.full(len(e), float(crease_width))
-    f = pattern.assignment == "F"
-    lo, hi = np.minimum(a[f], b[f]), np.maximum(a[f], b[f])
-    out[f] = L[f] * dphi / np.log(hi / lo)
-    j = pattern.assignment == "J"
-    dr = float(np.ptp(r)) / (len(r) // nl - 1)
-    out[j] = np.minimum(dr, np.minimum(a[j], b[j]) * dphi)
-    return out
 
 
 def build_family(values: dict, label) -> CreasePattern:

@@ -492,14 +492,15 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
     # of the thinner panel, D = E t^3 / (12 (1 - nu^2)) per unit length over half the distance
     # h1 + h2 (heights 2 A / L of the two panels) between the opposite corners:
     # k = 2 D L / (h1 + h2), exact for cylindrical bending about rungs of a quad strip; the
-    # half distance is taken as at least the crease width W (a sliver is no stiffer than a
-    # facet of the panel's thickness over W, what a J edge was before)
+    # half distance is taken as at least the panel's thickness (a plate does not bend over
+    # less than its thickness: a sliver is no stiffer than D L / t)
     jay = np.asarray(pattern.assignment)[cid] == "J"
     if jay.any():
         jc, f1, f2 = cid[jay], t.first[cid[jay]], t.last[cid[jay]]
         Lj = edge_len[:, jc]
-        D = E_panel[:, None] * np.minimum(tp[:, f1], tp[:, f2]) ** 3 / (12.0 * (1 - nu_panel**2))
-        half = np.maximum((area[:, f1] + area[:, f2]) / Lj, W[:, jc])
+        tj = np.minimum(tp[:, f1], tp[:, f2])
+        D = E_panel[:, None] * tj**3 / (12.0 * (1 - nu_panel**2))
+        half = np.maximum((area[:, f1] + area[:, f2]) / Lj, tj)
         k_hinge[:, jay] = D * Lj / half
     k_panel = E_panel[:, None] * tp[:, face] ** 3 * spoke_len
 

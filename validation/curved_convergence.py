@@ -7,9 +7,9 @@ Two reference cases of the ``curved-pleat`` family (:mod:`holofold.geometry.curv
 * ``pleat``: a curved pleat of 3 creases (r 100-180 mm, every 20 mm, 90 deg, 60 deg).
 
 Each is folded by :func:`holofold.mechanics.fold_pattern` (concentrated hinges, E 2 GPa,
-nu 0.3, panels 0.2 mm, creases 0.5 mm thick and 1 mm wide; facet hinges with the plate's
-bending stiffness, :func:`~holofold.geometry.curved_pleat.facet_widths`; intersections not
-checked) to 100 % at refinement levels ``pieces:across`` (pieces per arc, quads across each
+nu 0.3, panels 0.2 mm, creases 0.5 mm thick and 1 mm wide; the mesh edges inside a pleat
+bend with the plate's stiffness, :func:`holofold.mechanics.build_concentrated`; intersections
+not checked) to 100 % at refinement levels ``pieces:across`` (pieces per arc, quads across each
 pleat). The levels are nested, so the vertices of the coarsest level are the same material
 points in every level. Measured per level:
 
@@ -45,7 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from holofold.geometry.curved_pleat import CurvedPleat, facet_widths
+from holofold.geometry.curved_pleat import CurvedPleat
 from holofold.mechanics import fold_pattern
 
 #: the two reference cases: name -> CurvedPleat arguments (without pieces, across)
@@ -83,7 +83,7 @@ def fold_level(case: str, pieces: int, across: int, time_limit: float | None = N
     p = g.pattern()
     t0 = time.perf_counter()
     res = fold_pattern(
-        p, 1.0, crease_width=facet_widths(p, CREASE_WIDTH), **SECTION,
+        p, 1.0, crease_width=CREASE_WIDTH, **SECTION,
         check_intersections=False, time_limit=time_limit,
     )  # fmt: skip
     dt = time.perf_counter() - t0
