@@ -58,7 +58,7 @@ def test_a_run_stopped_by_a_signal_counts_in_the_time_total(tmp_path, monkeypatc
 
     import pytest
 
-    from holofold.design import loop
+    from holofold.design.loop import design_loop as loop
     from holofold.design.loop.design_loop import DesignLoop, run_design
 
     def stopped(self):  # 1.25 s of simulation, then Ctrl-C (or SIGTERM as SystemExit)

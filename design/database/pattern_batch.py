@@ -123,7 +123,8 @@ def _fold_fields(fold) -> dict:
 
 
 def _simulate(path, setting, options, size, scale, stage):
-    from holofold.mechanics import scaled_pattern, simulate_pattern
+    import holofold.mechanics.pattern_simulation as simulation  # its simulate_pattern, as
+    # looked up at the call (a test replaces it there)
 
     reader = reader_for(path)
     given = {k: v for k, v in options.items() if v is not None and k in reader.options}
@@ -133,11 +134,11 @@ def _simulate(path, setting, options, size, scale, stage):
     stage[0] = "fold"
     if size is not None:
         xy = pattern.flat if pattern.flat is not None else pattern.coords
-        pattern = scaled_pattern(pattern, size / float(np.ptp(xy, axis=0).max()))
+        pattern = simulation.scaled_pattern(pattern, size / float(np.ptp(xy, axis=0).max()))
     elif scale is not None:
-        pattern = scaled_pattern(pattern, scale)
+        pattern = simulation.scaled_pattern(pattern, scale)
     pattern = dataclasses.replace(pattern, meta={**pattern.meta, "source": Path(path).name})
-    return pattern, simulate_pattern(pattern, setting)
+    return pattern, simulation.simulate_pattern(pattern, setting)
 
 
 def check_pattern_file(path, setting, options=None, size=None, scale=None, time_limit=None) -> dict:
