@@ -231,3 +231,27 @@ def test_misspelled_family_parameter_refused_in_one_line(tmp_path):
     f.write_text(SCENARIO.format(extra="").replace("curved-pleat", "curved-plaet"), "utf-8")
     with pytest.raises(ValueError, match="family = 'curved-plaet'"):
         read_scenario(f)
+
+
+def test_printable_parts_of_a_folded_pleat_are_one_body_each():
+    """Its panels are triangles joined by J edges (no hinge): flat and folded, the part is one
+    watertight body (the folded one came apart in 40 before the joins overlapped), and the
+    triangles of a panel bent at its joins do not count as panels running into each other."""
+    import warnings
+
+    from holofold.geometry.printable import folded_printable_solid, printable_solid
+    from holofold.geometry.solid import SolidWarning
+    from holofold.mechanics import fold_pattern
+
+    p = get_family("curved-pleat").make(
+        inner_radius=0.1, pleat_width=0.02094, creases=3, sector=90, fold_angle=52.99
+    )
+    r = fold_pattern(p, 1.0, panel_thickness=0.3e-3, crease_thickness=0.3e-3,
+                     crease_width=1e-3, E=2e9, nu=0.38)  # fmt: skip
+    flat = printable_solid(p, 0.3e-3, 0.3e-3, 1e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SolidWarning)
+        folded = folded_printable_solid(r.folded(), 0.3e-3, 0.3e-3, 1e-3)
+    assert flat.is_watertight and folded.is_watertight
+    # the folded part keeps the flat part's volume within the bent hinges' difference (0.3 %)
+    assert folded.volume == pytest.approx(flat.volume, rel=0.01)
