@@ -121,14 +121,21 @@ class PanelContact:
             )
 
     def _exclude_neighbours(self, X) -> int:
-        """Primitives within the barrier's reach in the starting state never collide with each
-        other: neighbours of a flat sheet closer than the thickness in its plane (thin
-        triangles round a vertex, the two coincident sides of a cut), which a barrier
-        infinite below the thickness could not start from (the exclusion of rest-state
-        neighbours of cloth simulators). Sets the mesh's collision filter; returns the number
-        of vertex pairs excluded. Their crossing is still caught by the intersection check."""
+        """Where the starting state is a flat sheet, primitives within the barrier's reach in
+        it never collide with each other: neighbours in its plane (thin triangles round a
+        vertex, the two coincident sides of a cut), which a barrier infinite below the
+        thickness could not start from and would push apart in the plane (the exclusion of
+        rest-state neighbours of cloth simulators). A starting state that is not flat keeps
+        every pair (its layers are layers). Sets the mesh's collision filter; returns the
+        number of vertex pairs excluded. Their crossing is still caught by the intersection
+        check."""
         if not len(self._collisions(X)):
             return 0
+        centred = X - X.mean(axis=0)
+        if np.linalg.svd(centred, compute_uv=False)[-1] > 1e-9 * max(self.size, 1e-300) * math.sqrt(
+            len(X)
+        ):  # not a flat sheet: layers near each other are layers (closer than the thickness:
+            return 0  # refused below)
         reach = self.dmin + self.dhat
         cand = self.ipc.Candidates()
         cand.build(self.mesh, X, 0.5 * reach)

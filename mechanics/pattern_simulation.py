@@ -118,11 +118,13 @@ class PatternSetting:
         Largest rest-angle change per fold step, degrees.
     collisions : bool
         Check the folded thick panels for collisions.
-    contact : bool
+    contact : bool or "auto"
         Barrier contact between the thick panels while folding
-        (:mod:`holofold.mechanics.contact`, needs ``holofold[contact]``): the fold stops where
-        the panels touch instead of passing them through each other and stopping at the last
-        clean state. Off by default (its cost: docs/patterns.md).
+        (:mod:`holofold.mechanics.contact`, needs ``holofold[contact]``): the layers are held a
+        panel thickness apart, and the fold stops where they cannot go on. ``"auto"``
+        (default): on where IPC Toolkit is installed, else off (the intersection check still
+        stops a fold at its last clean state; :attr:`contact_on` says which); True: on,
+        refused before any work without IPC Toolkit; False: off.
     thick : str
         The thickness technique of the panels checked (``"centred"``, ``"offset"``,
         ``"tapered"``) or ``"auto"`` (default): the first of them that folds without overlap
@@ -144,7 +146,7 @@ class PatternSetting:
     max_step_deg: float = 3.0
     collisions: bool = True
     thick: str = "auto"
-    contact: bool = False
+    contact: bool | str = "auto"
 
     def __post_init__(self):
         if isinstance(self.material, str):
@@ -163,8 +165,15 @@ class PatternSetting:
             raise ParameterError(f"load names must differ: {names}")
         if self.loads and not self.supports:
             raise ParameterError("loads need supports: give the vertices that hold the pattern")
-        if self.contact and not has_ipctk():  # before any work
+        if not (self.contact is True or self.contact is False or self.contact == "auto"):
+            raise ParameterError(f"contact = {self.contact!r}; allowed: 'auto', True, False")
+        if self.contact is True and not has_ipctk():  # before any work
             raise EnvironmentFault(CONTACT_INSTALL)
+
+    @property
+    def contact_on(self) -> bool:
+        """Whether the fold runs with barrier contact (``contact`` "auto": where installed)."""
+        return has_ipctk() if self.contact == "auto" else bool(self.contact)
 
 
 @dataclass(frozen=True)
@@ -329,7 +338,7 @@ def simulate_pattern(pattern: CreasePattern, setting: PatternSetting) -> Pattern
     fold = fold_pattern(
         pattern, s.fold, panel_thickness=s.panel_thickness, crease_thickness=s.crease_thickness,
         crease_width=s.crease_width, E=s.material.E, nu=s.material.nu, model=s.model,
-        max_step_deg=s.max_step_deg, contact=s.contact,
+        max_step_deg=s.max_step_deg, contact=s.contact_on,
     )  # fmt: skip
     outcomes = []
     if s.loads:
@@ -440,6 +449,7 @@ def _summary(sim: PatternSimulation) -> dict:
             "model": s.model,
             "supports": [str(v) for v in s.supports],
             "support_dofs": s.support_dofs,
+            "contact": s.contact_on,
         },
         "fold": {
             "verdict": f.verdict,

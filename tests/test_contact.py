@@ -129,3 +129,24 @@ def test_a_snap_into_the_layers_is_a_contact_stop_not_a_stall():
     assert 0.85 < on.touch_at <= on.reached < 0.9
     assert min(on.touch_where) >= 0 and "held a panel thickness apart" in on.note
     assert not any(intersects(on.structure, U) for U in on.U)
+
+
+def test_a_cut_pattern_starts_flat_with_contact():
+    """Origami Simulator's simple pop-up: the two sides of each cut coincide in the flat sheet
+    (IPC Toolkit's own test flags them, and the barrier is infinite there). Pairs within reach
+    in a flat start are excluded from colliding, so it folds; no stored state intersects."""
+    import warnings
+
+    from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
+    from holofold.mechanics.intersection import has_intersections
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = read_pattern(Path(__file__).parent / "data" / "origami-simulator" / "popupSimple.svg")
+    p = scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))
+    pp = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9, nu=0.42)
+    on = fold_pattern(p, 1.0, contact=True, **pp)
+    assert on.complete and on.verdict == "folds rigidly"
+    # holofold's own test (IPC Toolkit's flags the coincident sides of the cuts themselves)
+    assert not any(has_intersections(c, p.faces, backend="numpy") for c in on.coords)

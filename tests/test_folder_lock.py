@@ -192,7 +192,8 @@ def test_the_lock_is_reentrant_in_one_process_and_a_refused_run_leaves_no_folder
 
 
 def test_a_run_checks_the_folder_holds_its_own_table_and_settings(tmp_path, monkeypatch):
-    from holofold.design import generate_database, store
+    from holofold.design import generate_database
+    from holofold.design.database import store
 
     db = tmp_path / "db"
     generate_database("single-miura", 12, db, seed=4, chunk_size=6)

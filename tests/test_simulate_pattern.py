@@ -204,6 +204,32 @@ def test_contact_without_ipc_toolkit_stops_before_any_work(tmp_path, capsys, mon
     assert len(err.strip().splitlines()) == 1 and not out.exists()
 
 
+def test_contact_is_on_where_ipc_toolkit_is_and_off_where_it_is_not(tmp_path, monkeypatch):
+    """The default ("auto"): the simulation folds with contact where IPC Toolkit is installed
+    and without it elsewhere, and simulation.json says which; --no-contact turns it off."""
+    import json
+
+    import holofold.mechanics.pattern_simulation as sim
+
+    monkeypatch.setattr(sim, "has_ipctk", lambda: False)
+    assert PatternSetting().contact_on is False
+    code = main(["simulate", str(OS / "waterbombBase.svg"), "-o", str(tmp_path / "a")])
+    assert code == 0
+    assert (
+        json.loads((tmp_path / "a" / "simulation.json").read_text())["setting"]["contact"] is False
+    )
+    monkeypatch.setattr(sim, "has_ipctk", lambda: True)
+    assert PatternSetting().contact_on is True and PatternSetting(contact=False).contact_on is False
+    code = main(["simulate", str(OS / "waterbombBase.svg"), "--no-contact", "-o",
+                 str(tmp_path / "b")])  # fmt: skip
+    assert code == 0
+    assert (
+        json.loads((tmp_path / "b" / "simulation.json").read_text())["setting"]["contact"] is False
+    )
+    with pytest.raises(ParameterError, match="allowed: 'auto', True, False"):
+        PatternSetting(contact="yes")
+
+
 def test_a_sheet_too_small_for_its_creases_is_refused_not_given_a_negative_mass(tmp_path, capsys):
     """The issue's Miura scaled to 3 mm with 1 mm creases: the panels vanish under their hinge
     strips (before: mass -0.0045 g, 'folds rigidly'); refused in one line, nothing written."""

@@ -79,9 +79,14 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--increments", type=int, default=5, help="load increments (default 5)")
     p.add_argument("--no-collisions", action="store_true", help="skip the collision check")
     p.add_argument(
-        "--contact", action="store_true",
-        help="barrier contact between the thick panels while folding (needs holofold[contact]; "
-        "slower: docs/patterns.md)",
+        "--contact", action="store_const", const=True, default="auto",
+        help="barrier contact between the thick panels while folding (the default where "
+        "IPC Toolkit is installed: holofold[contact]; refused without it)",
+    )  # fmt: skip
+    p.add_argument(
+        "--no-contact", action="store_const", const=False, dest="contact",
+        help="fold without contact (the intersection check still stops a fold where panels "
+        "would pass through each other)",
     )  # fmt: skip
     p.add_argument("--units", choices=("mm", "m"), default="mm", help="STL/OBJ unit (mm)")
     p.add_argument(
