@@ -131,11 +131,12 @@ class PanelContact:
         check."""
         if not len(self._collisions(X)):
             return 0
-        centred = X - X.mean(axis=0)
-        if np.linalg.svd(centred, compute_uv=False)[-1] > 1e-9 * max(self.size, 1e-300) * math.sqrt(
-            len(X)
-        ):  # not a flat sheet: layers near each other are layers (closer than the thickness:
-            return 0  # refused below)
+        # out of plane: the smallest singular value of the centred nodes (RMS distance from
+        # their best plane x sqrt(n)); a start that is not flat keeps every pair (a pair closer
+        # than the thickness there is refused below)
+        out_of_plane = np.linalg.svd(X - X.mean(axis=0), compute_uv=False)[-1]
+        if out_of_plane > 1e-9 * max(self.size, 1e-300) * math.sqrt(len(X)):
+            return 0
         reach = self.dmin + self.dhat
         cand = self.ipc.Candidates()
         cand.build(self.mesh, X, 0.5 * reach)
