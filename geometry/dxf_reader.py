@@ -178,6 +178,16 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
     kept: list = []
     ents = list(_entities(doc.modelspace()))
     pts_all = []
+
+    def add(pieces, code, ang):
+        """Each polyline of ``pieces`` as segments of assignment ``code`` and angle ``ang``."""
+        for P in pieces:
+            pts_all.append(P)
+            for a, b in zip(P[:-1], P[1:], strict=True):
+                segs.append([a, b])
+                codes.append(code)
+                angles.append(ang)
+
     for e in ents:
         t = e.dxftype()
         if t not in ("LINE", "LWPOLYLINE", "POLYLINE", *_CURVES):
@@ -206,13 +216,7 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
                 got = _kept_curves(e, p, code, ang)
                 if got is not None:  # curves, and the straight pieces between them
                     kept += got[0]
-                    pieces = got[1]
-                    for P in pieces:
-                        pts_all.append(P)
-                        for a, b in zip(P[:-1], P[1:], strict=True):
-                            segs.append([a, b])
-                            codes.append(code)
-                            angles.append(ang)
+                    add(got[1], code, ang)
                     continue
             pieces = []
             for sub in p.sub_paths():
@@ -232,12 +236,7 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
                 P = np.array([[v.x, v.y] for v in vs])
                 if len(P) >= 2:
                     pieces.append(P)
-        for P in pieces:
-            pts_all.append(P)
-            for a, b in zip(P[:-1], P[1:], strict=True):
-                segs.append([a, b])
-                codes.append(code)
-                angles.append(ang)
+        add(pieces, code, ang)
     if curved_creases:
         raise FormatError(
             f"{name}: {curved_creases} curved crease(s); holofold folds straight creases: draw "
