@@ -52,14 +52,15 @@ def _mod(a, b):
 
 
 @njit(**_OPTS)
-def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, energy, force, K):
+def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, out):
     """Bars of :func:`~holofold.mechanics.bars.bar_kernel` from nodal arrays.
 
     ``X``, ``U`` (nn, 3) reference coordinates and displacements, m; ``b0``, ``b1`` (nb,)
-    end nodes; ``D0`` (3, nb) reference bar vectors; ``L0``, ``EA`` (nb,). Writes
-    ``energy`` (nb,), ``force`` (3, 2, nb) and, if ``tangent``, ``K`` (3, 3, 2, 2, nb): the
-    numpy kernel's layouts.
+    end nodes; ``D0`` (3, nb) reference bar vectors; ``L0``, ``EA`` (nb,). Writes ``out =
+    (energy, force, K)``: ``energy`` (nb,), ``force`` (3, 2, nb) and, if ``tangent``, ``K``
+    (3, 3, 2, 2, nb): the numpy kernel's layouts.
     """
+    energy, force, K = out
     nb = b0.shape[0]
     for e in range(nb):
         na = np.uintp(b0[e])  # unsigned: no negative-index wrap-around in the loads
@@ -148,17 +149,19 @@ def spring_angles(X, U, sT, theta):
 
 
 @njit(**_OPTS)
-def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, theta):
+def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, out):
     """Springs of :func:`~holofold.mechanics.springs.spring_kernel` from nodal arrays.
 
     ``X``, ``U`` (nn, 3); ``sT`` (4, ns) node quadruples (i, j, k, l); ``k``, ``theta0``
-    (ns,); ``k_nonneg``: every k >= 0 (the numpy path's branch). Writes ``energy`` (ns,),
+    (ns,); ``k_nonneg``: every k >= 0 (the numpy path's branch). Writes ``out = (energy,
+    force, K, theta)``: ``energy`` (ns,),
     ``force`` (3, 4, ns), ``theta`` (ns,) and, if ``tangent``, ``K`` (3, 3, 10, ns): the numpy
     kernel's layouts (or any strided views with those indices; the outputs must not overlap
     each other or the inputs). The angles first (:func:`spring_angles`, scalar), then one
     branch-free loop over the springs (:mod:`~holofold.mechanics._spring_loop`), which runs
     vectorised across springs where the outputs are the kernels' contiguous layouts.
     """
+    energy, force, K, theta = out
     spring_angles(X, U, sT, theta)
     if tangent:
         spring_tangent_loop(X, U, sT, k, theta0, k_nonneg, energy, force, K, theta)
@@ -181,40 +184,35 @@ def scatter(src_a, tgt_a, val_a, src_b, tgt_b, val_b, src_c, tgt_c, val_c, out):
 
 
 @njit(**_OPTS)
-def _assemble_sample(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-    views, flats, f, K,
-):  # fmt: skip
-    """Sample ``s``'s kernels into ``views`` (memory ``flats``), its internal force into ``f``
-    and its tangent into ``K`` by the scatter lists (both zeroed first: the scatters write
+def _assemble_sample(m, s, sc, tangent_lists, f, K):
+    """Sample ``s``'s kernels (``m`` a :class:`~holofold.mechanics.kernel_args.ModelArrays`)
+    into ``sc.views`` (memory ``sc.flats``), its internal force into ``f`` by ``sc.force``
+    and its tangent into ``K`` by ``tangent_lists`` (both zeroed first: the scatters write
     only the entries that receive something)."""
-    eb, fb, Kb, es, fs, Ks, th = views
+    eb, fb, Kb, es, fs, Ks, th = sc.views
     f[:] = 0.0
     K[:] = 0.0
-    _, vfb, vkb, _, vfs, vks, _ = flats
-    fa, fsa, fb_, fsb, fc, fsc = force_lists
+    _, vfb, vkb, _, vfs, vks, _ = sc.flats
+    fa, fsa, fb_, fsb, fc, fsc = sc.force
     ka, ksa, kb_, ksb, kc, ksc = tangent_lists
-    bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
-    spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
+    bar_elements(m.X[s], m.U[s], m.b0[s], m.b1[s], m.D0[s], m.L0[s], m.EA[s], True, (eb, fb, Kb))
+    spring_elements(
+        m.X[s], m.U[s], m.sT[s], m.k[s], m.theta0[s], m.k_nonneg[s], True, (es, fs, Ks, th)
+    )
     scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, f)
     scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, K)
 
 
 @njit(**_OPTS)
-def assemble_batch(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, f_out, k_out,
-):  # fmt: skip
-    """For each sample ``s = idx[j]``: the kernels into the element arrays ``views`` (the
-    seven of one sample, in the kernels' layouts), then ``f_out[j]`` by the ``force_lists``
-    and ``k_out[j]`` by the ``tangent_lists`` (each the six lists of :func:`scatter`, without
-    the values), whose sources index the memory of the views, ``flats`` (``f_out`` and
-    ``k_out`` need not start as zeros)."""
+def assemble_batch(m, idx, sc, tangent_lists, f_out, k_out):
+    """For each sample ``s = idx[j]`` of ``m`` (a :class:`~holofold.mechanics.kernel_args.
+    ModelArrays`): the kernels into the element arrays ``sc.views`` (the seven of one sample,
+    in the kernels' layouts), then ``f_out[j]`` by ``sc.force`` and ``k_out[j]`` by
+    ``tangent_lists`` (each the six lists of :func:`scatter`, without the values), whose
+    sources index the memory of the views, ``sc.flats`` (``f_out`` and ``k_out`` need not
+    start as zeros)."""
     for j in range(idx.shape[0]):
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
-            tangent_lists, views, flats, f_out[j], k_out[j],
-        )  # fmt: skip
+        _assemble_sample(m, idx[j], sc, tangent_lists, f_out[j], k_out[j])
 
 
 # ------------------------------------------------------------------------ LAPACK calls
@@ -256,16 +254,17 @@ def _addresses(names: tuple[str, ...]) -> np.ndarray:
 
 
 @njit(**_OPTS)
-def band_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, perm, bw, addrs, Uflat, dU, f_out, info,
-):  # fmt: skip
+def band_newton_step(m, idx, sc, tangent_lists, Fi, fac, Uflat, out):
     """One Newton update of each sample ``s = idx[j]`` on the banded Cholesky path: the
-    kernels and scatters of :func:`assemble_batch` (force into ``f_out[j]``), ``dpbtrf`` of the
-    band, ``dpbtrs`` of ``(Fi[s] - f)[free]`` in the band's order ``perm``, ``dU[j]`` the
-    solution on the free DOFs and ``Uflat[s, free] += dU[j]``. ``info[j]``: 0 done, 1 not
-    positive definite (nothing solved or updated), 2 a non-finite solution (U not updated).
-    The operations of ``Assembler.evaluate_factorized`` and its band solver, in their order."""
+    kernels and scatters of :func:`assemble_batch` (force into ``out.f[j]``), ``dpbtrf`` of
+    the band, ``dpbtrs`` of ``(Fi[s] - f)[free]`` in the band's order ``fac.perm``,
+    ``out.dU[j]`` the solution on the free DOFs and ``Uflat[s, free] += dU[j]``.
+    ``out.info[j]``: 0 done, 1 not positive definite (nothing solved or updated), 2 a
+    non-finite solution (U not updated). The operations of ``Assembler.evaluate_factorized``
+    and its band solver, in their order. ``fac``: a :class:`~holofold.mechanics.kernel_args.
+    Factor` (dpbtrf, dpbtrs); ``out`` a ``BandOut``."""
+    free, perm, bw, addrs = fac
+    dU, f_out, info = out
     nf = free.shape[0]
     uplo = np.array([ord("U")], np.uint8)
     n_ = np.array([nf], np.int32)
@@ -278,10 +277,7 @@ def band_newton_step(
     for j in range(idx.shape[0]):
         s = idx[j]
         f = f_out[j]
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, ab,
-        )  # fmt: skip
+        _assemble_sample(m, s, sc, tangent_lists, f, ab)
         _fcall(addrs[0], (uplo, n_, kd_, ab, ld_, inf_))
         if inf_[0] != 0:
             info[j] = 1
@@ -309,10 +305,7 @@ def _accept(x, Uflat, s, free) -> int:
 
 
 @njit(**_OPTS)
-def small_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, chol_lists,
-    full_lists, views, flats, Fi, free, perm, bw, addrs, Uflat, dU, info, res, lu,
-):  # fmt: skip
+def small_newton_step(m, idx, sc, lists, Fi, fac, Uflat, out):
     """One Newton update of each sample ``s = idx[j]`` on the dense-path model (at most
     ``DENSE_MAX_DOF`` free DOFs) by the cheapest factorisation that holds: a Cholesky, and
     the LU of the whole matrix only where the tangent is not positive definite.
@@ -325,7 +318,12 @@ def small_newton_step(
     and ``lu[j]`` is set to 1. ``addrs``: dgetrf, dgetrs, then dpbtrf, dpbtrs (banded) or
     dpotrf, dpotrs (dense). ``res[j]`` receives ``(Fi[s] - f)[free]``; ``dU[j]`` the solution;
     ``info[j]``: 0 done (``Uflat[s, free] += dU[j]``), 1 singular, 2 a non-finite solution
-    (U not updated)."""
+    (U not updated). ``lists = (chol_lists, full_lists)``; ``fac`` a :class:`~holofold.
+    mechanics.kernel_args.Factor` (free, perm, bw, addrs); ``out`` a ``StepOut`` (dU, info,
+    res, lu)."""
+    chol_lists, full_lists = lists
+    free, perm, bw, addrs = fac
+    dU, info, res, lu = out
     nf = free.shape[0]
     c_u = np.array([ord("U")], np.uint8)
     c_n = np.array([ord("N")], np.uint8)
@@ -345,15 +343,9 @@ def small_newton_step(
         r = res[j]
         if lu[j] == 0:
             if bw >= 0:
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    chol_lists, views, flats, f, c,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, chol_lists, f, c)
             else:
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    full_lists, views, flats, f, a,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, full_lists, f, a)
                 c[:] = a
             if bw >= 0:
                 _fcall(addrs[2], (c_u, n_, kd_, c, ld_, inf_))
@@ -377,15 +369,9 @@ def small_newton_step(
                 continue
             lu[j] = 1
             if bw >= 0:  # the band held only the Cholesky's entries: the whole matrix now
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    full_lists, views, flats, f, a,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, full_lists, f, a)
         else:
-            _assemble_sample(
-                X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                full_lists, views, flats, f, a,
-            )  # fmt: skip
+            _assemble_sample(m, s, sc, full_lists, f, a)
         _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
         if inf_[0] > 0:
             info[j] = 1
@@ -399,11 +385,7 @@ def small_newton_step(
 
 
 @njit(**_OPTS)
-def newton_increments(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    full_lists, views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol,
-    max_iter, U_hist, conv, iters, res, moved, failed,
-):  # fmt: skip
+def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     """Newton-Raphson load control of each sample ``s = idx[j]``, every increment and
     iteration in this one call (:func:`holofold.mechanics.solvers.solve_newton`'s semantics).
 
@@ -417,14 +399,24 @@ def newton_increments(
     dpbtrs). A failed step stops the sample: ``failed[j] = (code, increment, step)`` with code
     1 (singular, or not positive definite on the banded path: the caller solves that sample
     another way) or 2 (a non-finite solution), the failing increment recorded with the last U
-    and R, not converged."""
+    and R, not converged.
+
+    ``lists = (tangent_lists, full_lists)``; ``load`` an :class:`~holofold.mechanics.
+    kernel_args.Increments` (F0, P, increments, tol, max_iter); ``fac`` a ``Factor`` (free,
+    perm, bw, addrs; ``bw < 0``: the dense path); ``rec`` an ``IncrementRecords`` (U_hist,
+    conv, iters, res, moved, failed)."""
+    tangent_lists, full_lists = lists
+    F0, P, increments, tol, max_iter = load
+    free, perm, bw, addrs = fac
+    U_hist, conv, iters, res, moved, failed = rec
+    banded = bw >= 0
     nf = free.shape[0]
     nd = Uflat.shape[1]
     c_u = np.array([ord("U")], np.uint8)
     c_n = np.array([ord("N")], np.uint8)
     n_ = np.array([nf], np.int32)
-    kd_ = np.array([bw], np.int32)
-    ld_ = np.array([bw + 1], np.int32)
+    kd_ = np.array([max(bw, 0)], np.int32)
+    ld_ = np.array([max(bw, 0) + 1], np.int32)
     one = np.array([1], np.int32)
     inf_ = np.zeros(1, np.int32)
     piv = np.empty(nf, np.int32)
@@ -445,10 +437,7 @@ def newton_increments(
             R = np.inf
             code = 0
             while step < max_iter and R > tol:
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    tangent_lists, views, flats, f, a,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, tangent_lists, f, a)
                 if banded:
                     _fcall(addrs[0], (c_u, n_, kd_, a, ld_, inf_))
                     if inf_[0] != 0:
@@ -468,10 +457,7 @@ def newton_increments(
                     if inf_[0] == 0:
                         _fcall(addrs[3], (c_u, n_, one, a, n_, x, n_, inf_))
                     else:  # the whole matrix this time
-                        _assemble_sample(
-                            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s,
-                            force_lists, full_lists, views, flats, f, a,
-                        )  # fmt: skip
+                        _assemble_sample(m, s, sc, full_lists, f, a)
                         _fcall(addrs[0], (n_, n_, a, n_, piv, inf_))
                         if inf_[0] > 0:
                             code = 1
@@ -524,14 +510,13 @@ def thermal_sides(x, tri, u, v, cross):
 
 
 @njit(**_OPTS)
-def thermal_system(
-    cos, sin, Lab, Lac, half_ab_ac, k_th, slots, side, k_env, layers, h, ptr, idx, data,
-    area, A, Gq,
-):  # fmt: skip
-    """From the angle's ``cos``, ``sin`` (nt,): ``area`` (nt,), the conduction matrix ``A``
-    (flat nn^2, zeros on entry) and the node-layer conductances ``Gq`` (nn, L), as
+def thermal_system(cos, sin, pieces, area, A, Gq):
+    """From the angle's ``cos``, ``sin`` (nt,) and the model's fixed ``pieces`` (a
+    :class:`~holofold.mechanics.thermal.CompiledPieces`): ``area`` (nt,), the conduction
+    matrix ``A`` (flat nn^2, zeros on entry) and the node-layer conductances ``Gq`` (nn, L), as
     ``triangle_edges``, ``_element_matrices`` + ``np.bincount`` and ``_air_links`` + the
     incidence product compute them. Returns False (nothing assembled) if an area is <= 0."""
+    Lab, Lac, half_ab_ac, k_th, slots, side, k_env, layers, h, ptr, idx, data = pieces
     nt = cos.shape[0]
     e = np.empty((3, 2))
     for t in range(nt):

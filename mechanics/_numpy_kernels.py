@@ -29,9 +29,10 @@ __all__ = [
 ]
 
 
-def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, energy, force, K):
-    """Bars into ``energy`` (nb,), ``force`` (3, 2, nb) and, if ``tangent``, ``K``
-    (3, 3, 2, 2, nb) (see ``_compiled.bar_elements``)."""
+def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, out):
+    """Bars into ``out = (energy, force, K)``: ``energy`` (nb,), ``force`` (3, 2, nb) and, if
+    ``tangent``, ``K`` (3, 3, 2, 2, nb) (see ``_compiled.bar_elements``)."""
+    energy, force, K = out
     d = (U[b1] - U[b0]).T
     res = bar_kernel(D0, d, L0, EA, tangent=tangent)
     energy[...] = res.energy
@@ -40,9 +41,11 @@ def bar_elements(X, U, b0, b1, D0, L0, EA, tangent, energy, force, K):
         K[...] = res.tangent
 
 
-def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, energy, force, K, theta):
-    """Springs into ``energy`` (ns,), ``force`` (3, 4, ns), ``theta`` (ns,) and, if
-    ``tangent``, ``K`` (3, 3, 10, ns) (see ``_compiled.spring_elements``)."""
+def spring_elements(X, U, sT, k, theta0, k_nonneg, tangent, out):
+    """Springs into ``out = (energy, force, K, theta)``: ``energy`` (ns,), ``force``
+    (3, 4, ns), ``theta`` (ns,) and, if ``tangent``, ``K`` (3, 3, 10, ns) (see
+    ``_compiled.spring_elements``)."""
+    energy, force, K, theta = out
     res, th = spring_kernel((X + U).T[:, sT], k, theta0, tangent=tangent)
     energy[...] = res.energy
     force[...] = res.force
@@ -59,32 +62,25 @@ def scatter(src_a, tgt_a, val_a, src_b, tgt_b, val_b, src_c, tgt_c, val_c, out):
             out += np.bincount(tgt, weights=val[src], minlength=n)
 
 
-def _assemble_sample(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-    views, flats, f, K,
-):  # fmt: skip
-    eb, fb, Kb, es, fs, Ks, th = views
+def _assemble_sample(m, s, sc, tangent_lists, f, K):
+    eb, fb, Kb, es, fs, Ks, th = sc.views
     f[:] = 0.0
     K[:] = 0.0
-    _, vfb, vkb, _, vfs, vks, _ = flats
-    fa, fsa, fb_, fsb, fc, fsc = force_lists
+    _, vfb, vkb, _, vfs, vks, _ = sc.flats
+    fa, fsa, fb_, fsb, fc, fsc = sc.force
     ka, ksa, kb_, ksb, kc, ksc = tangent_lists
-    bar_elements(X[s], U[s], b0[s], b1[s], D0[s], L0[s], EA[s], True, eb, fb, Kb)
-    spring_elements(X[s], U[s], sT[s], k[s], theta0[s], k_nonneg[s], True, es, fs, Ks, th)
+    bar_elements(m.X[s], m.U[s], m.b0[s], m.b1[s], m.D0[s], m.L0[s], m.EA[s], True, (eb, fb, Kb))
+    spring_elements(
+        m.X[s], m.U[s], m.sT[s], m.k[s], m.theta0[s], m.k_nonneg[s], True, (es, fs, Ks, th)
+    )
     scatter(fa, fsa, vfb, fb_, fsb, vfs, fc, fsc, vfs, f)
     scatter(ka, ksa, vkb, kb_, ksb, vks, kc, ksc, vks, K)
 
 
-def assemble_batch(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, f_out, k_out,
-):  # fmt: skip
+def assemble_batch(m, idx, sc, tangent_lists, f_out, k_out):
     """Samples ``idx``: force into ``f_out[j]``, tangent target into ``k_out[j]``."""
     for j in range(idx.shape[0]):
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx[j], force_lists,
-            tangent_lists, views, flats, f_out[j], k_out[j],
-        )  # fmt: skip
+        _assemble_sample(m, idx[j], sc, tangent_lists, f_out[j], k_out[j])
 
 
 def _accept(x, Uflat, s, free) -> int:
@@ -94,21 +90,17 @@ def _accept(x, Uflat, s, free) -> int:
     return 0
 
 
-def band_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    views, flats, Fi, free, perm, bw, addrs, Uflat, dU, f_out, info,
-):  # fmt: skip
+def band_newton_step(m, idx, sc, tangent_lists, Fi, fac, Uflat, out):
     """One Newton update per sample on the banded Cholesky path (``_compiled``'s twin: info
     0 done, 1 not positive definite, 2 a non-finite solution)."""
+    free, perm, bw, _ = fac
+    dU, f_out, info = out
     nf = free.shape[0]
     ab = np.empty((bw + 1) * nf)
     for j in range(idx.shape[0]):
         s = idx[j]
         f = f_out[j]
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, tangent_lists,
-            views, flats, f, ab,
-        )  # fmt: skip
+        _assemble_sample(m, s, sc, tangent_lists, f, ab)
         c, inf = dpbtrf(ab.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
         if inf != 0:
             info[j] = 1
@@ -119,13 +111,13 @@ def band_newton_step(
         info[j] = _accept(x, Uflat, s, free)
 
 
-def small_newton_step(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, chol_lists,
-    full_lists, views, flats, Fi, free, perm, bw, addrs, Uflat, dU, info, res, lu,
-):  # fmt: skip
+def small_newton_step(m, idx, sc, lists, Fi, fac, Uflat, out):
     """One Newton update per sample on a dense-path model: banded (``bw >= 0``) or dense
     Cholesky, the LU of the whole matrix where it fails or ``lu[j]`` is 1 (then set); the
     compiled twin's semantics (``_compiled.small_newton_step``)."""
+    chol_lists, full_lists = lists
+    free, perm, bw, _ = fac
+    dU, info, res, lu = out
     nf = free.shape[0]
     a = np.empty(nf * nf)
     c = np.empty((bw + 1) * nf if bw >= 0 else nf * nf)
@@ -134,16 +126,10 @@ def small_newton_step(
         s = idx[j]
         if lu[j] == 0:
             if bw >= 0:
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    chol_lists, views, flats, f, c,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, chol_lists, f, c)
                 fac, inf = dpbtrf(c.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
             else:
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    full_lists, views, flats, f, a,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, full_lists, f, a)
                 fac, inf = dpotrf(a.reshape(nf, nf).T, lower=0, clean=0)
             if inf == 0:
                 r = (Fi[s] - f)[free]
@@ -155,10 +141,7 @@ def small_newton_step(
                 info[j] = _accept(dU[j], Uflat, s, free)
                 continue
             lu[j] = 1
-        _assemble_sample(
-            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists, full_lists,
-            views, flats, f, a,
-        )  # fmt: skip
+        _assemble_sample(m, s, sc, full_lists, f, a)
         fac, piv, inf = dgetrf(a.reshape(nf, nf).T)
         if inf > 0:
             info[j] = 1
@@ -169,13 +152,14 @@ def small_newton_step(
         info[j] = _accept(dU[j], Uflat, s, free)
 
 
-def newton_increments(
-    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, idx, force_lists, tangent_lists,
-    full_lists, views, flats, F0, P, free, banded, perm, bw, addrs, Uflat, increments, tol,
-    max_iter, U_hist, conv, iters, res, moved, failed,
-):  # fmt: skip
+def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     """Newton-Raphson load control of each sample, every increment in this call (the
     compiled twin's semantics and records; see ``_compiled.newton_increments``)."""
+    tangent_lists, full_lists = lists
+    F0, P, increments, tol, max_iter = load
+    free, perm, bw, _ = fac
+    U_hist, conv, iters, res, moved, failed = rec
+    banded = bw >= 0
     nf = free.shape[0]
     a = np.empty((bw + 1) * nf if banded else nf * nf)
     f = np.empty(Uflat.shape[1])
@@ -187,10 +171,7 @@ def newton_increments(
             start = Uflat[s].copy()
             step, R, code = 1, np.inf, 0
             while step < max_iter and R > tol:
-                _assemble_sample(
-                    X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s, force_lists,
-                    tangent_lists, views, flats, f, a,
-                )  # fmt: skip
+                _assemble_sample(m, s, sc, tangent_lists, f, a)
                 r = (Fi - f)[free]
                 if banded:
                     c, inf = dpbtrf(a.reshape(nf, bw + 1).T, lower=0, overwrite_ab=1)
@@ -204,10 +185,7 @@ def newton_increments(
                     if inf == 0:
                         x = dpotrs(c, r, lower=0)[0]
                     else:
-                        _assemble_sample(
-                            X, U, b0, b1, D0, L0, EA, sT, k, theta0, k_nonneg, s,
-                            force_lists, full_lists, views, flats, f, a,
-                        )  # fmt: skip
+                        _assemble_sample(m, s, sc, full_lists, f, a)
                         lu, piv, inf = dgetrf(a.reshape(nf, nf).T)
                         if inf > 0:
                             code = 1

@@ -25,6 +25,7 @@ import scipy.sparse as sp
 
 from holofold.mechanics import kernels, linear
 from holofold.mechanics.bars import ElementResponse
+from holofold.mechanics.kernel_args import ModelArrays, Scatter
 from holofold.mechanics.linear import DENSE_MAX_DOF, SingularSystemError, solver_path
 from holofold.mechanics.sparsity import AssemblyPattern, ReducedPattern, SumLists, assembly_pattern
 from holofold.mechanics.springs import arccos_shift
@@ -114,9 +115,10 @@ class KernelInputs(NamedTuple):
             np.ascontiguousarray(structure.spring_k, dtype=float),
         )
 
-    def with_displacements(self, U) -> tuple:
-        """The kernels' leading arguments: ``(X, U, b0, b1, D0, L0, EA, sT, k)``."""
-        return (self.X, U, *self[1:])
+    def model(self, U, theta0, k_nonneg) -> ModelArrays:
+        """The kernels' model record: these arrays with displacements ``U``, rest angles
+        ``theta0`` and ``k_nonneg`` (batch-shaped like the inputs)."""
+        return ModelArrays(self.X, U, *self[1:], theta0, k_nonneg)
 
     def batch_of_one(self) -> KernelInputs:
         return KernelInputs(*(a.reshape((1, *a.shape)) for a in self))
@@ -234,11 +236,11 @@ class Assembler:
         theta0 = self.rest_angles(U, spring_rest)
         X, b0, b1, D0, L0, EA, sT, k = self.inputs
         ck.bar_elements(
-            X, U, b0, b1, D0, L0, EA, tangent, out.bar_energy, out.bar_force, out.bar_tangent
+            X, U, b0, b1, D0, L0, EA, tangent, (out.bar_energy, out.bar_force, out.bar_tangent)
         )
         ck.spring_elements(
-            X, U, sT, k, theta0, self.k_nonneg, tangent, out.spring_energy, out.spring_force,
-            out.spring_tangent, out.spring_angle,
+            X, U, sT, k, theta0, self.k_nonneg, tangent,
+            (out.spring_energy, out.spring_force, out.spring_tangent, out.spring_angle),
         )  # fmt: skip
         return out
 
@@ -406,6 +408,11 @@ class BatchAssembler:
     def free_dofs(self) -> np.ndarray:
         return self.groups[0][1].free
 
+    def scatter(self, pat: AssemblyPattern) -> Scatter:
+        """The kernels' :class:`~holofold.mechanics.kernel_args.Scatter` of connectivity
+        ``pat``: its force sums and this batch's element arrays."""
+        return Scatter(pat.force_sums, self.scratch, self.scratch.flat())
+
     def rest_angles(self, U3, active, spring_rest=None) -> np.ndarray:
         """(S, ns) rest angles the kernels use (the reference's arccos shift where asked)."""
         rest = self.theta0 if spring_rest is None else np.array(spring_rest, dtype=float)
@@ -460,9 +467,8 @@ class BatchAssembler:
             fj = np.empty((idx.size, self.n_dof))
             kj = np.empty((idx.size, red.storage_size(storage)))
             ck.assemble_batch(
-                *self.inputs.with_displacements(U), theta0, self.k_nonneg, idx,
-                pat.force_sums, lists, self.scratch, self.scratch.flat(), fj, kj,
-            )  # fmt: skip
+                self.inputs.model(U, theta0, self.k_nonneg), idx, self.scatter(pat), lists, fj, kj
+            )
             f[idx] = fj
             for j, s in enumerate(idx):
                 solves[s] = self._solver(s, path, red, kj[j], U[s], rest[s])

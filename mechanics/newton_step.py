@@ -16,6 +16,14 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from holofold.mechanics import kernels
+from holofold.mechanics.kernel_args import (
+    BandOut,
+    Factor,
+    IncrementRecords,
+    Increments,
+    Scatter,
+    StepOut,
+)
 from holofold.mechanics.linear import (
     NON_FINITE,
     SINGULAR,
@@ -67,9 +75,10 @@ class DenseStepper:
         one = asm.inputs.batch_of_one()
         chol, full, perm, bw, addrs = _small_args(red, path.module)
         self._args = (
-            *one.with_displacements(U.reshape(1, -1, 3)), theta0, np.array([asm.k_nonneg]),
-            _ONE, asm.pattern.force_sums, chol, full, scratch, scratch.flat(), F.reshape(1, -1),
-            red.free, perm, bw, addrs, U.reshape(1, -1), self.dU, self.info, res, self.lu,
+            one.model(U.reshape(1, -1, 3), theta0, np.array([asm.k_nonneg])), _ONE,
+            Scatter(asm.pattern.force_sums, scratch, scratch.flat()), (chol, full),
+            F.reshape(1, -1), Factor(red.free, perm, bw, addrs), U.reshape(1, -1),
+            StepOut(self.dU, self.info, res, self.lu),
         )  # fmt: skip
 
     def __call__(self) -> np.ndarray:
@@ -115,31 +124,29 @@ def batch_newton_step(batch: BatchAssembler, U, rhs_force, active):
     errors: dict = {}
     rest = active.copy()
     if not any(batch.arccos):
-        flats = batch.scratch.flat()
         for pat, red, members in batch.groups:
             idx = np.ascontiguousarray(members[active[members]], dtype=np.intp)
             kind = solver_path(red, batch.dense_max)
             if idx.size == 0 or kind not in _LAPACK:
                 continue
-            addrs = ck.lapack_addresses(*_LAPACK[kind])
-            common = (
-                *batch.inputs.with_displacements(U3), batch.theta0, batch.k_nonneg, idx,
-                pat.force_sums,
-            )  # fmt: skip
+            model = batch.inputs.model(U3, batch.theta0, batch.k_nonneg)
             dU = np.empty((idx.size, red.n_free))
             info = np.zeros(idx.size, np.int8)
             if kind == "banded":
                 band = red.band
-                fj = np.empty((idx.size, batch.n_dof))
+                fac = Factor(
+                    red.free, band.perm, int(band.bandwidth), ck.lapack_addresses(*_LAPACK[kind])
+                )
+                out = BandOut(dU, np.empty((idx.size, batch.n_dof)), info)
                 ck.band_newton_step(
-                    *common, red.tangent_sums("banded"), batch.scratch, flats, Fi, red.free,
-                    band.perm, band.bandwidth, addrs, U, dU, fj, info,
-                )  # fmt: skip
+                    model, idx, batch.scatter(pat), red.tangent_sums("banded"), Fi, fac, U, out
+                )
             else:  # the Cholesky first, the LU where it fails (as DenseStepper)
                 chol, full, perm, bw, small = _small_args(red, ck)
                 ck.small_newton_step(
-                    *common, chol, full, batch.scratch, flats, Fi, red.free, perm, bw, small,
-                    U, dU, info, dU, np.zeros(idx.size, np.int8),
+                    model, idx, batch.scatter(pat), (chol, full), Fi,
+                    Factor(red.free, perm, bw, small), U,
+                    StepOut(dU, info, dU, np.zeros(idx.size, np.int8)),
                 )  # fmt: skip
             dU_all[idx] = dU
             rest[idx] = False
@@ -198,27 +205,24 @@ def batch_newton_increments(batch: BatchAssembler, U, F0, P, increments, tol, ma
         np.zeros((S, increments), np.int64), np.full((S, increments), np.nan),
         np.zeros((S, increments)), np.zeros((S, 3), np.int64), np.zeros(S, bool),
     )  # fmt: skip
-    F0 = np.ascontiguousarray(F0, dtype=float)
-    P = np.ascontiguousarray(P, dtype=float)
-    flats = batch.scratch.flat()
+    load = Increments(
+        np.ascontiguousarray(F0, dtype=float), np.ascontiguousarray(P, dtype=float),
+        int(increments), float(tol), int(max_iter),
+    )  # fmt: skip
+    model = batch.inputs.model(U3, batch.theta0, batch.k_nonneg)
     for (pat, red, members), kind in zip(batch.groups, kinds, strict=True):
         banded = kind == "banded"
         band = red.band if banded else None
         perm = band.perm if banded else np.zeros(0, np.intp)
-        bw = band.bandwidth if banded else 0
+        bw = int(band.bandwidth) if banded else -1
         idx = np.ascontiguousarray(members, dtype=np.intp)
-        n = idx.size
-        out = (np.empty((n, increments, nd)), np.zeros((n, increments), bool),
-               np.zeros((n, increments), np.int64), np.full((n, increments), np.nan),
-               np.zeros((n, increments)), np.zeros((n, 3), np.int64))  # fmt: skip
-        ck.newton_increments(
-            *batch.inputs.with_displacements(U3), batch.theta0, batch.k_nonneg, idx,
-            pat.force_sums, red.tangent_sums("banded" if banded else "dense_upper"),
-            red.tangent_sums("banded" if banded else "dense_cm"), batch.scratch, flats, F0, P,
-            red.free, banded, perm, bw,
-            ck.lapack_addresses(*_SOLVE[kind]), U, int(increments), float(tol),
-            int(max_iter), *out,
-        )  # fmt: skip
+        out = IncrementRecords.empty(idx.size, increments, nd)
+        lists = (
+            red.tangent_sums("banded" if banded else "dense_upper"),
+            red.tangent_sums("banded" if banded else "dense_cm"),
+        )
+        fac = Factor(red.free, perm, bw, ck.lapack_addresses(*_SOLVE[kind]))
+        ck.newton_increments(model, idx, batch.scatter(pat), lists, load, fac, U, out)
         for field, values in zip(rec[:6], out, strict=True):
             field[idx] = values
         rec.banded[idx] = banded

@@ -32,6 +32,7 @@ Typical use::
 from __future__ import annotations
 
 from functools import cache
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -333,14 +334,35 @@ def _stack_size(sup, rptr, sparent, chead, cnext):
 
 
 # ------------------------------------------------------------------------ numeric factor
+class FrontPlan(NamedTuple):
+    """What the numeric factorisation reads of the symbolic analysis (see ``_Analysis``):
+    value slots, column pointers, entry positions, supernode bounds and relative row maps,
+    row and factor pointers, the supernodal tree (parent, first child, next sibling), and
+    the update stack's and largest front's sizes."""
+
+    slots: np.ndarray
+    cp: np.ndarray
+    pos: np.ndarray
+    sup: np.ndarray
+    rel: np.ndarray
+    rptr: np.ndarray
+    lptr: np.ndarray
+    sparent: np.ndarray
+    chead: np.ndarray
+    cnext: np.ndarray
+    stack_n: int
+    max_front: int
+
+
 @_jit
-def _factor(data, slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, stack_n,
-            max_front, addrs, lx, ldl, ipiv):  # fmt: skip
-    """Multifrontal numeric factorisation into ``lx`` (each supernode's m x nc block,
-    column-major); 0, or 1 + the column where the matrix is not positive definite (``ldl``:
-    where a pivot block is singular). ``ldl``: each pivot block by LAPACK's Bunch-Kaufman
-    ``dsytrf`` (pivots in ``ipiv``, interchanges within the block only) and the rows below
-    kept as they are (block elimination), for symmetric indefinite matrices."""
+def _factor(data, plan, addrs, lx, ldl, ipiv):
+    """Multifrontal numeric factorisation of the values ``data`` by ``plan`` (a
+    :class:`FrontPlan`) into ``lx`` (each supernode's m x nc block, column-major); 0, or 1 +
+    the column where the matrix is not positive definite (``ldl``: where a pivot block is
+    singular). ``ldl``: each pivot block by LAPACK's Bunch-Kaufman ``dsytrf`` (pivots in
+    ``ipiv``, interchanges within the block only) and the rows below kept as they are (block
+    elimination), for symmetric indefinite matrices."""
+    slots, cp, pos, sup, rel, rptr, lptr, sparent, chead, cnext, stack_n, max_front = plan
     ns = sup.shape[0] - 1
     F = np.empty(max_front)
     X = np.empty(max_front)
@@ -612,6 +634,10 @@ class _Analysis:
         self.lptr = np.concatenate([[0], np.cumsum(m * nc)]).astype(np.int64)
         self.max_front = int((m * m).max()) if m.size else 0
         self.stack = int(_stack_size(sup, rptr, sparent, chead, cnext))
+        self.plan = FrontPlan(
+            self.slots, cp, self.pos, sup, rel, rptr, self.lptr, sparent, chead, cnext,
+            self.stack, self.max_front,
+        )  # fmt: skip
         self.flops = float((count.astype(float) ** 2).sum())
         self.ri = ri
 
@@ -665,9 +691,8 @@ class SupernodalCholesky:
         a = self._a
         lx = np.empty(int(a.lptr[-1]))
         code = _factor(
-            np.ascontiguousarray(data, dtype=float), a.slots, a.cp, a.pos, a.sup, a.rel,
-            a.rptr, a.lptr, a.sparent, a.chead, a.cnext, a.stack, a.max_front, _addresses(),
-            lx, False, np.zeros(1, np.int32),
+            np.ascontiguousarray(data, dtype=float), a.plan, _addresses(), lx, False,
+            np.zeros(1, np.int32),
         )  # fmt: skip
         return None if code else SupernodalFactor(a, lx)
 
@@ -680,10 +705,7 @@ class SupernodalCholesky:
         data = np.ascontiguousarray(data, dtype=float)
         lx = np.empty(int(a.lptr[-1]))
         ipiv = np.zeros(a.n, np.int32)
-        code = _factor(
-            data, a.slots, a.cp, a.pos, a.sup, a.rel, a.rptr, a.lptr, a.sparent, a.chead,
-            a.cnext, a.stack, a.max_front, _addresses(), lx, True, ipiv,
-        )  # fmt: skip
+        code = _factor(data, a.plan, _addresses(), lx, True, ipiv)
         if code:
             return None
         x = np.sin(np.arange(1.0, a.n + 1.0))  # a check solve, in the factor's order

@@ -69,8 +69,8 @@ _DENSE_MAX = 1500  # use dense Cholesky up to this many unknowns
 
 
 class CompiledPieces(NamedTuple):
-    """The fixed arguments of ``_compiled.thermal_system`` in its order (a named tuple: the
-    kernel takes it spread). Per triangle (nt,): ``Lab``, ``Lac`` rest side lengths (m),
+    """The fixed arguments of ``_compiled.thermal_system`` (a named tuple: the kernel takes it
+    whole). Per triangle (nt,): ``Lab``, ``Lac`` rest side lengths (m),
     ``half_ab_ac`` 0.5 Lab Lac (m^2), ``k_th`` conductivity x thickness (W/K), ``side`` the
     air-link perimeter term (nt, L); ``slots`` (9 nt,) dense positions of the element matrices;
     ``k_env`` air conductivity (W/(m K)), ``layers`` air layers, ``h`` air thickness (m, (nt,)
@@ -421,7 +421,7 @@ def _compiled_system(model: ThermalModel, x: np.ndarray):
     ck.thermal_sides(x, tri, u, v, cross)
     alpha = np.arctan2(cross, np.einsum("ij,ij->i", u, v))
     area, A, Gq = np.empty(nt), np.zeros(n * n), np.empty((n, model.env_layers))
-    if not ck.thermal_system(np.cos(alpha), np.sin(alpha), *model.compiled_pieces, area, A, Gq):
+    if not ck.thermal_system(np.cos(alpha), np.sin(alpha), model.compiled_pieces, area, A, Gq):
         _element_matrices(model, None, area)  # raises, naming the triangle
     return A.reshape(n, n), _series(Gq)
 

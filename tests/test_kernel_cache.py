@@ -50,7 +50,7 @@ _SPRINGS = textwrap.dedent(
     e, f, K, t = np.empty(30), np.empty((3, 4, 30)), np.empty((3, 3, 10, 30)), np.empty(30)
     mod = kernels.kernel_path("compiled").module
     assert mod.__file__.startswith({src!r}), mod.__file__
-    mod.spring_elements(X, U, sT, k, th0, True, False, e, f, K, t)
+    mod.spring_elements(X, U, sT, k, th0, True, False, (e, f, K, t))
     print(repr(float(e.sum())))
     """
 )

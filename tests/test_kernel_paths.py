@@ -3,6 +3,8 @@ the element kernels to round-off: forces, tangents and energies to 1e-12 relativ
 scale. No test here asserts bit equality across the paths: their rounding differs with the CPU
 (numpy's SIMD arctan2 against libm's atan2) and the summation order."""
 
+import inspect
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -82,7 +84,7 @@ def test_spring_elements_are_the_spring_kernel(path, negative_k, tangent, elemen
     if element_major:
         f = np.empty((ns, 4, 3)).transpose(2, 1, 0)
         K = np.empty((ns, 10, 3, 3)).transpose(2, 3, 1, 0)
-    path.module.spring_elements(X, U, sT, k, th0, bool((k >= 0).all()), tangent, e, f, K, t)
+    path.module.spring_elements(X, U, sT, k, th0, bool((k >= 0).all()), tangent, (e, f, K, t))
     close(e, ref.energy)
     close(f, ref.force)
     close(t, theta)
@@ -105,7 +107,7 @@ def test_bar_elements_are_the_bar_kernel(path):
     ref = bar_kernel(D0, (U[b1] - U[b0]).T, L0, EA)
     nb = len(bars)
     e, f, K = np.empty(nb), np.empty((3, 2, nb)), np.empty((3, 3, 2, 2, nb))
-    path.module.bar_elements(X, U, b0, b1, D0, L0, EA, True, e, f, K)
+    path.module.bar_elements(X, U, b0, b1, D0, L0, EA, True, (e, f, K))
     close(e, ref.energy)
     close(f, ref.force)
     close(K, ref.tangent)
@@ -326,3 +328,32 @@ def test_an_unknown_kernel_path_is_one_environment_line(monkeypatch):
     monkeypatch.setenv(kernels.ENV, "fortran")
     with pytest.raises(kernels.EnvironmentFault, match="use auto, numpy or compiled"):
         kernels.active()
+
+
+def _parameters(fn) -> list[str]:
+    return list(inspect.signature(getattr(fn, "py_func", fn)).parameters)
+
+
+@pytest.mark.skipif(_NO_COMPILED is not None, reason=f"no compiled path: {_NO_COMPILED}")
+def test_both_paths_take_the_same_few_arguments():
+    """Issue 35: every kernel the two paths share has the same parameters in both, and no
+    kernel (theirs, the thermal and the supernodal Cholesky's) takes more than
+    MAX_KERNEL_ARGS: the rest travel in the named tuples of mechanics/kernel_args.py."""
+    from holofold.mechanics import _compiled, _numpy_kernels, supernodal
+    from holofold.mechanics.kernel_args import MAX_KERNEL_ARGS
+
+    shared = set(_numpy_kernels.__all__) - {"lapack_addresses"}
+    assert {"assemble_batch", "newton_increments", "small_newton_step"} <= shared
+    for name in sorted(shared):
+        assert _parameters(getattr(_compiled, name)) == _parameters(
+            getattr(_numpy_kernels, name)
+        ), name
+    over = {}
+    for mod in (_compiled, _numpy_kernels, supernodal):
+        for name, fn in vars(mod).items():
+            kernel = hasattr(fn, "py_func") or (
+                inspect.isfunction(fn) and fn.__module__ == mod.__name__
+            )
+            if kernel and len(_parameters(fn)) > MAX_KERNEL_ARGS:
+                over[f"{mod.__name__}.{name}"] = len(_parameters(fn))
+    assert over == {}
