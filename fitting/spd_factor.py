@@ -77,6 +77,8 @@ class SPDFactor:
         self._pattern = None  # (indptr, indices) of the last pattern, CHOLMOD's symbolic
         self._symbolic = None
         self._A = None
+        self._diag = np.zeros(0, np.int64)
+        self._gather = None  # (indptr, indices, gather) of the last A: its upper triangle
         self._factor = None
 
     # --------------------------------------------------------------------- factorise
@@ -86,8 +88,9 @@ class SPDFactor:
         :class:`numpy.linalg.LinAlgError` when eight tenfold raises do not make it positive
         definite."""
         A = A.tocsr()
-        mu = max(float(mu), 1e-11 * float(A.diagonal().max(initial=0.0)))
-        return self._factor_sparse(A, mu) if self.sparse else self._factor_banded(A, mu)
+        if self.sparse:
+            return self._factor_sparse(A, mu)
+        return self._factor_banded(A, max(float(mu), 1e-11 * float(A.diagonal().max(initial=0.0))))
 
     def _factor_banded(self, A: sp.csr_matrix, mu: float) -> float:
         B = A[self.order][:, self.order].tocoo()
@@ -109,25 +112,58 @@ class SPDFactor:
             return mu
         raise np.linalg.LinAlgError("not positive definite")
 
-    def _factor_sparse(self, A: sp.csr_matrix, mu: float) -> float:
-        matrix, spmatrix, cholmod, amd = _cvxopt()
-        n = A.shape[0]
-        # the upper triangle row by row is the lower triangle column by column (cvxopt's CCS)
-        U = sp.triu(A, format="csr")
-        U.sort_indices()
-        if self._pattern is None or not (
-            np.array_equal(self._pattern[0], U.indptr)
-            and np.array_equal(self._pattern[1], U.indices)
+    def _upper(self, A: sp.csr_matrix) -> np.ndarray:
+        """The values of A's upper triangle in the order of CHOLMOD's stored pattern (the
+        upper triangle row by row, columns ascending). The gather is planned once per pattern
+        of ``A`` (a product of the same sparse patterns has the same, possibly unsorted, CSR
+        pattern every time): then it is one indexing, not ``triu`` and a sort per call."""
+        if self._gather is not None and (
+            np.array_equal(self._gather[0], A.indptr) and np.array_equal(self._gather[1], A.indices)
         ):
-            rows = np.repeat(np.arange(n), np.diff(U.indptr))
-            self._pattern = (U.indptr.copy(), U.indices.copy())
-            self._A = spmatrix(matrix(U.data.astype(float)), matrix(U.indices.astype(np.int64)),
-                               matrix(rows.astype(np.int64)), (n, n))  # fmt: skip
-            if not np.array_equal(np.asarray(self._A.I).ravel(), U.indices):  # pragma: no cover
-                raise RuntimeError("cvxopt stored the pattern in an unexpected order")
-            self._diag = np.flatnonzero(U.indices == rows)
-            self._symbolic = _supernodal(cholmod, cholmod.symbolic, self._A, amd.order(self._A))
-        values = U.data.astype(float)
+            return A.data[self._gather[2]]
+        n = A.shape[0]
+        rows = np.repeat(np.arange(n), np.diff(A.indptr))
+        cols = A.indices
+        up = np.flatnonzero(cols >= rows)
+        up = up[np.lexsort((cols[up], rows[up]))]
+        if len(up) and np.any(
+            (rows[up][1:] == rows[up][:-1]) & (cols[up][1:] == cols[up][:-1])
+        ):  # duplicate entries: sum them the slow way (not planned)
+            self._gather = None
+            U = sp.triu(A, format="csr")
+            U.sum_duplicates()
+            U.sort_indices()
+            return self._ensure_pattern(U.indptr, U.indices, U.data)
+        self._gather = (A.indptr.copy(), A.indices.copy(), up)
+        indptr = np.searchsorted(rows[up], np.arange(n + 1)).astype(A.indptr.dtype)
+        return self._ensure_pattern(indptr, cols[up], A.data[up])
+
+    def _ensure_pattern(self, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray):
+        """Set up CHOLMOD's matrix and symbolic factorisation for the upper-triangle pattern
+        (indptr, indices) unless it is the last one; returns ``data``."""
+        matrix, spmatrix, cholmod, amd = _cvxopt()
+        if self._pattern is not None and (
+            np.array_equal(self._pattern[0], indptr) and np.array_equal(self._pattern[1], indices)
+        ):
+            return data
+        n = len(indptr) - 1
+        rows = np.repeat(np.arange(n), np.diff(indptr))
+        self._pattern = (np.array(indptr), np.array(indices))
+        # the upper triangle row by row is the lower triangle column by column (cvxopt's CCS)
+        self._A = spmatrix(matrix(np.asarray(data, float)), matrix(indices.astype(np.int64)),
+                           matrix(rows.astype(np.int64)), (n, n))  # fmt: skip
+        if not np.array_equal(np.asarray(self._A.I).ravel(), indices):  # pragma: no cover
+            raise RuntimeError("cvxopt stored the pattern in an unexpected order")
+        self._diag = np.flatnonzero(indices == rows)
+        self._symbolic = _supernodal(cholmod, cholmod.symbolic, self._A, amd.order(self._A))
+        return data
+
+    def _factor_sparse(self, A: sp.csr_matrix, mu: float) -> float:
+        matrix, _, cholmod, _ = _cvxopt()
+        values = np.array(self._upper(A), dtype=float)
+        if len(self._diag) != A.shape[0]:
+            raise np.linalg.LinAlgError("not positive definite (an empty row)")
+        mu = max(float(mu), 1e-11 * float(values[self._diag].max(initial=0.0)))
         values[self._diag] += mu
         for _ in range(8):
             self._A.V = matrix(values)

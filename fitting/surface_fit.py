@@ -367,13 +367,24 @@ class _KKT:
         self.block = SPDFactor(grid.band_order, grid.bandwidth, sparse=sparse)
         self.n_factor = 0
         self._jc = self._jct = None  # the last constraint Jacobian and its transpose
+        self._pending = None  # (Jb, Jc, mu) of the next factorisation
         self.minres_its: list[int] = []
 
     def refactor(self, Jb: sp.csr_matrix, Jc: sp.csr_matrix, mu: float) -> None:
-        # the damping keeps the factorisation positive definite in floating point (SPDFactor
-        # raises it from at least 1e-11 of the largest diagonal entry while Cholesky breaks down)
+        """Plan a factorisation of the preconditioner block for ``Jb``, ``Jc`` and ``mu``; it is
+        made at the next :meth:`solve` (a plan replaced before any solve costs nothing)."""
+        self._pending = (Jb, Jc, mu)
+
+    def _factor(self) -> None:
+        Jb, Jc, mu = self._pending
+        self._pending = None
+        # J_s^T J_s + rho J_c^T J_c as one product of the stacked Jacobians (one sparse
+        # product, the same pattern every time: SPDFactor plans its gather once). The damping
+        # keeps the factorisation positive definite in floating point (SPDFactor raises it
+        # from at least 1e-11 of the largest diagonal entry while Cholesky breaks down)
+        B = sp.vstack([Jb, math.sqrt(_RHO) * Jc], format="csr")
         try:
-            self.block.factor(Jb.T @ Jb + _RHO * (Jc.T @ Jc), mu)
+            self.block.factor((B.T @ B).tocsr(), mu)
         except np.linalg.LinAlgError:
             raise SurfaceFitError(
                 "the fit's linear systems are singular (the pattern degenerated)"
@@ -382,6 +393,8 @@ class _KKT:
 
     def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
               tol: float = _TOL_STEP) -> tuple[np.ndarray, int]:  # fmt: skip
+        if self._pending is not None:
+            self._factor()
         n, m = H.shape[0], Jc.shape[0]
         if Jc is not self._jc:
             self._jc, self._jct = Jc, Jc.T.tocsr()
@@ -427,23 +440,36 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
     refactor_after = 12  # MINRES iterations that call for a fresh factorisation
 
     def restore(X, c, Jc, steps: int):
-        """Newton steps onto the constraints from X; returns X, c, Jc, steps taken, message."""
+        """Newton steps onto the constraints from X; returns X, c, Jc, steps taken, message.
+
+        A step with a fresh Jacobian (and a fresh factorisation of the preconditioner, which
+        is only good for the Jacobian it was made with) is followed by chord steps (the same
+        Jacobian and factorisation, the residual at the new X) while they contract the
+        residual fast enough; else the Jacobian and the factorisation are renewed."""
         cm = float(np.abs(c).max())
         if cm < CONSTRAINT_TOL:
             return X, c, Jc, 0, ""
-        ro, Jo = problem.objective(X)
-        H = (Jo.T @ Jo + mu_r * eye).tocsr()
-        kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
-        fresh = True
+        zero = np.zeros(ndof)
+        renew, fresh, Jref, H = True, False, Jc, None
         for k in range(1, steps + 1):
             if cm < CONSTRAINT_TOL:
-                return X, c, Jc, k - 1, ""
-            d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c, tol=_TOL_PROJECT)
-            if d is None and not fresh:  # a stale factorisation: refresh it and retry
-                ro, Jo = problem.objective(X)
+                return X, c, problem.constraints(X)[1] if Jc is None else Jc, k - 1, ""
+            if renew:
+                if Jc is None:
+                    c, Jc = problem.constraints(X)
+                _, Jo = problem.objective(X)
                 H = (Jo.T @ Jo + mu_r * eye).tocsr()
                 kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
-                d, n_it = kkt.solve(H, Jc, np.zeros(ndof), c, tol=_TOL_PROJECT)
+                Jref, renew, fresh = Jc, False, True
+            d, n_it = kkt.solve(H, Jref, zero, c, tol=_TOL_PROJECT)
+            if d is None and not fresh:  # a chord step that fails: renew and retry
+                if Jc is None:
+                    c, Jc = problem.constraints(X)
+                _, Jo = problem.objective(X)
+                H = (Jo.T @ Jo + mu_r * eye).tocsr()
+                kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
+                Jref, fresh = Jc, True
+                d, n_it = kkt.solve(H, Jref, zero, c, tol=_TOL_PROJECT)
             if d is None:
                 return X, c, Jc, k, "the linear systems of the restoration did not converge"
             # damped Newton: halve the step until the constraint residual falls
@@ -454,6 +480,9 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                 if float(ct @ ct) < c2:
                     break
             else:
+                if not fresh:  # the chord's direction: renew the Jacobian and try again
+                    renew = True
+                    continue
                 return (
                     X,
                     c,
@@ -465,17 +494,22 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                         "cells"
                     ),
                 )
-            X = Xt
-            c, Jc = problem.constraints(X)
+            cm_old = cm
+            X, c, Jc = Xt, ct, None  # the Jacobian at X is computed only when needed
             cm = float(np.abs(c).max())
             if not np.isfinite(cm):
                 return X, c, Jc, k, "the restoration diverged (non-finite constraints)"
             fresh = False
-            if n_it > refactor_after or cm > 1e-6:
-                ro, Jo = problem.objective(X)
-                H = (Jo.T @ Jo + mu_r * eye).tocsr()
-                kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
-                fresh = True
+            # chord steps contract linearly: worth it where the last step contracted a
+            # hundredfold (or the residual is already small), else a fresh Newton step
+            renew = (
+                alpha < 1
+                or n_it > refactor_after
+                or cm > 0.25 * cm_old
+                or (cm > 1e-6 and cm > 0.01 * cm_old)
+            )
+        if Jc is None:
+            c, Jc = problem.constraints(X)
         if cm < CONSTRAINT_TOL:
             return X, c, Jc, steps, ""
         return (
