@@ -150,3 +150,31 @@ def test_a_cut_pattern_starts_flat_with_contact():
     assert on.complete and on.verdict == "folds rigidly"
     # holofold's own test (IPC Toolkit's flags the coincident sides of the cuts themselves)
     assert not any(has_intersections(c, p.faces, backend="numpy") for c in on.coords)
+
+
+def test_the_barrier_solve_by_cholesky_matches_lu_and_still_descends_where_indefinite():
+    """PanelContact's Newton update solves (A + mu I) d = r by the sparse Cholesky where A + mu I
+    is positive definite (analysis kept while the pattern repeats) and falls back to SuperLU's
+    LU, raising mu, where it is not; either way d matches a direct solve and descends."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu, spsolve
+
+    pc = PanelContact(_Two(), kappa=1e3)
+    n = pc.n_dof
+    rng = np.random.default_rng(3)
+    B = sp.random(n, n, density=0.2, random_state=4) + sp.identity(n)
+    A = (B @ B.T + sp.identity(n)).tocsc()  # SPD
+    r = rng.normal(size=n)
+    for _ in range(2):  # the second reuses the analysis
+        d, mu = pc._descent(A, r, 0.0, 1.0, sp, splu)
+        assert mu == 0.0
+        np.testing.assert_allclose(d, spsolve(A, r), rtol=1e-9, atol=0)
+    from holofold.mechanics.linear import cholesky_backend
+
+    # the Cholesky ran where there is one (CHOLMOD, or the supernodal one with compiled kernels)
+    assert (pc._chol[0] is not None) == (cholesky_backend() is not None)
+    indefinite = (A - 2.0 * abs(A).sum(axis=1).max() * sp.identity(n)).tocsc()
+    assert pc._cholesky_solve(indefinite, r) is None
+    d, mu = pc._descent(indefinite, r, 0.0, 1.0, sp, splu)
+    assert float(r @ d) > 0
+    np.testing.assert_allclose(d, spsolve((indefinite + mu * sp.identity(n)).tocsc(), r), rtol=1e-8)
