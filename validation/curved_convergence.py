@@ -16,7 +16,8 @@ points in every level. Measured per level:
 * ``shape``: the largest distance of those points from the finest level's, after the best
   rigid alignment (Kabsch; the default support, the panel nearest the centre, differs between
   meshes), in % of the sheet's size (the flat layout's larger side);
-* ``energy``: the elastic energy at the full fold (J);
+* ``energy``: the elastic energy at the full fold (J), and its ratio to the plate energy of
+  the rotationally symmetric fold (:func:`cone_energy`);
 * ``opening``: the opening stiffness of the folded sector (N/m, :func:`opening_stiffness`: a
   force pair at its two straight ends, linear from the folded state);
 * the analytic check along every crease (Fuchs & Tabachnikov, "More on paperfolding", Amer.
@@ -29,6 +30,10 @@ points in every level. Measured per level:
   radial ruling from the vertex to the next ring, ``cos(alpha) = |b . n|`` (the mean of the two
   sides). Reported: the largest relative error ``|kappa cos(alpha) - 1/rho| rho`` over the
   middle half of every crease (:func:`curvature_error`).
+
+* the energy shares (:func:`energy_shares`): which elements carry the folded state's energy
+  and the opening mode's (bars, panel springs, crease hinges, and the ``J`` joins inside the
+  pleats split into radial, ring and diagonal ones, :func:`edge_classes`).
 
 The observed order between levels ``a`` and ``b`` is ``log2(e_a / e_b) / log2(h_a / h_b)``
 (``h`` the arc piece). Run::
@@ -46,7 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from holofold.geometry.curved_pleat import CurvedPleat
-from holofold.mechanics import fold_pattern
+from holofold.mechanics import SpringRole, fold_pattern
 
 #: the two reference cases: name -> CurvedPleat arguments (without pieces, across)
 CASES = {
@@ -75,6 +80,7 @@ class Level:
     verdict: str
     curvature_error: float
     opening: float
+    shares: tuple[dict, dict]
 
 
 def fold_level(case: str, pieces: int, across: int, time_limit: float | None = None) -> Level:
@@ -89,7 +95,8 @@ def fold_level(case: str, pieces: int, across: int, time_limit: float | None = N
     dt = time.perf_counter() - t0
     x = res.coords[-1]
     return Level(g, x, float(res.energy.total), dt, res.reached, res.verdict,
-                 curvature_error(g, x), opening_stiffness(g, res))  # fmt: skip
+                 curvature_error(g, x), opening_stiffness(g, res),
+                 energy_shares(g, res))  # fmt: skip
 
 
 def opening_stiffness(g: CurvedPleat, res) -> float:
@@ -100,7 +107,62 @@ def opening_stiffness(g: CurvedPleat, res) -> float:
     from holofold.mechanics.assembly import Assembler
 
     st = res.structure
+    u = _opening_mode(g, res, Assembler(st)).reshape(-1, 3)
+    rings = np.arange(len(g.radii))
+    a, b = st.vertex_nodes(g.vertex(rings, 0)), st.vertex_nodes(g.vertex(rings, g.pieces))
+    x = res.coords[-1]
+    d = x[g.vertex(rings, g.pieces)].mean(axis=0) - x[g.vertex(rings, 0)].mean(axis=0)
+    d /= np.linalg.norm(d)
+    return float(1.0 / ((u[b].mean(axis=0) - u[a].mean(axis=0)) @ d))
+
+
+def edge_classes(g: CurvedPleat, p) -> np.ndarray:
+    """(ne,) class of every edge of ``g``'s pattern ``p``: ``crease``, ``border``, and the
+    ``J`` joins inside a pleat split into ``radial`` (along the rulings), ``ring`` and
+    ``diagonal``."""
+    ring, line = np.divmod(p.edges, g.pieces + 1)
+    asg = np.asarray(p.assignment)
+    out = np.where(ring[:, 0] == ring[:, 1], "ring", "diagonal").astype(object)
+    out[line[:, 0] == line[:, 1]] = "radial"
+    out[(asg == "M") | (asg == "V")] = "crease"
+    out[asg == "B"] = "border"
+    return out
+
+
+def energy_shares(g: CurvedPleat, res) -> tuple[dict, dict]:
+    """Where the energy is: the fractions of the folded state's elastic energy, and of the
+    opening mode's (:func:`opening_stiffness`: the quadratic energy of the displacement under
+    the force pair, by central differences of every element's energy), carried by the bars,
+    the panel springs and the hinges of each :func:`edge_classes` class."""
+    from holofold.mechanics.assembly import Assembler
+
+    st = res.structure
     asm = Assembler(st)
+    U = res.U[-1]
+    role, sc = np.asarray(st.spring_role), np.asarray(st.spring_crease)
+    lab = np.full(len(role), "panel", dtype=object)
+    hinge = role == SpringRole.HINGE
+    lab[hinge] = edge_classes(g, g.pattern())[sc[hinge]]
+    u = _opening_mode(g, res, asm).reshape(U.shape)
+    eps = 1e-6 / np.abs(u).max()
+    b0, s0 = asm.element_response(U, res.rest, tangent=False)
+    bp, sp = asm.element_response(U + eps * u, res.rest, tangent=False)
+    bm, sm = asm.element_response(U - eps * u, res.rest, tangent=False)
+    qb = bp.energy + bm.energy - 2 * b0.energy
+    qs = sp.energy + sm.energy - 2 * s0.energy
+    shares = []
+    for eb, es in ((b0.energy, s0.energy), (qb, qs)):
+        tot = eb.sum() + es.sum()
+        d = {"bars": float(eb.sum() / tot)}
+        d.update({c: float(es[lab == c].sum() / tot) for c in sorted(set(lab))})
+        shares.append(d)
+    return shares[0], shares[1]
+
+
+def _opening_mode(g: CurvedPleat, res, asm) -> np.ndarray:
+    """(3 n_nodes,) displacement under the opening force pair (:func:`opening_stiffness`),
+    over the force (m/N)."""
+    st = res.structure
     _, _, solve = asm.evaluate_factorized(res.U[-1], res.rest)
     rings = np.arange(len(g.radii))
     a, b = st.vertex_nodes(g.vertex(rings, 0)), st.vertex_nodes(g.vertex(rings, g.pieces))
@@ -113,8 +175,21 @@ def opening_stiffness(g: CurvedPleat, res) -> float:
     free = asm.free_dofs
     u = np.zeros(3 * st.n_nodes)
     u[free] = solve(f.ravel()[free])
-    u = u.reshape(-1, 3)
-    return float(1.0 / ((u[b].mean(axis=0) - u[a].mean(axis=0)) @ d))
+    return u
+
+
+def cone_energy(g: CurvedPleat) -> float:
+    """Plate bending energy (J) of the rotationally symmetric fold of ``g`` at its full fold
+    angle: every crease folds by ``2 alpha`` (its osculating plane bisecting the fold), every
+    pleat is a cone band with the radial rulings and the curvature ``tan(alpha) / r`` across
+    them, so ``D / 2 tan^2(alpha) sector ln(r_out / r_in)`` with ``D = E t^3 / (12 (1 -
+    nu^2))`` of the panels (the creases at their rest angle store nothing). An equilibrium of
+    the plate by symmetry (the free ends may let a lower one exist): the reference the model's
+    energy should approach."""
+    t, E, nu = SECTION["panel_thickness"], SECTION["E"], SECTION["nu"]
+    D = E * t**3 / (12.0 * (1.0 - nu**2))
+    c = math.tan(0.5 * g.fold_angle)
+    return 0.5 * D * c**2 * g.sector * math.log(g.outer_radius / g.inner_radius)
 
 
 def curvature_error(g: CurvedPleat, x: np.ndarray, span: int = 16) -> float:
@@ -185,10 +260,11 @@ def study(case: str, levels=LEVELS, time_limit: float | None = None, say=print) 
             dict(case=case, pieces=lv.geometry.pieces, across=lv.geometry.across,
                  panels=2 * lv.geometry.pieces * (lv.geometry.creases + 1) * lv.geometry.across,
                  shape_pct=100.0 * float(d.max()) / size, energy=lv.energy,
-                 energy_pct=100.0 * abs(lv.energy / fine.energy - 1.0), opening=lv.opening,
+                 energy_pct=100.0 * abs(lv.energy / fine.energy - 1.0),
+                 energy_cone=lv.energy / cone_energy(lv.geometry), opening=lv.opening,
                  opening_pct=100.0 * abs(lv.opening / fine.opening - 1.0),
                  curvature=lv.curvature_error, reached=lv.reached, verdict=lv.verdict,
-                 seconds=lv.seconds)
+                 seconds=lv.seconds, shares=lv.shares)
         )  # fmt: skip
     return rows
 
@@ -204,22 +280,50 @@ def orders(rows: list[dict], key: str) -> list[float]:
     return out
 
 
+def richardson(rows: list[dict], key: str) -> tuple[float, float]:
+    """``(order, limit)`` of ``key`` from the last three levels (each halving the piece):
+    the observed order ``p = log2((v1 - v2) / (v2 - v3))`` and ``v3 - (v2 - v3) / (2^p - 1)``
+    (NaN where the differences do not shrink monotonically)."""
+    v1, v2, v3 = (r[key] for r in rows[-3:])
+    q = (v1 - v2) / (v2 - v3) if v2 != v3 else float("nan")
+    if not q > 1.0:
+        return float("nan"), float("nan")
+    return math.log2(q), v3 - (v2 - v3) / (q - 1.0)
+
+
 def table(rows: list[dict]) -> str:
     """A markdown table of :func:`study` rows."""
     lines = [
         "| case | pieces:across | panels | shape (% of size) | energy (mJ) | energy (%) "
+        "| energy / cone "
         "| opening (N/m) | opening (%) | curvature relation (rel.) | reached | verdict "
         "| fold (s) |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
             f"| {r['case']} | {r['pieces']}:{r['across']} | {r['panels']} | "
             f"{r['shape_pct']:.3g} | {1e3 * r['energy']:.4g} | {r['energy_pct']:.3g} | "
+            f"{r['energy_cone']:.3f} | "
             f"{r['opening']:.4g} | {r['opening_pct']:.3g} | "
             f"{r['curvature']:.2e} | {100 * r['reached']:.0f} % | {r['verdict']} | "
             f"{r['seconds']:.1f} |"
         )
+    return "\n".join(lines)
+
+
+def shares_table(rows: list[dict]) -> str:
+    """A markdown table of the energy shares (%, :func:`energy_shares`) of :func:`study` rows,
+    the folded state's then the opening mode's, per level."""
+    keys = sorted({k for r in rows for sh in r["shares"] for k in sh})
+    lines = [
+        "| case | pieces:across | state | " + " | ".join(keys) + " |",
+        "|---|---|---|" + "---|" * len(keys),
+    ]
+    for r in rows:
+        for name, sh in zip(("folded", "opening"), r["shares"], strict=True):
+            cells = " | ".join(f"{100 * sh.get(k, 0.0):.1f}" for k in keys)
+            lines.append(f"| {r['case']} | {r['pieces']}:{r['across']} | {name} | {cells} |")
     return "\n".join(lines)
 
 
@@ -236,6 +340,10 @@ def main(argv=None) -> None:
         print(f"observed order, shape: {[round(v, 2) for v in orders(rows, 'shape_pct')]}; "
               f"energy: {[round(v, 2) for v in orders(rows, 'energy_pct')]}; "
               f"opening: {[round(v, 2) for v in orders(rows, 'opening_pct')]}")  # fmt: skip
+        for key in ("energy", "opening"):
+            p, lim = richardson(rows, key)
+            print(f"Richardson from the last three levels, {key}: order {p:.2f}, limit {lim:.4g}")
+        print(shares_table(rows))
         print()
 
 
