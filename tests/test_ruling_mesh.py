@@ -302,11 +302,12 @@ def test_a_sliver_facet_is_no_stiffer_than_a_plate_over_its_thickness():
     assert (2 * D * L / (2 * 0.0002) > 1.5 * k).all()
 
 
-@pytest.mark.slow
-def test_wavy_pleats_fold_past_where_the_fanned_panels_stalled():
-    """Origami Simulator's wavy pleats (acceptance settings: 200 mm, PP, 1 mm panels): the
-    fanned panels stalled at 0 % (Newton does not converge); meshed along their rulings they
-    fold to 20 % (26 % measured before the stall, 60 s, 2026-12-07)."""
+def test_wavy_pleats_fold_to_the_end_with_rulings_on_the_border():
+    """Origami Simulator's wavy pleats (acceptance settings: 200 mm, PP, 1 mm panels): with
+    the panels fanned it stalled at 0 %, with strips stitched but the border faces fanned from
+    their corners at 26 % (Newton does not converge); with the rulings ending on Steiner
+    points of the border it folds to 100 % in 1.3 s CPU, the panels bending (8.3 deg: a curved
+    crease folds only with bending panels) and stretching at most 0.007 (2026-12-07)."""
     from holofold.mechanics import fold_pattern, scaled_pattern
 
     with warnings.catch_warnings():
@@ -314,7 +315,10 @@ def test_wavy_pleats_fold_past_where_the_fanned_panels_stalled():
         p = read_pattern(DATA / "wavy_pleats.svg")
     p = scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))
     r = fold_pattern(
-        p, 0.2, panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9,
+        p, 1.0, panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9,
         nu=0.42, time_limit=600.0, check_intersections=True,
     )  # fmt: skip
-    assert r.reached >= 0.2 - 1e-9, r.summary()
+    assert r.complete and r.reached == pytest.approx(1.0), r.summary()
+    assert len(r.snaps) == 0, r.summary()
+    assert r.verdict == "does not fold rigidly", r.summary()
+    assert float(np.max(r.energy.panel_strain)) < 0.01, r.summary()
