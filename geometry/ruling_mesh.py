@@ -32,6 +32,8 @@ densely along the drawing's :class:`~holofold.geometry.curved.Curve` objects.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from holofold.geometry.errors import ParameterError
@@ -47,6 +49,10 @@ __all__ = [
     "chord_triangles",
 ]
 
+#: degrees a chord from a curve vertex to its foot on a straight side may turn from the curve's
+#: normal there (a guard: wavy_pleats and Improvisation-62 turn up to 44; the partial cuts of
+#: Tri-Wing_Boomerang_Tiling and Rotating_Star, refused since they leave vertices out, up to 95)
+MAX_RULING_TURN = 60.0
 #: the most points :func:`curve_samples` places along all curves together
 MAX_SAMPLES = 2_000_000
 
@@ -325,7 +331,10 @@ def _ruling_ends(p: np.ndarray, on: np.ndarray, min_gap: float):
     at equal relative arc length, run near that way; the normals themselves converge at the
     centres of curvature and cross beyond). Returns ``[(i, side, u)]`` in the run's order,
     each end at least ``min_gap`` from the last and from the side's corners, the chords inside
-    the face."""
+    the face; ``[]`` unless every inner vertex of the run gets an end within
+    :data:`MAX_RULING_TURN` of its normal (a strip between the curve and one straight side:
+    where only some chords fit, the rest of the face fanned from the chords' ends, and
+    Tri-Wing_Boomerang_Tiling stalled at 3 % instead of folding to 100 %)."""
     hits = _ruling_hits(p, on, 0.0)
     if not hits:
         return []
@@ -346,6 +355,14 @@ def _ruling_ends(p: np.ndarray, on: np.ndarray, min_gap: float):
             continue
         last = u
         out.append((i, j, u))
+    if len(out) < m - 1:
+        return []
+    for i, j, u in out:
+        t = p[(i + 1) % n] - p[(i - 1) % n]
+        c = p[j] + u * d[j] - p[i]
+        cos = abs(float(t[0] * c[1] - t[1] * c[0])) / max(np.hypot(*t) * np.hypot(*c), 1e-300)
+        if cos < math.cos(math.radians(MAX_RULING_TURN)):
+            return []
     return out
 
 

@@ -148,6 +148,25 @@ def test_steiner_points_end_the_rulings_of_a_one_curve_face_on_its_border():
     assert max(_fan(T, 0, arc), _fan(T, 1, arc)) <= 1
 
 
+def test_steiner_points_refuse_a_partial_or_turned_cut():
+    """Where the feet reach only some of the arc's vertices (a border shorter than the arc), or
+    the chords turn far from the curve's normals (an arc dipping towards the border), the face
+    keeps its Delaunay mesh: partial cuts fanned the rest (Tri-Wing_Boomerang_Tiling 100 % ->
+    3 %, Rotating_Star 61 % -> 15 %, 60 s folds, 2026-12-07)."""
+    xy, face, edges, asg, ang, on = _bump_face(12)
+    short = xy.copy()
+    short[:2, 0] = [-0.5, 0.5]  # the border from -0.5 to 0.5: the outer feet miss it
+    x = np.linspace(1.0, -1.0, 13)
+    dip = xy.copy()
+    dip[2:, 1] = 1.2 - np.sqrt(np.clip(1.0 - x**2, 0.0, None))  # a half circle down to 0.2
+    for pts in (short, dip):
+        X, F, E, *_ = steiner_points(pts, [face], edges, asg, ang, on)
+        assert len(X) == len(pts) and len(E) == len(edges)
+        assert np.array_equal(F[0], face)
+    X, *_ = steiner_points(xy, [face], edges, asg, ang, on)
+    assert len(X) == len(xy) + 11  # the bump itself is cut
+
+
 def _crease_fan(p):
     """Per vertex off every crease: how many crease vertices its J edges reach."""
     E, a = p.edges, p.assignment
