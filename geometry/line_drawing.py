@@ -23,7 +23,7 @@ from holofold.geometry.cuts import separate_cuts
 from holofold.geometry.errors import FormatError, ParameterError
 from holofold.geometry.facets import SPLIT_MODES, split_faces
 from holofold.geometry.pattern import MAX_PANELS, CreasePattern
-from holofold.geometry.ruling_mesh import curve_edge_mask, curve_points_on
+from holofold.geometry.ruling_mesh import curve_edge_mask, curve_points_on, steiner_points
 
 __all__ = [
     "PatternWarning",
@@ -85,6 +85,10 @@ def finish_pattern(
     on_curve = None
     if split == "rulings" and curve_points is not None and len(curve_points):
         on_curve = curve_edge_mask(xy, edges, curve_points, curve_tol)
+        if coords3 is None:  # rulings from a curve to a border end on points of their own
+            xy, faces, edges, asg, ang, on_curve = steiner_points(
+                xy, faces, edges, asg, ang, on_curve
+            )
     faces, edges, asg, ang, n_split = split_faces(xy, faces, edges, asg, ang, split, on_curve)
     if n_split:
         why = "non-convex" if split == "as-needed" else "with more than 3 vertices"

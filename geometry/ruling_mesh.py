@@ -32,6 +32,8 @@ densely along the drawing's :class:`~holofold.geometry.curved.Curve` objects.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from holofold.geometry.errors import ParameterError
@@ -43,8 +45,14 @@ __all__ = [
     "strip_triangles",
     "delaunay_triangles",
     "ruling_triangles",
+    "steiner_points",
+    "chord_triangles",
 ]
 
+#: degrees a chord from a curve vertex to its foot on a straight side may turn from the curve's
+#: normal there (a guard: wavy_pleats and Improvisation-62 turn up to 44; the partial cuts of
+#: Tri-Wing_Boomerang_Tiling and Rotating_Star, refused since they leave vertices out, up to 95)
+MAX_RULING_TURN = 60.0
 #: the most points :func:`curve_samples` places along all curves together
 MAX_SAMPLES = 2_000_000
 
@@ -247,4 +255,241 @@ def ruling_triangles(xy, face, on_curve) -> np.ndarray:
     """The triangles of one counter-clockwise face with curve pieces on its boundary:
     :func:`strip_triangles`, else :func:`delaunay_triangles`, (n - 2, 3) vertex ids."""
     T = strip_triangles(xy, face, on_curve)
+    if T is None:
+        T = chord_triangles(xy, face, on_curve)
     return delaunay_triangles(xy, face) if T is None else T
+
+
+def _ruling_hits(p: np.ndarray, on: np.ndarray, min_gap: float):
+    """The rulings of a face with one curve run, estimated along the curve's normals.
+
+    ``p`` (n, 2) the counter-clockwise corners, ``on`` (n,) bool the curve sides. From every
+    inner vertex of the run a ray along the curve's inward normal; where its first crossing of
+    the boundary is a straight side, the ruling ends there. Returns ``[(i, k, u)]``: corner
+    ``i`` of the run, side ``k`` (from corner k to k + 1) at parameter ``u`` in [0, 1], kept
+    in order (the rulings do not cross: going along the run, the ends move back along the
+    rest of the boundary, each at least ``min_gap`` from the last and from the corners)."""
+    n = len(p)
+    runs = _runs(on)
+    if len(runs) != 1 or runs[0][1] >= n:
+        return []
+    a0, m = runs[0]
+    q = np.roll(p, -1, axis=0)
+    d = q - p
+    out = []
+    last = np.inf  # position of the last end, along the boundary from the run's end
+    end = (a0 + m) % n  # the run's last corner
+    for k in range(1, m):
+        i = (a0 + k) % n
+        t = p[(i + 1) % n] - p[(i - 1) % n]
+        nrm = np.array([-t[1], t[0]]) / max(np.hypot(*t), 1e-300)
+        # ray p[i] + s nrm against every side p[j] + u d[j], except the two sides at corner i
+        den = nrm[0] * d[:, 1] - nrm[1] * d[:, 0]
+        w = p - p[i]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = (w[:, 0] * d[:, 1] - w[:, 1] * d[:, 0]) / den
+            u = (w[:, 0] * nrm[1] - w[:, 1] * nrm[0]) / den
+        ok = np.isfinite(s) & (s > 1e-12) & (u >= -1e-9) & (u <= 1 + 1e-9)
+        ok[[i, (i - 1) % n]] = False
+        if not ok.any():
+            continue
+        j = int(np.flatnonzero(ok)[np.argmin(s[ok])])
+        if on[j]:
+            continue  # the ray meets the curve again first
+        L = float(np.hypot(*d[j]))
+        uj = float(np.clip(u[j], 0.0, 1.0))
+        if uj * L < min_gap or (1 - uj) * L < min_gap:
+            continue
+        pos = ((j - end) % n) + uj  # along the boundary from the run's end
+        if pos >= last - min_gap / max(L, 1e-300):
+            continue
+        last = pos
+        out.append((i, j, uj))
+    return out
+
+
+def _crosses(a, b, p: np.ndarray) -> bool:
+    """Whether the open segment a-b properly crosses a side of the closed loop ``p``."""
+    q = np.roll(p, -1, axis=0)
+
+    def orient(x, y, z):
+        return (y[..., 0] - x[..., 0]) * (z[..., 1] - x[..., 1]) - (y[..., 1] - x[..., 1]) * (
+            z[..., 0] - x[..., 0]
+        )
+
+    size = float(np.ptp(p, axis=0).max()) or 1.0
+    eps = 1e-9 * size * size
+    d1, d2 = orient(a, b, p), orient(a, b, q)
+    d3, d4 = orient(p, q, a[None]), orient(p, q, b[None])
+    return bool(((d1 * d2 < -eps * eps) & (d3 * d4 < -eps * eps)).any())
+
+
+def _ruling_ends(p: np.ndarray, on: np.ndarray, min_gap: float):
+    """Where the rulings from the inner vertices of a face's one curve run end: on the straight
+    side that most rays along the curve's inward normals reach first (:func:`_ruling_hits`),
+    at the foot of the perpendicular from each vertex (the rulings of the neighbouring strips,
+    at equal relative arc length, run near that way; the normals themselves converge at the
+    centres of curvature and cross beyond). Returns ``[(i, side, u)]`` in the run's order,
+    each end at least ``min_gap`` from the last and from the side's corners, the chords inside
+    the face; ``[]`` unless every inner vertex of the run gets an end within
+    :data:`MAX_RULING_TURN` of its normal (a strip between the curve and one straight side:
+    where only some chords fit, the rest of the face fanned from the chords' ends, and
+    Tri-Wing_Boomerang_Tiling stalled at 3 % instead of folding to 100 %)."""
+    hits = _ruling_hits(p, on, 0.0)
+    if not hits:
+        return []
+    n = len(p)
+    d = np.roll(p, -1, axis=0) - p
+    L = np.linalg.norm(d, axis=1)
+    count = np.bincount([j for _, j, _ in hits], minlength=n).astype(float)
+    j = int(np.argmax(count + L / (L.max() + 1.0)))
+    a0, m = _runs(on)[0]
+    out, last = [], np.inf
+    for k in range(1, m):
+        i = (a0 + k) % n
+        u = float((p[i] - p[j]) @ d[j]) / (L[j] * L[j])
+        if u * L[j] < min_gap or (1 - u) * L[j] < min_gap or u > last - min_gap / L[j]:
+            continue
+        foot = p[j] + u * d[j]
+        if _crosses(p[i], foot, p):
+            continue
+        last = u
+        out.append((i, j, u))
+    if len(out) < m - 1:
+        return []
+    for i, j, u in out:
+        t = p[(i + 1) % n] - p[(i - 1) % n]
+        c = p[j] + u * d[j] - p[i]
+        cos = abs(float(t[0] * c[1] - t[1] * c[0])) / max(np.hypot(*t) * np.hypot(*c), 1e-300)
+        if cos < math.cos(math.radians(MAX_RULING_TURN)):
+            return []
+    return out
+
+
+def steiner_points(xy, faces, edges, assignment, fold_angle, on_curve, split=("B",)):
+    """New vertices on the straight sides of the faces with one curve run where the rulings
+    from the curve end (:func:`_ruling_hits`), so that the rulings need not fan from the
+    side's corners (a fan is a cone: its apex keeps its distance from every point of the curve,
+    which the curve's fold does not, and the panel must stretch).
+
+    Only sides whose assignment is in ``split`` (default the borders ``B``: one face, so no
+    other face changes) get points. Returns ``xy, faces, edges, assignment, fold_angle,
+    on_curve`` with the new vertices last and each split edge replaced by its pieces (its
+    assignment and fold angle kept; not curve pieces)."""
+    xy = np.asarray(xy, float)
+    E = np.asarray(edges, np.int64).reshape(-1, 2)
+    asg = np.asarray(assignment)
+    ang = np.asarray(fold_angle, float)
+    cm = np.asarray(on_curve, bool)
+    key = {(min(a, b), max(a, b)): k for k, (a, b) in enumerate(E.tolist())}
+    curve_keys = {k for k, c in zip(key, cm[list(key.values())], strict=True) if c}
+    new_on: dict[int, list[float]] = {}  # edge id -> parameters (from E[e, 0]) of new points
+    for f in faces:
+        f = np.asarray(f, np.int64)
+        n = len(f)
+        if n <= 3:
+            continue
+        sides = [(min(a, b), max(a, b)) for a, b in zip(f, np.roll(f, -1), strict=True)]
+        on = np.array([s in curve_keys for s in sides])
+        if not on.any():
+            continue
+        p = xy[f]
+        seg = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+        gap = 0.5 * float(np.median(seg[on]))
+        for _, j, u in _ruling_ends(p, on, gap):
+            e = key[sides[j]]
+            if asg[e] not in split:
+                continue
+            uu = u if E[e, 0] == f[j] else 1.0 - u
+            new_on.setdefault(e, []).append(uu)
+    if not new_on:
+        return xy, list(faces), E, asg, ang, cm
+    pts, chains = [xy], {}
+    nv = len(xy)
+    for e, us in new_on.items():
+        a, b = E[e]
+        us = np.unique(np.round(us, 12))
+        ids = np.arange(nv, nv + len(us))
+        nv += len(us)
+        pts.append(xy[a][None] + us[:, None] * (xy[b] - xy[a])[None])
+        chains[e] = [int(a), *ids.tolist(), int(b)]
+    keep = np.ones(len(E), bool)
+    keep[list(chains)] = False
+    add_e, add_a, add_f = [], [], []
+    for e, ch in chains.items():
+        for x, y in zip(ch[:-1], ch[1:], strict=True):
+            add_e.append((x, y))
+            add_a.append(asg[e])
+            add_f.append(ang[e])
+    by_pair = {(ch[0], ch[-1]): ch for ch in chains.values()}
+    out_faces = []
+    for f in faces:
+        g = []
+        for a, b in zip(f, np.roll(f, -1), strict=True):
+            g.append(int(a))
+            if (a, b) in by_pair:
+                g.extend(by_pair[(a, b)][1:-1])
+            elif (b, a) in by_pair:
+                g.extend(by_pair[(b, a)][-2:0:-1])
+        out_faces.append(np.array(g, np.int64))
+    E2 = np.vstack([E[keep], np.array(add_e, np.int64)])
+    return (
+        np.vstack(pts), out_faces, E2, np.concatenate([asg[keep], np.array(add_a, asg.dtype)]),
+        np.concatenate([ang[keep], np.array(add_f, float)]),
+        np.concatenate([cm[keep], np.zeros(len(add_e), bool)]),
+    )  # fmt: skip
+
+
+def chord_triangles(xy, face, on_curve) -> np.ndarray | None:
+    """A face with one curve run cut along its rulings that end on points of its straight sides
+    (:func:`steiner_points`: a vertex between two collinear sides, at the foot of the
+    perpendicular from a vertex of the run), each piece triangulated by
+    :func:`delaunay_triangles`; None where there is no such point."""
+    f = np.asarray(face, np.int64)
+    p = np.asarray(xy, float)[f]
+    on = np.asarray(on_curve, bool)
+    n = len(f)
+    if not on.any():
+        return None
+    runs = _runs(on)
+    if len(runs) != 1 or runs[0][1] >= n:
+        return None
+    a0, m = runs[0]
+    run = [(a0 + k) % n for k in range(1, m)]
+    chords = []
+    for c in range(n):
+        if c in run or c == a0 or c == (a0 + m) % n:
+            continue
+        prev, nxt = p[(c - 1) % n], p[(c + 1) % n]
+        t = nxt - prev
+        Lt = float(np.hypot(*t))
+        w = p[c] - prev
+        if abs(float(w[0] * t[1] - w[1] * t[0])) > 1e-9 * Lt * Lt:
+            continue  # a corner, not a point on a straight side
+        off = np.abs((p[run] - p[c]) @ t) / Lt
+        k = int(np.argmin(off + 1e-9 * np.linalg.norm(p[run] - p[c], axis=1)))
+        if off[k] <= 1e-6 * Lt and not _crosses(p[run[k]], p[c], p):
+            chords.append((run[k], c))
+    if not chords:
+        return None
+    pieces = [list(range(n))]
+    for i, c in chords:
+        for k, poly in enumerate(pieces):
+            if i in poly and c in poly:
+                a, b = poly.index(i), poly.index(c)
+                a, b = min(a, b), max(a, b)
+                pieces[k : k + 1] = [poly[a : b + 1], poly[b:] + poly[: a + 1]]
+                break
+    tris = []
+    for poly in pieces:
+        if len(poly) < 3:
+            continue
+        t = delaunay_triangles(p, np.array(poly)) if len(poly) > 3 else np.array([poly])
+        tris.append(t)
+    T = np.concatenate(tris)
+    total = 0.5 * float(np.sum(_cross_loop(p)))
+    a2 = _area2(p, T)
+    tiles = abs(0.5 * a2.sum() - total) <= 1e-9 * abs(total)  # chords inside: no overlap
+    if len(T) != n - 2 or (a2 <= 1e-12 * abs(total)).any() or not tiles:
+        return None
+    return f[T]

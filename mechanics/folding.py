@@ -5,8 +5,9 @@ as-built 3-D state when it has none) with a real material and section, then driv
 angle of every mountain and valley crease from flat towards ``fraction`` x its target fold
 angle (Origami Simulator's "fold percent"), one Newton-converged step at a time
 (:func:`~holofold.mechanics.solvers.solve_selffold`, one increment per call). A step that does
-not converge is retried at half the size, down to 1/16 of the nominal step; then the fold stops
-there and the result says so. Nothing is loaded: the model only moves where its rest angles
+not converge is retried at half the size, down to 1/16 of the nominal step (1/1024 for a
+pattern with curved creases, :data:`_CURVED_HALVINGS`); then the fold stops there and the
+result says so. Nothing is loaded: the model only moves where its rest angles
 take it.
 
 What each assignment becomes (FOLD codes):
@@ -100,6 +101,16 @@ _MAX_HALVINGS = 4
 #: simple vertex's snap converged in 158 updates where a step's cap is 120; 3x keeps Lang's
 #: cardinal (whose snaps do not converge) at 26 s CPU against 24 s with 1x and 93 s with 10x
 SNAP_UPDATES = 3
+#: a pattern with curved creases (``pattern.curves``) halves a failed step this many times
+#: before it takes the failure for a limit point: its bending panels make the tangent
+#: ill-conditioned (Leafy_Opus_T-69 at 0.7 %: smallest eigenvalues 0.017 N/m against diagonal
+#: entries up to 1.8e9 N/m), so Newton's reach is far shorter than a straight pattern's
+#: (Leafy from flat: 0.1 % diverges, 0.01 % converges in 3 iterations); at 1/16 of the step
+#: the fold claimed snaps that were none: Origami Simulator's 9 curved files that snapped in
+#: 60 s claimed 25 snaps at 1/16 and 1 at 1/1024, converging through the rest; the fraction
+#: reached within 1.1 % on 8 of them (docs/curved-creases.md). Patterns without curves keep
+#: :data:`_MAX_HALVINGS`.
+_CURVED_HALVINGS = 10
 
 DRIVEN, FACET, PASSIVE = 0, 1, 2
 
@@ -532,6 +543,7 @@ def fold_pattern(
     n_steps = max(2, math.ceil(top / max_step_deg)) if top > 0 else 1
     h0 = fraction / n_steps
     done, h, halvings = 0.0, h0, 0
+    most_halvings = _CURVED_HALVINGS if len(getattr(pattern, "curves", ()) or ()) else _MAX_HALVINGS
     fr, Us, clock = [0.0], [U.copy()], [0.0]
     snaps: list[float] = []
     flows: list[float] = []  # steps carried by pseudo-transient flow where Newton stalled
@@ -579,7 +591,7 @@ def fold_pattern(
             clock.append(time.perf_counter() - started)
             h = min(h0, 2.0 * h)
             continue
-        if h <= h0 / 2**_MAX_HALVINGS:
+        if h <= h0 / 2**most_halvings:
             # no equilibrium near the last one: a limit point; the sheet snaps to another
             # equilibrium, found by minimising the energy (Levenberg-Marquardt)
             relaxed = _relax(asm, U, rest(nxt), tol)
