@@ -15,6 +15,7 @@ Every file is written atomically (:mod:`holofold.geometry.outputs`).
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,14 +96,32 @@ def _dxf(obj, unit, **kw):
 
 
 def _mesh_writer(kind: str):
+    """holofold's own writer of ``kind``: a pattern's folded surface or a trimesh.Trimesh,
+    as arrays (:mod:`holofold.geometry.mesh_files`; no trimesh is imported for a pattern)."""
+
     def write(obj, unit, **kw):
-        from holofold.geometry.mesh import export_mesh
+        from holofold.geometry.mesh import export_mesh, folded_arrays
+        from holofold.geometry.mesh_files import mesh_file
 
         if kw:
             raise TypeError(f".{kind} export takes no options, got {', '.join(kw)}")
+        if isinstance(obj, CreasePattern):
+            v, t, _ = folded_arrays(obj)
+            return mesh_file(v, t, kind, unit, obj.meta.get("kind", "pattern"))
         return export_mesh(obj, kind, unit)
 
     return write
+
+
+#: the built-in mesh formats holofold writes from a pattern's arrays (no trimesh.Trimesh built)
+_ARRAY_FORMATS = ("stl", "obj", "ply")
+
+
+def _is_trimesh(obj) -> bool:
+    """Whether ``obj`` is a trimesh.Trimesh (without importing trimesh: where it is not
+    imported, nothing can be one)."""
+    tm = sys.modules.get("trimesh")
+    return tm is not None and isinstance(obj, tm.Trimesh)
 
 
 def _glb(obj, unit, **kw):
@@ -137,8 +156,6 @@ def export(
     its unit refuses another. ``kw`` go to the format's writer. Nothing is written if the
     format, the object or the unit is wrong.
     """
-    import trimesh
-
     from holofold.geometry.units import length_factor
 
     path = Path(path)
@@ -150,7 +167,7 @@ def export(
         )
     if fmt.takes == "pattern" and not isinstance(obj, CreasePattern):
         raise TypeError(f".{kind} export needs a CreasePattern, got {type(obj).__name__}")
-    if fmt.takes == "mesh" and not isinstance(obj, trimesh.Trimesh | CreasePattern):
+    if fmt.takes == "mesh" and not (isinstance(obj, CreasePattern) or _is_trimesh(obj)):
         raise TypeError(
             f".{kind} export needs a trimesh.Trimesh or a CreasePattern, got {type(obj).__name__}"
         )
@@ -161,7 +178,7 @@ def export(
         )
     unit = fmt.unit or (MESH_UNITS if units is None else units)
     length_factor(unit)
-    if fmt.takes == "mesh" and isinstance(obj, CreasePattern):
+    if fmt.takes == "mesh" and isinstance(obj, CreasePattern) and kind not in _ARRAY_FORMATS:
         from holofold.geometry.mesh import folded_mesh
 
         obj = folded_mesh(obj)

@@ -7,10 +7,11 @@ has the pattern's vertices first (ids kept) and one centre per panel after them
 (non-planar) quad is the same surface the simulator sees. Faces are oriented consistently
 (:func:`holofold.geometry.pattern.orient_faces`), so normals point to one side of the sheet.
 
-STL, OBJ and PLY are written by trimesh (:func:`export_mesh`), in millimetres unless asked
-otherwise (the convention of slicers and CAD programs, which read these unit-less formats as mm);
-the unit is stated where the format allows: an OBJ comment, a PLY header comment and the STL's
-80-byte header (which no reader interprets).
+STL, OBJ and PLY are written by holofold's own array code (:mod:`holofold.geometry.mesh_files`,
+no trimesh: :func:`export_mesh`, and :func:`holofold.geometry.export` of a pattern, which builds
+no ``trimesh.Trimesh``), in millimetres unless asked otherwise (the convention of slicers and CAD
+programs, which read these unit-less formats as mm); the unit is stated where the format allows:
+an OBJ comment, a PLY header comment and the STL's 80-byte header (which no reader interprets).
 """
 
 from __future__ import annotations
@@ -18,8 +19,8 @@ from __future__ import annotations
 import lazy_loader
 import numpy as np
 
+from holofold.geometry.mesh_files import MESH_FILE_TYPES, mesh_file
 from holofold.geometry.pattern import CreasePattern, orient_faces
-from holofold.geometry.units import length_factor
 
 # trimesh (with scipy.spatial and scipy.optimize) costs 0.5-1 s to import; it loads on first use
 trimesh = lazy_loader.load("trimesh")
@@ -27,13 +28,14 @@ trimesh = lazy_loader.load("trimesh")
 __all__ = [
     "fan_triangulation",
     "folded_mesh",
+    "folded_arrays",
     "flat_mesh",
     "export_mesh",
     "MESH_TYPES",
     "MESH_UNITS",
 ]
 
-MESH_TYPES = ("stl", "obj", "ply")
+MESH_TYPES = MESH_FILE_TYPES
 
 #: default length unit of mesh files (slicers and CAD read STL/OBJ/PLY as millimetres)
 MESH_UNITS = "mm"
@@ -72,10 +74,15 @@ def fan_triangulation(coords: np.ndarray, faces) -> tuple[np.ndarray, np.ndarray
     return np.vstack([coords, centres]), tris, owner
 
 
+def folded_arrays(pattern: CreasePattern) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The arrays of :func:`folded_mesh` without trimesh: vertices (nv + nf, 3) m, triangles
+    (sum k, 3) int, face_index (sum k,) panel ids."""
+    return fan_triangulation(pattern.coords, orient_faces(pattern.faces))
+
+
 def folded_mesh(pattern: CreasePattern) -> trimesh.Trimesh:
     """The folded (3-D) surface of ``pattern``; metadata holds ``face_index`` (panel ids)."""
-    faces = orient_faces(pattern.faces)
-    v, t, owner = fan_triangulation(pattern.coords, faces)
+    v, t, owner = folded_arrays(pattern)
     mesh = trimesh.Trimesh(vertices=v, faces=t, process=False)
     mesh.metadata["face_index"] = owner
     mesh.metadata["name"] = pattern.meta.get("kind", "pattern")
@@ -94,26 +101,13 @@ def flat_mesh(pattern: CreasePattern) -> trimesh.Trimesh:
 
 
 def export_mesh(mesh: trimesh.Trimesh, file_type: str, units: str = MESH_UNITS) -> bytes | str:
-    """Serialise ``mesh`` (metres) as STL (binary), OBJ or PLY (binary) in ``units``.
-
-    The coordinates are divided by :func:`~holofold.geometry.units.length_factor` of ``units``;
-    the unit is named in an OBJ comment (``# units: mm``), a PLY header comment
-    (``comment units: mm``) and the STL header.
-    """
+    """Serialise ``mesh`` (metres) as STL (binary), OBJ or PLY (binary) in ``units``
+    (:func:`holofold.geometry.mesh_files.mesh_file`: the coordinates divided by
+    :func:`~holofold.geometry.units.length_factor` of ``units``; the unit named in an OBJ comment
+    ``# holofold mesh, units: mm``, a PLY header comment and the STL header; the OBJ object named
+    by ``mesh.metadata["name"]``)."""
     file_type = file_type.lower().lstrip(".")
     if file_type not in MESH_TYPES:
         raise ValueError(f"unknown mesh type {file_type!r}; known: {', '.join(MESH_TYPES)}")
-    k = length_factor(units)
-    if k != 1.0:
-        mesh = mesh.copy()
-        mesh.apply_scale(1.0 / k)
-    data = trimesh.exchange.export.export_mesh(mesh, None, file_type=file_type)
-    note = f"holofold mesh, units: {units}"
-    if file_type == "stl":  # 80-byte header, free text (must not start with "solid")
-        return note.encode("ascii").ljust(80, b" ")[:80] + data[80:]
-    if file_type == "obj":
-        return f"# {note}\n" + (data if isinstance(data, str) else data.decode())
-    head, sep, body = data.partition(b"end_header\n")
-    first, nl, rest = head.partition(b"\n")  # "ply", then the format line
-    fmt, nl2, rest = rest.partition(b"\n")
-    return first + nl + fmt + nl2 + f"comment {note}\n".encode("ascii") + rest + sep + body
+    name = mesh.metadata.get("name") if isinstance(mesh.metadata, dict) else None
+    return mesh_file(mesh.vertices, mesh.faces, file_type, units, name)

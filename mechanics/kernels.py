@@ -18,6 +18,11 @@ the environment variable ``HOLOFOLD_KERNELS``:
 ``numpy``
     never compile.
 
+A one-shot run of a small model (:func:`small_model`: under :data:`SMALL_MODEL_PANELS` panels,
+``holofold simulate`` of one pattern) runs on numpy in ``auto`` unless this process has loaded
+the compiled kernels already: numba's import and loading its machine code (0.45-0.6 s CPU) cost
+such a run more than the numpy kernels do (issue 37 item 4; benchmarks/speed_targets.md).
+
 The kernel cache is a folder keyed on a hash of the kernels' sources (every file the compiled
 code is built from), the numba, llvmlite, numpy and Python versions and the CPU, so an edited
 kernel can never run stale machine code (numba alone keys each cached function on its own file
@@ -37,6 +42,8 @@ import sys
 import tempfile
 import time
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -54,6 +61,8 @@ __all__ = [
     "kernel_path",
     "cache_folder",
     "check_environment",
+    "small_model",
+    "SMALL_MODEL_PANELS",
 ]
 
 #: the kernel paths, reference first
@@ -61,6 +70,10 @@ KERNEL_PATHS = ("numpy", "compiled")
 ENV = "HOLOFOLD_KERNELS"
 #: the modules the compiled kernels are built from (their sources key the cache)
 COMPILED_SOURCES = ("_jit.py", "_compiled.py", "_spring_loop.py", "supernodal.py")
+#: below this many panels a one-shot run in ``auto`` mode skips numba (:func:`small_model`):
+#: whole ``holofold simulate --no-contact`` processes, numpy vs compiled kernels, CPU s: 24
+#: panels 1.57 vs 2.19, 156 panels 6.05 vs 5.80, 330 panels 5.59 vs 2.69 (load 8-10)
+SMALL_MODEL_PANELS = 100
 #: how often (s) a process on the numpy path looks whether the compiled kernels are ready
 POLL_SECONDS = 2.0
 
@@ -271,6 +284,24 @@ _AUTO = _Auto()
 
 _FIXED: dict[str, KernelPath] = {}
 
+#: inside :func:`small_model` of a small model (``auto`` runs numpy there)
+_SMALL = False
+
+
+@contextmanager
+def small_model(panels: int) -> Iterator[bool]:
+    """Within: a one-shot run of a model of ``panels`` panels; where they are fewer than
+    :data:`SMALL_MODEL_PANELS` and this process has not loaded the compiled kernels, ``auto``
+    runs the numpy kernels (no numba import, no background compile started). Yields whether
+    it does; ``HOLOFOLD_KERNELS=numpy`` or ``compiled`` are obeyed as always."""
+    global _SMALL
+    before = _SMALL
+    _SMALL = int(panels) < SMALL_MODEL_PANELS and _COMPILED_MODULE is None
+    try:
+        yield _SMALL
+    finally:
+        _SMALL = before
+
 
 def active() -> KernelPath:
     """The kernel path this process runs now (see the module docstring). Cheap: called once
@@ -281,7 +312,7 @@ def active() -> KernelPath:
         return path
     mode = requested()
     if mode == "auto":
-        return _AUTO.resolve()
+        return _numpy_path() if _SMALL else _AUTO.resolve()
     path = _FIXED[os.environ.get(ENV, "auto")] = kernel_path(mode)
     return path
 

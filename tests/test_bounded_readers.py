@@ -163,7 +163,7 @@ def test_outputs_bytes_equal_across_processes():
         runs.append(subprocess.run([sys.executable, "-c", code], capture_output=True, check=True,
                                    timeout=120, env=env).stdout.decode().split())  # fmt: skip
     sizes = [int(h.split(":")[0]) for h in runs[0]]
-    assert len(sizes) == 7 and min(sizes) > 1000, sizes
+    assert len(sizes) == 7 and min(sizes) > 900, sizes  # the PLY: 972 bytes (no trimesh comment)
     assert runs[1] == runs[0] and runs[2] == runs[0]
 
 

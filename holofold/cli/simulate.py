@@ -133,7 +133,7 @@ def run(args) -> int:
     import numpy as np
 
     from holofold.geometry import check_output_folder, check_range, read_pattern, reader_for
-    from holofold.mechanics import scaled_pattern, simulate_pattern, write_simulation
+    from holofold.mechanics import scaled_pattern, simulate_pattern, small_model, write_simulation
 
     if _is_batch(args):
         return _run_batch(args)
@@ -162,7 +162,8 @@ def run(args) -> int:
     elif args.scale is not None:
         pattern = scaled_pattern(pattern, args.scale)
     pattern = replace(pattern, meta={**pattern.meta, "source": Path(args.pattern).name})
-    sim = simulate_pattern(pattern, setting)
+    with small_model(pattern.n_faces):  # one run: numba only where it pays (issue 37)
+        sim = simulate_pattern(pattern, setting)
     written = write_simulation(sim, out, units=args.units)
     size = np.ptp(pattern.flat if pattern.flat is not None else pattern.coords, axis=0)
     print(
