@@ -105,9 +105,13 @@ def export_mesh(mesh: trimesh.Trimesh, file_type: str, units: str = MESH_UNITS) 
     (:func:`holofold.geometry.mesh_files.mesh_file`: the coordinates divided by
     :func:`~holofold.geometry.units.length_factor` of ``units``; the unit named in an OBJ comment
     ``# holofold mesh, units: mm``, a PLY header comment and the STL header; the OBJ object named
-    by ``mesh.metadata["name"]``)."""
+    by ``mesh.metadata["name"]``; per-vertex colours kept in OBJ and PLY, as trimesh wrote
+    them)."""
     file_type = file_type.lower().lstrip(".")
     if file_type not in MESH_TYPES:
         raise ValueError(f"unknown mesh type {file_type!r}; known: {', '.join(MESH_TYPES)}")
     name = mesh.metadata.get("name") if isinstance(mesh.metadata, dict) else None
-    return mesh_file(mesh.vertices, mesh.faces, file_type, units, name)
+    colours = None
+    if file_type != "stl" and getattr(mesh.visual, "kind", None) == "vertex":
+        colours = np.asarray(mesh.visual.vertex_colors)  # kept in OBJ and PLY
+    return mesh_file(mesh.vertices, mesh.faces, file_type, units, name, colours)

@@ -90,3 +90,25 @@ def test_obj_text_layout_and_refusals():
         mesh_file(v, [[0, 1, 3]], "stl")
     with pytest.raises(ValueError, match="unknown mesh type"):
         mesh_file(v, [[0, 1, 2]], "glb")
+
+
+@pytest.mark.parametrize("kind", ("ply", "obj"))
+def test_vertex_colours_are_kept(miura, kind):
+    """A mesh coloured per vertex (the gripper's closed_temperature.ply) keeps its colours in
+    PLY (uchar RGBA) and OBJ (r g b after each vertex): trimesh reads them back (OBJ to the
+    1/255 its floats round to); STL, which has none, refuses them."""
+    mesh = folded_mesh(miura)
+    rng = np.random.default_rng(5)
+    rgba = np.column_stack(
+        [rng.integers(0, 256, (len(mesh.vertices), 3)), np.full(len(mesh.vertices), 255)]
+    )
+    coloured = mesh.copy()
+    coloured.visual.vertex_colors = rgba.astype(np.uint8)
+    data = export_mesh(coloured, kind, units="mm")
+    raw = data.encode() if isinstance(data, str) else data
+    back = trimesh.load(io.BytesIO(raw), file_type=kind, process=False, force="mesh")
+    assert back.visual.kind == "vertex"
+    got = np.asarray(back.visual.vertex_colors)[:, :3].astype(int)
+    assert np.abs(got - rgba[:, :3]).max() <= (1 if kind == "obj" else 0)
+    with pytest.raises(ValueError, match="STL has no vertex colours"):
+        mesh_file(mesh.vertices, mesh.faces, "stl", colours=rgba)
