@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import warnings
 from pathlib import Path
 
@@ -9,7 +10,6 @@ import numpy as np
 import pytest
 
 from holofold.geometry import read_pattern
-from holofold.geometry.pattern import CreasePattern
 from holofold.geometry.ruling_mesh import (
     chord_triangles,
     delaunay_triangles,
@@ -18,6 +18,9 @@ from holofold.geometry.ruling_mesh import (
 )
 from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.hinges import build_concentrated
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from validation import hinge_plate_checks  # noqa: E402
 
 DATA = Path(__file__).parent / "data" / "origami-simulator"
 
@@ -252,25 +255,9 @@ def test_straight_crease_files_read_as_before(name):
 # --------------------------------------------------------------------------- plate bending
 def _strip(xs, ny, width=0.03):
     """A flat strip with rungs at ``xs`` and ny pieces across, each quad split along one
-    diagonal (the direction alternating per column); interior edges J, the outline B."""
-    nx = len(xs) - 1
-    x, y = np.meshgrid(xs, np.linspace(0, width, ny + 1), indexing="ij")
-    xy = np.c_[x.ravel(), y.ravel()]
-    vid = np.arange(len(xy)).reshape(nx + 1, ny + 1)
-    faces = []
-    for i in range(nx):
-        for j in range(ny):
-            a, b, c, d = vid[i, j], vid[i + 1, j], vid[i + 1, j + 1], vid[i, j + 1]
-            faces += [[a, b, c], [a, c, d]] if i % 2 == 0 else [[a, b, d], [b, c, d]]
-    sides = {}
-    for f in faces:
-        for k in range(3):
-            key = (min(f[k], f[(k + 1) % 3]), max(f[k], f[(k + 1) % 3]))
-            sides[key] = sides.get(key, 0) + 1
-    edges = np.array(sorted(sides))
-    asg = np.array(["J" if sides[tuple(e)] == 2 else "B" for e in edges.tolist()])
-    z = np.zeros(len(edges))
-    return CreasePattern(np.c_[xy, np.zeros(len(xy))], faces, edges, asg, z, flat=xy), vid
+    diagonal (the direction alternating per column); interior edges J, the outline B
+    (validation/hinge_plate_checks.py's rectangle)."""
+    return hinge_plate_checks.rectangle(np.asarray(xs, float), ny, width, split="column")
 
 
 @pytest.mark.parametrize(
