@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from holofold.geometry.close_pairs import close_pairs
 from holofold.geometry.errors import FormatError
 
 __all__ = ["Arrangement", "arrange_lines", "PRIORITY", "REL_TOL", "default_tolerance"]
@@ -145,13 +146,12 @@ def _cluster(points: np.ndarray, tol: float, extra=None, extra_labels: bool = Fa
     clusters they touch (each pair is one point) but do not move the means."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
 
     n0 = len(points)
     extra = np.zeros((0, 2)) if extra is None else np.asarray(extra, float).reshape(-1, 2)
     allp = np.vstack([points, extra])
     n = len(allp)
-    pairs = cKDTree(allp).query_pairs(tol, output_type="ndarray") if n else np.zeros((0, 2))
+    pairs = close_pairs(allp, tol)
     link = n0 + np.arange(0, len(extra), 2)
     pairs = np.vstack([np.asarray(pairs, np.intp).reshape(-1, 2), np.stack([link, link + 1], 1)])
     g = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))

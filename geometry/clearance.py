@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from scipy.spatial import cKDTree
 
+from holofold.geometry.close_pairs import close_pairs
 from holofold.geometry.errors import ParameterError
 from holofold.geometry.pattern import CreasePattern, newell_normals, orient_faces
 from holofold.geometry.solid import corner_edges, offset_corners
@@ -282,21 +282,20 @@ def _plane_gap(A, B):
     return np.where(lo > 0, lo, np.where(hi < 0, -hi, 0.0))
 
 
-def _first_apart(tree: cKDTree, centre: np.ndarray, share) -> float:
-    """Distance from some panel's centre to the nearest centre of a panel sharing no vertex with
-    it (an upper bound of the nearest such pair's centre distance); inf if there is none."""
-    nf = len(centre)
-    k = min(nf, 16)
+def _first_apart(centre: np.ndarray, share, r: float) -> float:
+    """Distance between the nearest two panel centres of panels sharing no vertex (an upper
+    bound of the nearest such pair's mid-surface distance); inf if there is none. The search
+    radius starts at ``r`` (> 0) and doubles until such a pair is within it."""
+    reach = float(np.linalg.norm(np.ptp(centre, axis=0))) if len(centre) else 0.0
+    r = r if r > 0 else max(reach, 1.0)
     while True:
-        d, j = tree.query(centre, k=k)
-        d, j = d.reshape(nf, k), j.reshape(nf, k)
-        rows = np.repeat(np.arange(nf), k)
-        apart = (np.asarray(share[rows, j.ravel()]).ravel() == 0).reshape(nf, k)
-        if apart.any():
-            return float(d[apart].min())
-        if k == nf:
+        pairs = close_pairs(centre, r)
+        apart = pairs[np.asarray(share[pairs[:, 0], pairs[:, 1]]).ravel() == 0]
+        if len(apart):
+            return float(np.linalg.norm(centre[apart[:, 0]] - centre[apart[:, 1]], axis=1).min())
+        if r > reach:  # every pair was within reach
             return math.inf
-        k = min(nf, 4 * k)
+        r *= 2.0
 
 
 def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> Printability:
@@ -315,9 +314,8 @@ def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> P
     nf = pattern.n_faces
     centre = pts.mean(axis=1)
     radius = np.linalg.norm(pts - centre[:, None, :], axis=2).max(axis=1)
-    tree = cKDTree(centre)
     # --- overlap: pairs whose bounding spheres meet
-    pairs = tree.query_pairs(r=2 * float(radius.max()), output_type="ndarray")
+    pairs = close_pairs(centre, 2 * float(radius.max()))
     if len(pairs):
         d = np.linalg.norm(centre[pairs[:, 0]] - centre[pairs[:, 1]], axis=1)
         pairs = pairs[d <= radius[pairs[:, 0]] + radius[pairs[:, 1]]]
@@ -329,12 +327,12 @@ def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> P
         shape=(nf, pattern.n_vertices),
     )  # fmt: skip
     share = (inc @ inc.T).tocsr()
-    far = _first_apart(tree, centre, share)
+    far = _first_apart(centre, share, 2 * float(radius.max()))
     if not math.isfinite(far):
         return Printability(volume, math.inf, maybe, None)
     mid_r = np.linalg.norm(P - P.mean(axis=1, keepdims=True), axis=2).max(axis=1)
     mid_c = P.mean(axis=1)
-    cand = tree.query_pairs(r=far + 4 * float(radius.max()), output_type="ndarray")
+    cand = close_pairs(centre, far + 4 * float(radius.max()))
     cand = cand[np.asarray(share[cand[:, 0], cand[:, 1]]).ravel() == 0]
     i, j = cand[:, 0], cand[:, 1]
     half = 0.5 * (t[i] + t[j])

@@ -43,8 +43,10 @@ def test_a_crease_pattern_does_not_load_networkx():
 
 
 #: modules ``holofold simulate`` writes its usual files without (issue 37 item 4: trimesh and
-#: networkx were the STL/OBJ writer's, matplotlib with pyplot and mplot3d the picture's)
-NOT_IN_SIMULATE = ("trimesh", "networkx", "matplotlib", "matplotlib.pyplot", "mpl_toolkits")
+#: networkx were the STL/OBJ writer's, matplotlib with pyplot and mplot3d the picture's,
+#: scipy.spatial the line reader's point merging and the printability's panel pairs)
+NOT_IN_SIMULATE = ("trimesh", "networkx", "matplotlib", "matplotlib.pyplot", "mpl_toolkits",
+                   "scipy.spatial")  # fmt: skip
 
 
 @pytest.mark.parametrize("contact", ["--contact", "--no-contact"])
