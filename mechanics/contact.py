@@ -425,15 +425,27 @@ def _crossing(X, triangles) -> bool:
 
 
 def _panels_of_node(structure) -> list[set]:
-    """The panels holding each node (empty for none), from ``structure.tri_panel``."""
+    """The panels holding each node (empty for none), from ``structure.tri_panel``. A crease
+    strip's triangles (``tri_panel`` -1, the compliant model) belong to the panels their nodes
+    touch, so a contact on a crease strip names the panels the crease joins, never panel -1."""
     out: list[set] = [set() for _ in range(len(structure.nodes))]
     panel = getattr(structure, "tri_panel", None)
     if panel is None:
         return out
-    for tri, p in zip(np.asarray(structure.triangles), np.asarray(panel), strict=True):
+    tris, panel = np.asarray(structure.triangles), np.asarray(panel)
+    for tri, p in zip(tris, panel, strict=True):
         if p >= 0:
             for n in tri:
                 out[n].add(int(p))
+    strip = [(tri, set().union(*(out[n] for n in tri))) for tri in tris[panel < 0]]
+    for tri, joined in strip:
+        for n in tri:
+            if not out[n]:
+                out[n] = set(joined)
+    for tri, _ in strip:  # a strip node reached only through other strip nodes
+        for n in tri:
+            if not out[n]:
+                out[n] = set().union(*(out[m] for m in tri))
     return out
 
 

@@ -223,3 +223,26 @@ def test_the_barrier_solve_gives_up_past_its_deadline():
     before = pc.newton_steps
     assert pc.step(asm, U, None, None, 1e-6, deadline=0.0) is None
     assert pc.newton_steps == before
+
+
+def test_a_crease_strip_names_the_panels_its_crease_joins():
+    """In the compliant model a crease strip's triangles hold no panel (``tri_panel`` -1); a
+    contact there names the panels the crease joins, never "panel -1" (seen on Origami
+    Simulator's curved files: "panels -1 and 513 touch")."""
+    from holofold.mechanics.contact import _panels_of_node
+    from holofold.mechanics.hinges import build_compliant
+
+    p = miura_sheet(2, 2, a=0.04, b=0.04, gamma=1.1, ext=0.6)
+    s = build_compliant(p, crease_width=2e-3, crease_thickness=1e-4, panel_thickness=1e-3,
+                        E_panel=1.5e9, E_crease=1.5e9, nu_panel=0.42, nu_crease=0.42)  # fmt: skip
+    held = _panels_of_node(s)
+    strip = np.unique(s.triangles[s.tri_panel < 0])
+    assert len(strip) and all(held[n] for n in np.unique(s.triangles))
+    # the panels named for a strip's triangles are the two its crease joins
+    faces = [set(f.tolist()) for f in p.faces]
+    named: dict[int, set] = {}
+    for tri, c in zip(s.triangles[s.tri_panel < 0], s.tri_crease[s.tri_panel < 0], strict=True):
+        named.setdefault(int(c), set()).update(*(held[n] for n in tri))
+    for c, got in named.items():
+        u, v = p.edges[c]
+        assert got == {f for f, verts in enumerate(faces) if u in verts and v in verts}
