@@ -244,11 +244,8 @@ class PanelContact:
             if d < best:
                 best, k = d, i
         # each c[i] is a view into the set: read the closest one by index, while c lives
-        ids = [int(v) for v in c[k].vertex_ids(E, F) if v >= 0]
-        name = type(c[k]).__name__  # FaceVertex: (v, f0, f1, f2); EdgeEdge, EdgeVertex: 2
-        cut = 2 if name.startswith(("EdgeEdge", "EdgeVertex")) else 1
-        a = self._panels_of(ids[cut:] if name.startswith("Face") else ids[:cut])
-        b = self._panels_of(ids[:cut] if name.startswith("Face") else ids[cut:])
+        one, other = _primitives(c[k], E, F)
+        a, b = self._panels_of(one), self._panels_of(other)
         pa = min(a, default=-1)
         pb = min(b - {pa}, default=min(b, default=-1))
         return len(c), (min(pa, pb), max(pa, pb))
@@ -422,6 +419,16 @@ def _crossing(X, triangles) -> bool:
     from holofold.mechanics.intersection import has_intersections
 
     return bool(has_intersections(np.asarray(X), np.asarray(triangles), backend="numpy"))
+
+
+def _primitives(collision, edges, faces) -> tuple[list[int], list[int]]:
+    """The node ids of a collision's two primitives. IPC Toolkit lists a pair's nodes as
+    ``(v, f0, f1, f2)`` (face-vertex), ``(v, e0, e1, -1)`` (edge-vertex), ``(v0, v1, -1, -1)``
+    (vertex-vertex): the vertex first; edge-edge as ``(a0, a1, b0, b1)``."""
+    ids = [int(v) for v in collision.vertex_ids(edges, faces)]
+    if type(collision).__name__.startswith("EdgeEdge"):
+        return ids[:2], ids[2:]
+    return ids[:1], [v for v in ids[1:] if v >= 0]
 
 
 def _panels_of_node(structure) -> list[set]:

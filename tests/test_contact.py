@@ -246,3 +246,33 @@ def test_a_crease_strip_names_the_panels_its_crease_joins():
     for c, got in named.items():
         u, v = p.edges[c]
         assert got == {f for f, verts in enumerate(faces) if u in verts and v in verts}
+
+
+def test_each_collision_type_splits_into_its_two_primitives():
+    """IPC Toolkit lists an edge-vertex pair as (v, e0, e1, -1): the vertex first. Reading it
+    as two and two named a vertex with one end of the edge, two nodes of different panels, so
+    the touch was reported as "panels -1 and 513" (Origami Simulator's Leafy_Opus_T-69)."""
+    import ipctk
+
+    from holofold.mechanics.contact import _primitives
+
+    E = np.array([[0, 1], [2, 3], [4, 5]], np.int32)
+    F = np.array([[6, 7, 8]], np.int32)
+    assert _primitives(ipctk.EdgeVertexCandidate(1, 9), E, F) == ([9], [2, 3])
+    assert _primitives(ipctk.FaceVertexCandidate(0, 9), E, F) == ([9], [6, 7, 8])
+    assert _primitives(ipctk.EdgeEdgeCandidate(0, 2), E, F) == ([0, 1], [4, 5])
+    assert _primitives(ipctk.VertexVertexCandidate(3, 9), E, F) == ([3], [9])
+
+
+def test_a_vertex_near_another_panels_edge_names_both_panels():
+    """A corner of panel 1 1.5 mm off an edge of panel 0, every other primitive farther: the
+    closest pair is edge-vertex and the touch names panels 0 and 1."""
+    s = _Two()
+    s.nodes = np.array([[0, 0, 0], [0.01, 0, 0], [0.01, 0.01, 0], [0, 0.01, 0],
+                        [0.005, -1.5e-3, 0], [0.004, -0.01, 0.006], [0.006, -0.01, -0.006],
+                        [0.005, -0.012, 0]], float)  # fmt: skip
+    s.triangles = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [5, 7, 6]])
+    s.tri_panel = np.array([0, 0, 1, 1])
+    pc = PanelContact(s, kappa=1e3)
+    n, where = pc.touching(np.zeros_like(s.nodes))
+    assert n > 0 and where == (0, 1)
