@@ -130,8 +130,8 @@ class KernelInputs(NamedTuple):
         first = structures[0].bars
         if all(s.bars is first for s in structures):  # one bar array (a builder's layout)
             bars = np.asarray(first, np.intp)
-            b0 = np.repeat(bars[None, :, 0], len(structures), axis=0)
-            b1 = np.repeat(bars[None, :, 1], len(structures), axis=0)
+            ends = np.repeat(bars.T[:, None], len(structures), axis=1)  # (2, S, nb)
+            b0, b1 = ends[0], ends[1]  # C-contiguous rows
             D0 = np.ascontiguousarray((X[:, bars[:, 1]] - X[:, bars[:, 0]]).transpose(0, 2, 1))
         else:
             bars = np.stack([s.bars for s in structures]).astype(np.intp)

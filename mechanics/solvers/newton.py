@@ -174,8 +174,8 @@ def solve_newton_batch(
     U = _stacked("U0", U0, S, nn)
     free = B.free_dofs
     X = B.inputs.X  # model_size of every structure at once
-    lo, hi = X.min(axis=1), X.max(axis=1)
-    size = np.maximum((hi - lo).max(axis=1), np.maximum(-lo, hi).max(axis=1))
+    lo, hi = X.min(axis=1), X.max(axis=1)  # per sample: max(ptp, max |x|) over the axes
+    size = np.maximum(hi - lo, np.maximum(-lo, hi)).max(axis=1)
     floors = np.where(np.any(P[:, free] != 0.0, axis=1), RESOLUTION * np.maximum(size, 1e-300), 0.0)
     rec = batch_newton_increments(B, U, F0v, P, increments, tol, max_iter)
     if rec is not None:  # every increment of every sample in one kernel call per connectivity
@@ -186,10 +186,14 @@ def solve_newton_batch(
             & rec.converged.all(axis=1)
             & ((floors == 0.0) | (rec.moved >= floors[:, None]).all(axis=1))
         ).tolist()
+        # their shared arrays, made once: the applied force after every increment and the
+        # convergence flags (a copy; each sample's row of it)
+        applied = (F0v + increments * P).reshape(S, nn, 3)
+        conv = rec.converged.copy()
         out = []
         for s in range(S):
             if clean[s]:
-                out.append(_converged_record(rec, s, structures[s], F0v[s], P[s]))
+                out.append(_converged_record(rec, s, structures[s], applied[s], conv[s]))
             elif rec.failed[s, 0] == 1 and rec.banded[s]:  # not positive definite: LU alone
                 out.append(solve_newton(
                     structures[s], loads[s], increments=increments, tol=tol,
@@ -241,18 +245,19 @@ def _stacked(name, values, S, nn) -> np.ndarray:
     return np.stack([nodal_array(name, values[s], nn).ravel() for s in range(S)])
 
 
-def _converged_record(rec, s, structure, F0, P) -> SolveResult:
+def _converged_record(rec, s, structure, applied, converged) -> SolveResult:
     """:func:`_from_records` of a sample whose every increment converged above the round-off
-    resolution and none failed (its status is :data:`CONVERGED`)."""
+    resolution and none failed (its status is :data:`CONVERGED`): ``applied`` (nn, 3) its
+    force after the last increment, N, ``converged`` its flags (a copy of the records')."""
     count = rec.U.shape[1]
     return SolveResult(
         U_history=rec.U[s].reshape(count, -1, 3),
-        load_factor=np.arange(1, count + 1, dtype=float),
-        converged=rec.converged[s].copy(),
+        load_factor=np.arange(1.0, count + 1.0),
+        converged=converged,
         iterations=rec.iterations[s],
         residual=rec.residual[s],
         status=CONVERGED,
-        applied_force=(F0 + count * P).reshape(-1, 3),
+        applied_force=applied,
         spring_rest=np.array(structure.spring_rest, float),
     )
 
