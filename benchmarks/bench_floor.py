@@ -39,7 +39,12 @@ workers / 2, which other jobs on the machine disturb less) and prints the floor 
 (per-row floors of 120 rows spread over the file, scaled to 3000 rows and divided by the 2
 cores).
 
+``--stages`` prints instead where one single Miura design's CPU time goes: the sheet nodes,
+the 3 models, the ``BatchAssembler``, the Newton kernel call and the rest (the path's own
+Python), us per design and against the floor.
+
     python benchmarks/bench_floor.py [--repeat 7] [--no-db] [--only arch] [--before-lu]
+    python benchmarks/bench_floor.py --stages
 """
 
 from __future__ import annotations
