@@ -104,3 +104,18 @@ def test_one_design_on_the_numpy_and_compiled_kernels(monkeypatch):
             assert c[col] > 0
             assert n[col] == pytest.approx(c[col], rel=1e-9)
             assert b[col] == pytest.approx(c[col], rel=1e-9)
+
+
+def test_a_load_direction_given_as_a_list_still_builds():
+    """A setting written in Python with a list direction (unhashable) builds the same load
+    groups as with the tuple."""
+    from dataclasses import replace
+
+    listed = replace(
+        single_miura.SETTING, loads=(sheet.SheetLoad("axial", [1.0, 0.0, 0.0], 3.0, 3),)
+    )
+    got = sheet.sheet_models(listed, ROW)
+    ref = _models(ROW)
+    for (_, g), (_, r) in zip(got, ref, strict=True):
+        np.testing.assert_array_equal(g[0].nodes, r[0].nodes)
+        assert (g[0].axis, g[0].sign) == (r[0].axis, r[0].sign)

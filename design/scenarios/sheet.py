@@ -394,8 +394,9 @@ def sheet_models_batch(setting: SheetSetting, rows, *, profile=PAPER, extensions
             profile=profile,
             supports=sups,
         )
+        dirs = tuple(tuple(float(v) for v in ld.direction) for ld in setting.loads)
         for (i, e), high, st in zip(items, highs, structures, strict=True):
-            out[i][e] = (st, _load_groups(high.tobytes(), setting.loads))
+            out[i][e] = (st, _load_groups(high.tobytes(), dirs))
     return out
 
 
@@ -413,12 +414,12 @@ def _support(n_nodes: int, low: bytes, dofs: str) -> np.ndarray:
 
 
 @lru_cache(maxsize=256)
-def _load_groups(high: bytes, loads: tuple[SheetLoad, ...]) -> tuple:
-    """One :class:`~holofold.mechanics.analyses.LoadGroup` per load on the vertices where the
-    bool bytes ``high`` are set (read-only node ids)."""
+def _load_groups(high: bytes, directions: tuple[tuple[float, ...], ...]) -> tuple:
+    """One :class:`~holofold.mechanics.analyses.LoadGroup` per load direction on the vertices
+    where the bool bytes ``high`` are set (read-only node ids)."""
     tip = np.flatnonzero(np.frombuffer(high, bool))
     tip.setflags(write=False)
-    return tuple(load_along(tip, ld.direction) for ld in loads)
+    return tuple(load_along(tip, d) for d in directions)
 
 
 def sheet_mass(setting: SheetSetting, row) -> float:
