@@ -39,7 +39,12 @@ workers / 2, which other jobs on the machine disturb less) and prints the floor 
 (per-row floors of 120 rows spread over the file, scaled to 3000 rows and divided by the 2
 cores).
 
+``--stages`` prints instead where one single Miura design's CPU time goes: the sheet nodes,
+the 3 models, the ``BatchAssembler``, the Newton kernel call and the rest (the path's own
+Python), us per design and against the floor.
+
     python benchmarks/bench_floor.py [--repeat 7] [--no-db] [--only arch] [--before-lu]
+    python benchmarks/bench_floor.py --stages
 """
 
 from __future__ import annotations
@@ -473,6 +478,70 @@ def database(floor_rows: int = 120):
     return wall, cpu, floor, len(table), ok
 
 
+class _Stages:
+    """Context: CPU time spent in some named calls of one design's path, accumulated (each
+    wrapped where the path looks it up: ``(module, attribute)``)."""
+
+    def __init__(self, spots: dict):
+        self.spots = spots  # stage -> (module, attribute)
+        self.spent = dict.fromkeys(spots, 0.0)
+
+    def __enter__(self):
+        self.orig = {}
+        for stage, (mod, attr) in self.spots.items():
+            fn = self.orig[stage] = getattr(mod, attr)
+
+            def timed(*a, _fn=fn, _stage=stage, **k):
+                t = clock()
+                try:
+                    return _fn(*a, **k)
+                finally:
+                    self.spent[_stage] += clock() - t
+
+            setattr(mod, attr, timed)
+        return self
+
+    def __exit__(self, *exc):
+        for stage, (mod, attr) in self.spots.items():
+            setattr(mod, attr, self.orig[stage])
+
+
+def stages(designs: int = 200, rounds: int = 7) -> None:
+    """Where one single Miura design's CPU time goes (``scenario.evaluate``, BLAS 1 thread):
+    per stage, us per design, the best of ``rounds`` rounds of ``designs`` designs each (the
+    stages timed by wrapping the calls; the rest is the evaluate path's own Python)."""
+    from holofold.design.scenarios import sheet
+    from holofold.geometry import miura
+
+    sc, row = _rows()["single Miura"]
+    spots = {
+        "sheet nodes (geometry.miura_nodes_batch)": (miura, "miura_nodes_batch"),
+        "3 models (build_concentrated_batch)": (sheet, "build_concentrated_batch"),
+        "BatchAssembler of the 3": (sheet, "BatchAssembler"),
+        "Newton: one kernel call for the 3 (batch_newton_increments)": (
+            newton_solvers, "batch_newton_increments"),
+    }  # fmt: skip
+    with threadpool_limits(1):
+        sc.evaluate(row)
+        iters, floor, _, _ = floor_of(lambda: sc.evaluate(row))
+        best: dict = {}
+        for _ in range(rounds):
+            with _Stages(spots) as st:
+                t = clock()
+                for _ in range(designs):
+                    sc.evaluate(row)
+                total = clock() - t
+            parts = {k: v / designs for k, v in st.spent.items()}
+            parts["rest: the evaluate path's own Python"] = total / designs - sum(parts.values())
+            parts["one design (scenario.evaluate)"] = total / designs
+            for k, v in parts.items():
+                best[k] = min(v, best.get(k, np.inf))
+    print(f"single Miura, one design: CPU us per design, best of {rounds} rounds of {designs}; "
+          f"floor {1e6 * floor:.1f} us ({iters} iterations)")  # fmt: skip
+    for k, v in best.items():
+        print(f"  {k:<62} {1e6 * v:>8.1f} us {v / floor:>6.2f} x floor")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="time per sample against its floor (issue 14)")
     ap.add_argument("--repeat", type=int, default=7, help="timed runs per workload")
@@ -484,7 +553,15 @@ def main(argv=None) -> int:
         help="also time each design with its dense-path steps forced onto LU (before issue "
         "37), interleaved with the other runs: a second row '<name> [LU]' against the same floor",
     )
+    ap.add_argument(
+        "--stages",
+        action="store_true",
+        help="only print where one single Miura design's CPU time goes, stage by stage",
+    )
     args = ap.parse_args(argv)
+    if args.stages:
+        stages()
+        return 0
     print(f"per sample, BLAS 1 thread, CPU time min / median of {args.repeat} runs (and wall")
     print("median); floor = iterations x (cheapest factorisation + solve of the actual tangents),")
     print("CPU time, measured in this run (the sum of each factorisation's best timing; run ms:")

@@ -209,6 +209,21 @@ def secant_stiffness_batch(
     runs = solve_newton_batch(
         structures, loads, increments=increments, tol=tol, max_iter=max_iter, batch=batch
     )
+    if (
+        len(runs) > 1
+        and all(g is groups[0] for g in groups)
+        and len({len(r.load_factor) for r in runs}) == 1
+    ):
+        # one load group (and as many increments) for all: their displacements in one go
+        g, total = groups[0], force_per_increment * len(runs[0].load_factor)
+        d = np.abs(g.displacements(np.stack([r.U for r in runs])))  # (S, k)
+        u = np.add.reduce(d, axis=-1) / d.shape[-1] if d.shape[-1] else np.full(len(runs), np.nan)
+        return [
+            StiffnessResult(
+                stiffness=total / ui if ui > 0 else float("inf"), displacement=ui, result=r
+            )
+            for ui, r in zip(u.tolist(), runs, strict=True)
+        ]
     return [_stiffness(g, r, force_per_increment) for g, r in zip(groups, runs, strict=True)]
 
 

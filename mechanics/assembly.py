@@ -127,16 +127,24 @@ class KernelInputs(NamedTuple):
     def stack_of(cls, structures) -> KernelInputs:
         """The inputs of S structures of one size, stacked (S, ...), built as arrays."""
         X = np.stack([np.asarray(s.nodes, float) for s in structures])
-        bars = np.stack([s.bars for s in structures]).astype(np.intp)
-        b0 = np.ascontiguousarray(bars[:, :, 0])
-        b1 = np.ascontiguousarray(bars[:, :, 1])
-        D0 = np.take_along_axis(X, b1[..., None], 1) - np.take_along_axis(X, b0[..., None], 1)
+        first = structures[0].bars
+        if all(s.bars is first for s in structures):  # one bar array (a builder's layout)
+            bars = np.asarray(first, np.intp)
+            ends = np.repeat(bars.T[:, None], len(structures), axis=1)  # (2, S, nb)
+            b0, b1 = ends[0], ends[1]  # C-contiguous rows
+            D0 = np.ascontiguousarray((X[:, bars[:, 1]] - X[:, bars[:, 0]]).transpose(0, 2, 1))
+        else:
+            bars = np.stack([s.bars for s in structures]).astype(np.intp)
+            b0 = np.ascontiguousarray(bars[:, :, 0])
+            b1 = np.ascontiguousarray(bars[:, :, 1])
+            D0 = np.take_along_axis(X, b1[..., None], 1) - np.take_along_axis(X, b0[..., None], 1)
+            D0 = np.ascontiguousarray(D0.transpose(0, 2, 1))
         springs = np.stack([s.springs for s in structures]).astype(np.intp)
         return cls(
             X,
             b0,
             b1,
-            np.ascontiguousarray(D0.transpose(0, 2, 1)),
+            D0,
             np.stack([np.asarray(s.bar_length, float) for s in structures]),
             np.stack([s.bar_E * s.bar_area for s in structures]).astype(float),
             np.ascontiguousarray(springs.transpose(0, 2, 1)),

@@ -216,14 +216,19 @@ def batch_newton_increments(batch: BatchAssembler, U, F0, P, increments, tol, ma
         perm = band.perm if banded else np.zeros(0, np.intp)
         bw = int(band.bandwidth) if banded else -1
         idx = np.ascontiguousarray(members, dtype=np.intp)
-        out = IncrementRecords.empty(idx.size, increments, nd)
+        whole = idx.size == S and (idx == np.arange(S)).all()  # rows of rec in place
+        if whole:
+            out = IncrementRecords(*rec[:6])
+        else:
+            out = IncrementRecords.empty(idx.size, increments, nd)
         lists = (
             red.tangent_sums("banded" if banded else "dense_upper"),
             red.tangent_sums("banded" if banded else "dense_cm"),
         )
         fac = Factor(red.free, perm, bw, ck.lapack_addresses(*_SOLVE[kind]))
         ck.newton_increments(model, idx, batch.scatter(pat), lists, load, fac, U, out)
-        for field, values in zip(rec[:6], out, strict=True):
-            field[idx] = values
+        if not whole:
+            for field, values in zip(rec[:6], out, strict=True):
+                field[idx] = values
         rec.banded[idx] = banded
     return rec

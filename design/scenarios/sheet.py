@@ -374,15 +374,12 @@ def sheet_models_batch(setting: SheetSetting, rows, *, profile=PAPER, extensions
         X = SHEET_FAMILIES[pat].nodes_batch(  # every sheet's nodes at once (bit for bit)
             setting, m, n, gammas, [exts[e] for _, e in items]
         )
-        masks: dict = {}  # one support mask (and load group) per set of nodes
-        groups_of: dict = {}
-        sups = []
-        for x in X:  # vertex v is node v; fixed: the nodes at x = min
-            fixed = np.flatnonzero(x[:, 0] == x[:, 0].min())
-            key = fixed.tobytes()
-            if key not in masks:
-                masks[key] = support_mask(len(x) + topo.n_faces, fixed, setting.support_dofs)
-            sups.append(masks[key])
+        # the nodes at x = min (fixed) and x = max (loaded) of every sheet, in two calls
+        x0 = X[:, :, 0]
+        lows = x0 == x0.min(axis=1, keepdims=True)
+        highs = x0 == x0.max(axis=1, keepdims=True)
+        nn = X.shape[1] + topo.n_faces
+        sups = [_support(nn, low.tobytes(), setting.support_dofs) for low in lows]
         col = lambda f, items=items: [f(rows[i]) for i, _ in items]  # noqa: E731
         structures = build_concentrated_batch(
             topo,
@@ -397,13 +394,32 @@ def sheet_models_batch(setting: SheetSetting, rows, *, profile=PAPER, extensions
             profile=profile,
             supports=sups,
         )
-        for (i, e), x, st in zip(items, X, structures, strict=True):
-            tip = np.flatnonzero(x[:, 0] == x[:, 0].max())
-            key = tip.tobytes()
-            if key not in groups_of:
-                groups_of[key] = tuple(load_along(tip, ld.direction) for ld in setting.loads)
-            out[i][e] = (st, groups_of[key])
+        dirs = tuple(tuple(float(v) for v in ld.direction) for ld in setting.loads)
+        for (i, e), high, st in zip(items, highs, structures, strict=True):
+            out[i][e] = (st, _load_groups(high.tobytes(), dirs))
     return out
+
+
+# the supports and load groups of a sheet depend on which of its nodes lie at x = min and
+# x = max, the same for every design of one pattern and size in practice: built once per set
+# (read-only arrays, shared by the structures and groups built from them)
+@lru_cache(maxsize=256)
+def _support(n_nodes: int, low: bytes, dofs: str) -> np.ndarray:
+    """(n_nodes, 3) read-only support mask fixing ``dofs`` of the vertices where the bool
+    bytes ``low`` (one per vertex) are set."""
+    fixed = np.flatnonzero(np.frombuffer(low, bool))
+    mask = support_mask(n_nodes, fixed, dofs)
+    mask.setflags(write=False)
+    return mask
+
+
+@lru_cache(maxsize=256)
+def _load_groups(high: bytes, directions: tuple[tuple[float, ...], ...]) -> tuple:
+    """One :class:`~holofold.mechanics.analyses.LoadGroup` per load direction on the vertices
+    where the bool bytes ``high`` are set (read-only node ids)."""
+    tip = np.flatnonzero(np.frombuffer(high, bool))
+    tip.setflags(write=False)
+    return tuple(load_along(tip, d) for d in directions)
 
 
 def sheet_mass(setting: SheetSetting, row) -> float:

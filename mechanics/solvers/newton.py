@@ -41,6 +41,7 @@ from holofold.mechanics.solvers._common import (
     nodal_array,
 )
 from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.status import CONVERGED
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.threads import single_threaded
 
@@ -173,20 +174,34 @@ def solve_newton_batch(
     U = _stacked("U0", U0, S, nn)
     free = B.free_dofs
     X = B.inputs.X  # model_size of every structure at once
-    size = np.maximum(np.ptp(X, axis=1).max(axis=1), np.abs(X).max(axis=(1, 2)))
+    lo, hi = X.min(axis=1), X.max(axis=1)  # per sample: max(ptp, max |x|) over the axes
+    size = np.maximum(hi - lo, np.maximum(-lo, hi)).max(axis=1)
     floors = np.where(np.any(P[:, free] != 0.0, axis=1), RESOLUTION * np.maximum(size, 1e-300), 0.0)
     rec = batch_newton_increments(B, U, F0v, P, increments, tol, max_iter)
     if rec is not None:  # every increment of every sample in one kernel call per connectivity
+        # samples with every increment converged and resolved and no failure: status
+        # CONVERGED without describing each increment (what describe() returns for them)
+        clean = (
+            (rec.failed[:, 0] == 0)
+            & rec.converged.all(axis=1)
+            & ((floors == 0.0) | (rec.moved >= floors[:, None]).all(axis=1))
+        ).tolist()
+        # their shared arrays, made once: the applied force after every increment and the
+        # convergence flags (a copy; each sample's row of it)
+        applied = (F0v + increments * P).reshape(S, nn, 3)
+        conv = rec.converged.copy()
         out = []
         for s in range(S):
-            if rec.failed[s, 0] == 1 and rec.banded[s]:  # not positive definite: LU alone
+            if clean[s]:
+                out.append(_converged_record(rec, s, structures[s], applied[s], conv[s]))
+            elif rec.failed[s, 0] == 1 and rec.banded[s]:  # not positive definite: LU alone
                 out.append(solve_newton(
                     structures[s], loads[s], increments=increments, tol=tol,
                     max_iter=max_iter, U0=None if U0 is None else U0[s],
                     F0=None if F0 is None else F0[s],
                 ))  # fmt: skip
-                continue
-            out.append(_from_records(rec, s, structures[s], tol, floors[s], F0v[s], P[s]))
+            else:
+                out.append(_from_records(rec, s, structures[s], tol, floors[s], F0v[s], P[s]))
         return out
     hists = [History(increments, nn) for _ in range(S)]
     alive = np.ones(S, bool)
@@ -228,6 +243,23 @@ def _stacked(name, values, S, nn) -> np.ndarray:
     if values is None:
         return np.zeros((S, 3 * nn))
     return np.stack([nodal_array(name, values[s], nn).ravel() for s in range(S)])
+
+
+def _converged_record(rec, s, structure, applied, converged) -> SolveResult:
+    """:func:`_from_records` of a sample whose every increment converged above the round-off
+    resolution and none failed (its status is :data:`CONVERGED`): ``applied`` (nn, 3) its
+    force after the last increment, N, ``converged`` its flags (a copy of the records')."""
+    count = rec.U.shape[1]
+    return SolveResult(
+        U_history=rec.U[s].reshape(count, -1, 3),
+        load_factor=np.arange(1.0, count + 1.0),
+        converged=converged,
+        iterations=rec.iterations[s],
+        residual=rec.residual[s],
+        status=CONVERGED,
+        applied_force=applied,
+        spring_rest=np.array(structure.spring_rest, float),
+    )
 
 
 def _from_records(rec, s, structure, tol, floor, F0, P) -> SolveResult:
