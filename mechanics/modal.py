@@ -35,7 +35,7 @@ def lumped_mass(
     structure : Structure
         Uses ``triangles``, ``tri_thickness``, ``tri_panel`` and reference ``nodes``; panel
         centre nodes are ``structure.panel_centres`` (else the first vertex of each panel
-        triangle).
+        triangle); a panel without one (-1, a bare triangle) gives a third to each corner.
     density : float or (nt,) float
         Mass density rho, kg/m^3 (per triangle if an array).
     centre_share : float

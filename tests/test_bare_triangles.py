@@ -141,3 +141,20 @@ def test_hypar_folds_past_the_sliver_collapse():
     assert (r.structure.panel_centres < 0).sum() == 158
     assert r.reached > 0.5, r.summary()
     assert r.wrong_way.size == 0
+
+
+@pytest.mark.parametrize("share", [1.0 / 3.0, 4.0 / 6.0])
+def test_lumped_mass_of_a_bare_triangle(share):
+    """The bare sliver's mass goes a third to each corner; the total is the sheet's."""
+    from holofold.mechanics.modal import lumped_mass
+
+    p = _sheet()
+    s = build_concentrated(p, profile=PHYSICAL, **_SECTION)
+    m = lumped_mass(s, 1000.0, centre_share=share)
+    X = s.nodes
+    t = s.triangles
+    area = 0.5 * np.linalg.norm(np.cross(X[t[:, 1]] - X[t[:, 0]], X[t[:, 2]] - X[t[:, 0]]), axis=1)
+    total = float((area * 1000.0 * s.tri_thickness).sum())
+    assert m.sum() == pytest.approx(total, rel=1e-12)
+    sliver = float(area[s.tri_panel == 1][0] * 1000.0 * 1e-3)
+    assert m[4] == pytest.approx(sliver / 3.0, rel=1e-12)  # vertex 4 is in the sliver only
