@@ -290,12 +290,12 @@ def build_concentrated(
         Nodes: the ``nv`` vertices, then one centre per panel in panel order
         (``panel_centres``; a triangle panel more slender than
         ``profile.centre_triangle_aspect`` has none, -1, and is one triangle held by its 3
-        edge bars). Bars: edge ``i`` is bar ``i`` (type
-        1), then the spokes panel by panel, corner by corner (type 5). Springs: one per
-        interior edge in edge order (role HINGE, ``spring_crease`` = edge id; its wing nodes
-        the panels' centres, or a bare triangle's opposite corner), then one per spoke (role
-        PANEL). ``creases`` lists the interior edges with their hinge springs and end
-        vertices; ``node_vertex`` is the vertex id (-2 for centres).
+        edge bars). Bars: edge ``i`` is bar ``i`` (type 1), then the spokes panel by panel,
+        corner by corner (type 5). Springs: one per interior edge in edge order (role HINGE,
+        ``spring_crease`` = edge id; its wing nodes the panels' centres, or a bare triangle's
+        opposite corner), then one per spoke (role PANEL). ``creases`` lists the interior
+        edges with their hinge springs and end vertices; ``node_vertex`` is the vertex id (-2
+        for centres).
     """
     E_panel = _scalar(E_panel, "E_panel", 0.0, None, low_open=True)
     E_crease = _scalar(E_crease, "E_crease", 0.0, None, low_open=True)
