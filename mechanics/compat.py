@@ -82,6 +82,17 @@ class Profile:
         from a vector of pi, so panel and diagonal springs are driven to flat (pi) rather than
         kept at their stress-free measured values. Harmless for flat panels; for warped panels
         it adds a spurious load. Physically right: False (keep their current rest angles).
+    centre_triangle_aspect : float
+        Concentrated hinges: a triangle panel whose aspect (longest side over height) is above
+        this has no centre node: its three bars hold it flat and rigid (Origami Simulator,
+        MERLIN, N5B8 keep triangles whole); the others get a centre node and a fan with panel
+        bending springs. The reference gives every panel one (inf), needed for the published
+        data (sheet pattern 2 has triangle panels). In a sliver the fan's sub-triangle next to
+        the long side folds flat and its spring angle turns singular (Origami Simulator's
+        hypar, 1:48, stalled at 13.2 %). Physically right: 10, measured on Origami
+        Simulator's files (docs/bar-and-hinge.md §3.3): 0 (no triangle gets a centre) makes
+        patterns whose triangles must bend stop earlier (flat_crane), 20 leaves the hypars
+        stalling at 19-30 %.
     thermal_reinterpolate_from_stage_start : bool
         Electro-thermal stage: within each thermal step the self-fold interpolation restarts
         from the rest angles at the *stage* start rather than from the previous step's
@@ -98,12 +109,17 @@ class Profile:
     mass_centre_share: float = 1.0 / 3.0
     reset_non_crease_rest_angles: bool = True
     thermal_reinterpolate_from_stage_start: bool = True
+    centre_triangle_aspect: float = math.inf
     arccos_dihedral: bool = False
     raw_crease_polarity: bool = True
     dissipation_pi_314: bool = True
     published_gripper_stiffness: bool = True
 
     def __post_init__(self):
+        if not float(self.centre_triangle_aspect) >= 0.0:
+            raise ValueError(
+                f"centre_triangle_aspect = {self.centre_triangle_aspect!r} must be >= 0 (inf: all)"
+            )
         share = float(self.mass_centre_share)
         if not 0.0 <= share <= 1.0:
             raise ValueError(f"mass_centre_share = {share!r} is outside the allowed range [0, 1]")
@@ -123,6 +139,7 @@ PHYSICAL = Profile(
     mass_centre_share=1.0 / 3.0,
     reset_non_crease_rest_angles=False,
     thermal_reinterpolate_from_stage_start=False,
+    centre_triangle_aspect=10.0,
     arccos_dihedral=False,
     raw_crease_polarity=False,
     dissipation_pi_314=False,

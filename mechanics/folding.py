@@ -226,7 +226,7 @@ def default_supports(pattern: CreasePattern, structure: Structure) -> np.ndarray
         mid = cent[faces].mean(axis=0)
         p = int(faces[np.argmin(np.linalg.norm(cent[faces] - mid, axis=1))])
         nodes.append(structure.vertex_nodes(pattern.faces[p], panel=p))
-        if structure.panel_centres is not None:
+        if structure.panel_centres is not None and structure.panel_centres[p] >= 0:
             nodes.append([structure.panel_centres[p]])
     return np.unique(np.concatenate(nodes)).astype(np.intp)
 

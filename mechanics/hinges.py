@@ -280,17 +280,22 @@ def build_concentrated(
     coords : (nv, 3) float, optional
         Other as-built vertex coordinates for the same faces (default ``pattern.coords``).
         Lets a sweep over fold states (extensions) reuse one validated pattern.
-    supports : (nv + nf, 3) bool, optional
-        Fixed degrees of freedom of the model's nodes (default: none).
+    supports : (nn, 3) or (nv + nf, 3) bool, optional
+        Fixed degrees of freedom of the model's nodes, or of the vertices and then the panel
+        centres (the rows of panels without a centre must be False; default: none).
 
     Returns
     -------
     Structure
-        Nodes: the ``nv`` vertices, then one centre per panel (node ``nv + p``). Bars: edge ``i``
-        is bar ``i`` (type 1), then the spokes panel by panel, corner by corner (type 5).
-        Springs: one per interior edge in edge order (role HINGE, ``spring_crease`` = edge
-        id), then one per spoke (role PANEL). ``creases`` lists the interior edges with their
-        hinge springs and end vertices; ``node_vertex`` is the vertex id (-2 for centres).
+        Nodes: the ``nv`` vertices, then one centre per panel in panel order
+        (``panel_centres``; a triangle panel more slender than
+        ``profile.centre_triangle_aspect`` has none, -1, and is one triangle held by its 3
+        edge bars). Bars: edge ``i`` is bar ``i`` (type 1), then the spokes panel by panel,
+        corner by corner (type 5). Springs: one per interior edge in edge order (role HINGE,
+        ``spring_crease`` = edge id; its wing nodes the panels' centres, or a bare triangle's
+        opposite corner), then one per spoke (role PANEL). ``creases`` lists the interior
+        edges with their hinge springs and end vertices; ``node_vertex`` is the vertex id (-2
+        for centres).
     """
     E_panel = _scalar(E_panel, "E_panel", 0.0, None, low_open=True)
     E_crease = _scalar(E_crease, "E_crease", 0.0, None, low_open=True)
@@ -403,36 +408,85 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def concentrated_layout(pattern: CreasePattern) -> ConcentratedLayout:
-    """The :class:`ConcentratedLayout` of a pattern (cached per pattern object)."""
-    lay = _LAYOUT.get(pattern)
+def _bare_triangles(pattern: CreasePattern, t: PatternTopology, limit: float) -> np.ndarray:
+    """(nf,) bool: triangle panels of aspect (longest side over height, L^2 / (2 A)) above
+    ``limit``, measured on the flat layout (else the coordinates); none for ``limit`` inf."""
+    bare = np.zeros(len(t.sizes), bool)
+    tri = np.flatnonzero(t.sizes == 3)
+    if not np.isfinite(limit) or tri.size == 0:
+        return bare
+    X = pattern.flat if pattern.flat is not None else pattern.coords
+    X = np.column_stack([X, np.zeros((len(X), 3 - X.shape[1]))]) if X.shape[1] < 3 else X
+    start = np.concatenate([[0], np.cumsum(t.sizes)[:-1]]).astype(np.intp)
+    v = t.verts[start[tri][:, None] + np.arange(3)]
+    a, b, c = X[v[:, 0]], X[v[:, 1]], X[v[:, 2]]
+    area2 = np.linalg.norm(_cross(b - a, c - a), axis=-1)  # twice the area
+    L2 = np.max([((b - a) ** 2).sum(-1), ((c - b) ** 2).sum(-1), ((a - c) ** 2).sum(-1)], axis=0)
+    with np.errstate(divide="ignore"):
+        aspect = np.where(area2 > 0, L2 / np.where(area2 > 0, area2, 1.0), np.inf)
+    bare[tri[aspect > limit]] = True
+    return bare
+
+
+def concentrated_layout(
+    pattern: CreasePattern, centre_triangle_aspect: float = np.inf
+) -> ConcentratedLayout:
+    """The :class:`ConcentratedLayout` of a pattern (cached per pattern object and aspect).
+
+    ``centre_triangle_aspect`` (``Profile.centre_triangle_aspect``): a triangle panel whose
+    aspect (longest side over height, on the pattern's flat layout, else its coordinates) is
+    above it is its own triangle (3 edge bars, no centre node, no spokes, no panel springs; a
+    hinge next to it uses the corner opposite the edge as wing node); every other panel gets a
+    centre node and a fan (inf: every panel, the reference)."""
+    cache = _LAYOUT.get(pattern)
+    if cache is None:
+        cache = _LAYOUT[pattern] = {}
+    key = float(centre_triangle_aspect)
+    lay = cache.get(key)
     if lay is not None:
         return lay
     nv, nf = pattern.n_vertices, pattern.n_faces
     t = pattern_topology(pattern)
     verts, face, nxt, prv = t.verts, t.face, t.nxt, t.prv
-    cnode = nv + face  # centre node of each corner's panel
+    centred = ~_bare_triangles(pattern, t, centre_triangle_aspect)
+    centre = np.full(nf, -1, np.intp)  # centre node of each panel, -1 for none
+    centre[centred] = nv + np.arange(int(centred.sum()))
+    qc = centred[face]  # corners of centred panels (the spokes)
+    cnode = centre[face]  # centre node of each corner's panel
     # bars: edges, then spokes
-    bars = np.vstack([pattern.edges.astype(np.intp), np.column_stack([verts, cnode])])
+    bars = np.vstack([pattern.edges.astype(np.intp), np.column_stack([verts, cnode])[qc]])
     bar_type = np.concatenate(
         [
             np.full(pattern.n_edges, BarType.PANEL_EDGE, np.int8),
-            np.full(len(verts), BarType.PANEL_SPOKE, np.int8),
+            np.full(int(qc.sum()), BarType.PANEL_SPOKE, np.int8),
         ]
     )
-    # springs: hinges on interior edges, then panel springs on spokes
+    # springs: hinges on interior edges, then panel springs on spokes; the wing node of a
+    # hinge is the panel's centre, or in a triangle without one the corner opposite the edge
     cid = np.flatnonzero(t.interior)
     e = pattern.edges[cid].astype(np.intp)
-    hinge = np.column_stack([nv + t.first[cid], e[:, 0], e[:, 1], nv + t.last[cid]])
-    panel = np.column_stack([verts[nxt], verts, cnode, verts[prv]])
+    ec = t.edge_corners[cid]  # the corner ending the edge in the first and in the last panel
+    f1, f2 = t.first[cid], t.last[cid]
+    w1 = np.where(centred[f1], centre[f1], verts[nxt[ec[:, 0]]])
+    w2 = np.where(centred[f2], centre[f2], verts[nxt[ec[:, 1]]])
+    hinge = np.column_stack([w1, e[:, 0], e[:, 1], w2])
+    panel = np.column_stack([verts[nxt], verts, cnode, verts[prv]])[qc]
     role = np.concatenate(
         [
             np.full(len(cid), SpringRole.HINGE, np.int8),
             np.full(len(panel), SpringRole.PANEL, np.int8),
         ]
     )
-    # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1)
-    triangles = np.column_stack([cnode, verts, verts[prv]]).astype(np.intp)
+    # fan triangles, reference order: (centre, C1, CN), then (centre, Cj, Cj-1); a triangle
+    # panel without a centre: (C1, C3, C2) (the fan's orientation), at its first corner
+    first = np.zeros(len(verts), bool)
+    first[np.concatenate([[0], np.cumsum(t.sizes)[:-1]]).astype(np.intp)] = True
+    keep = qc | first
+    triangles = np.where(
+        qc[:, None],
+        np.column_stack([cnode, verts, verts[prv]]),
+        np.column_stack([verts, verts[prv], verts[nxt]]),
+    )[keep].astype(np.intp)
     fields = dict(
         bars=bars.astype(np.intp),
         bar_type=bar_type,
@@ -441,14 +495,16 @@ def concentrated_layout(pattern: CreasePattern) -> ConcentratedLayout:
         spring_crease=np.concatenate([cid, np.full(len(panel), -1)]).astype(np.intp),
         triangles=triangles,
         tri_crease=np.full(len(triangles), -1, np.intp),
-        tri_panel=face.astype(np.intp),
+        tri_panel=face[keep].astype(np.intp),
         crease_ids=cid,
         crease_nodes=e,
-        panel_centres=(nv + np.arange(nf)).astype(np.intp),
-        node_vertex=np.concatenate([np.arange(nv), np.full(nf, -2)]).astype(np.intp),
+        panel_centres=centre,
+        node_vertex=np.concatenate([np.arange(nv), np.full(int(centred.sum()), -2)]).astype(
+            np.intp
+        ),
     )
     lay = ConcentratedLayout(**{k: _frozen(v) for k, v in fields.items()})
-    _LAYOUT[pattern] = lay
+    cache[key] = lay
     return lay
 
 
@@ -459,8 +515,11 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
     S = X.shape[0]
     ne, nf = pattern.n_edges, pattern.n_faces
     t = pattern_topology(pattern)
-    lay = concentrated_layout(pattern)
+    lay = concentrated_layout(pattern, profile.centre_triangle_aspect)
     sizes, verts, face, nxt = t.sizes, t.verts, t.face, t.nxt
+    centred = lay.panel_centres >= 0
+    qc = centred[face]  # corners with a spoke
+    spoke_face = face[qc]
     side_edge, last, interior = t.side, t.last, t.interior
     bars, cid = lay.bars, lay.crease_ids
 
@@ -469,19 +528,23 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
     for c in range(3):  # the mean of each panel's corners, per design
         centres[:, :, c] = _bincount(face, Xv[:, :, c], nf)
     centres = centres / sizes[:, None]
-    nodes = np.concatenate([X, centres], axis=1)
+    nodes = np.concatenate([X, centres[:, centred]], axis=1)
 
     L = np.linalg.norm(nodes[:, bars[:, 1]] - nodes[:, bars[:, 0]], axis=-1)
     edge_len, spoke_len = L[:, :ne], L[:, ne:]
 
-    # panel areas: fan triangles (centre, C_q, C_q+1)
+    # panel areas: fan triangles (centre, C_q, C_q+1) (the triangle's own area for one)
     cf = centres[:, face]
     tri_area = 0.5 * np.linalg.norm(_cross(Xv - cf, X[:, verts[nxt]] - cf), axis=-1)
     area = _bincount(face, tri_area, nf)
-    perim = _bincount(face, edge_len[:, side_edge] + spoke_len, nf)
+    # total length of the panel's bars: its sides and its spokes (none in a bare triangle)
+    if qc.all():
+        perim = _bincount(face, edge_len[:, side_edge] + spoke_len, nf)
+    else:
+        perim = _bincount(face, edge_len[:, side_edge], nf) + _bincount(spoke_face, spoke_len, nf)
     A_p = 2.0 * tp * area / ((1.0 - nu_panel) * perim)
     bar_area = np.empty((S, len(bars)))
-    bar_area[:, ne:] = A_p[:, face]
+    bar_area[:, ne:] = A_p[:, spoke_face]
     if profile.edge_bar_area_last_panel:
         bar_area[:, :ne] = 2.0 * A_p[:, last]
     else:
@@ -502,7 +565,7 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
         D = E_panel[:, None] * tj**3 / (12.0 * (1 - nu_panel**2))
         half = np.maximum((area[:, f1] + area[:, f2]) / Lj, tj)
         k_hinge[:, jay] = D * Lj / half
-    k_panel = E_panel[:, None] * tp[:, face] ** 3 * spoke_len
+    k_panel = E_panel[:, None] * tp[:, spoke_face] ** 3 * spoke_len
 
     # the checks Structure makes that a valid input can still fail (coordinates that overflow,
     # coincident nodes), once for the batch: the first design refused raises Structure's error
@@ -529,10 +592,9 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
     out = []
     for i in range(S):
         pw = None if panel_width is None else panel_width[i]
-        w = _panel_width(profile, pw, W[i], interior, nf, spoke_len[i], face)
+        w = _panel_width(profile, pw, W[i], interior, nf, spoke_len[i], spoke_face)
         sup = np.zeros((nn, 3), bool) if sups[i] is None else np.asarray(sups[i], bool)
-        if sup.shape != (nn, 3):
-            raise ValueError(f"supports must have shape ({nn}, 3), got {sup.shape}")
+        sup = _node_supports(sup, nn, pattern.n_vertices, centred)
         out.append(
             trusted_structure(  # the arrays are valid by construction (checked above)
                 nodes=nodes[i],
@@ -542,12 +604,25 @@ def _concentrated(pattern, X, W, tc, tp, E_panel, E_crease, nu_panel, panel_widt
                 springs=springs_all[i],
                 spring_k=np.concatenate([k_hinge[i], k_panel[i] / (12.0 * w)]),
                 spring_rest=rest_all[i],
-                tri_thickness=tp[i, face],
+                tri_thickness=tp[i, lay.tri_panel],
                 supports=sup,
                 **shared,
             )
         )
     return out
+
+
+def _node_supports(sup: np.ndarray, nn: int, nv: int, centred: np.ndarray) -> np.ndarray:
+    """(nn, 3) supports from ``sup`` given per node (nn, 3) or per vertex and panel
+    (nv + nf, 3): the rows of panels without a centre node dropped (they must be False)."""
+    nf = len(centred)
+    if sup.shape == (nv + nf, 3) and sup.shape != (nn, 3):
+        if sup[nv:][~centred].any():
+            raise ValueError("supports fix the centre of a triangle panel, which has none")
+        return np.concatenate([sup[:nv], sup[nv:][centred]])
+    if sup.shape != (nn, 3):
+        raise ValueError(f"supports must have shape ({nn}, 3), got {sup.shape}")
+    return sup
 
 
 # --------------------------------------------------------------------------- compliant

@@ -35,7 +35,7 @@ def lumped_mass(
     structure : Structure
         Uses ``triangles``, ``tri_thickness``, ``tri_panel`` and reference ``nodes``; panel
         centre nodes are ``structure.panel_centres`` (else the first vertex of each panel
-        triangle).
+        triangle); a panel without one (-1, a bare triangle) gives a third to each corner.
     density : float or (nt,) float
         Mass density rho, kg/m^3 (per triangle if an array).
     centre_share : float
@@ -66,11 +66,13 @@ def lumped_mass(
         centres = structure.panel_centres
         if centres is not None:
             cnode = np.asarray(centres)[structure.tri_panel[panel]]
-            is_c = tri[panel] == cnode[:, None]
+            is_c = tri[panel] == cnode[:, None]  # none for a triangle panel without a centre
         else:
             is_c = np.zeros((panel.sum(), 3), bool)
             is_c[:, 0] = True
         share[panel] = np.where(is_c, centre_share, 0.5 * (1.0 - centre_share))
+        if centres is not None:  # a panel that is one triangle: a third to each corner
+            share[np.flatnonzero(panel)[cnode < 0]] = 1.0 / 3.0
     out = np.zeros(structure.n_nodes)
     np.add.at(out, tri.ravel(), (m[:, None] * share).ravel())
     return out

@@ -22,7 +22,7 @@ creases), but any code may build one directly::
     tri_crease     (nt,) int       crease id of a crease-region triangle, -1 for panel triangles
     tri_panel      (nt,) int       panel id of a panel triangle, -1 for crease triangles
     creases        CreaseModel     how the pattern's interior creases are modelled (or None)
-    panel_centres  (nf,) int       centre node of each panel (or None)
+    panel_centres  (nf,) int       centre node of each panel, -1 for none (or None)
     node_vertex    (nn,) int       pattern vertex of each node: -1 crease node, -2 panel centre
                                    (or None)
     profile        Profile         the paper-compatibility switches the model was built with
