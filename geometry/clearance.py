@@ -282,20 +282,22 @@ def _plane_gap(A, B):
     return np.where(lo > 0, lo, np.where(hi < 0, -hi, 0.0))
 
 
-def _first_apart(centre: np.ndarray, share, r: float) -> float:
+def _first_apart(centre: np.ndarray, share, r: float, pairs: np.ndarray) -> float:
     """Distance between the nearest two panel centres of panels sharing no vertex (an upper
     bound of the nearest such pair's mid-surface distance); inf if there is none. The search
-    radius starts at ``r`` (> 0) and doubles until such a pair is within it."""
+    radius starts at ``r`` (> 0; ``pairs`` the centre pairs within it) and doubles until such
+    a pair is within it."""
     reach = float(np.linalg.norm(np.ptp(centre, axis=0))) if len(centre) else 0.0
-    r = r if r > 0 else max(reach, 1.0)
+    if not r > 0:
+        r, pairs = max(reach, 1.0), close_pairs(centre, max(reach, 1.0))
     while True:
-        pairs = close_pairs(centre, r)
         apart = pairs[np.asarray(share[pairs[:, 0], pairs[:, 1]]).ravel() == 0]
         if len(apart):
             return float(np.linalg.norm(centre[apart[:, 0]] - centre[apart[:, 1]], axis=1).min())
         if r > reach:  # every pair was within reach
             return math.inf
         r *= 2.0
+        pairs = close_pairs(centre, r)
 
 
 def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> Printability:
@@ -315,7 +317,8 @@ def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> P
     centre = pts.mean(axis=1)
     radius = np.linalg.norm(pts - centre[:, None, :], axis=2).max(axis=1)
     # --- overlap: pairs whose bounding spheres meet
-    pairs = close_pairs(centre, 2 * float(radius.max()))
+    near = close_pairs(centre, 2 * float(radius.max()))  # also _first_apart's first search
+    pairs = near
     if len(pairs):
         d = np.linalg.norm(centre[pairs[:, 0]] - centre[pairs[:, 1]], axis=1)
         pairs = pairs[d <= radius[pairs[:, 0]] + radius[pairs[:, 1]]]
@@ -327,7 +330,7 @@ def printability(pattern: CreasePattern, panel_thickness, crease_width=0.0) -> P
         shape=(nf, pattern.n_vertices),
     )  # fmt: skip
     share = (inc @ inc.T).tocsr()
-    far = _first_apart(centre, share, 2 * float(radius.max()))
+    far = _first_apart(centre, share, 2 * float(radius.max()), near)
     if not math.isfinite(far):
         return Printability(volume, math.inf, maybe, None)
     mid_r = np.linalg.norm(P - P.mean(axis=1, keepdims=True), axis=2).max(axis=1)
