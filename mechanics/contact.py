@@ -121,8 +121,9 @@ class PanelContact:
         self._chol = (None, None)  # (pattern key, sparse Cholesky analysis) of the last solve
         self._last_collisions = (None, None)  # (X, collisions) of the last broad phase
         self.last_active = 0
-        self.touched = (0, (-1, -1))  # the most pairs within reach in the last solve, where
+        self.touched = (0, (-1, -1))  # the most pairs within reach in the last solve, and where
         self.newton_steps = 0
+        self.exact_updates = 0  # of those, updates by the exact Hessian (the rest: projected)
         X = self.X0
         if ipc.has_intersections(self.mesh, X) and _crossing(X, tri):
             raise ParameterError("panel contact: the panels intersect in the starting state")
@@ -280,24 +281,35 @@ class PanelContact:
     def step(self, asm, U_prev, U_trial, rest, tol, max_iter: int = 30, deadline=None):
         """The accepted state of one fold step: ``U_trial`` (the contact-free equilibrium, or
         None) itself if the path ``U_prev -> U_trial`` is collision free and no pair is active
-        at ``U_trial``; else the equilibrium with the barrier from ``U_prev`` (Newton with
-        CCD-limited, energy-decreasing updates), or None if that does not reach ``tol``. Where
+        at ``U_trial``; else the equilibrium with the barrier (Newton with CCD-limited,
+        energy-decreasing updates, by the exact Hessian where the tangent is positive definite,
+        else the barrier's projected per pair), or None if that does not reach ``tol``. It
+        starts from the clean part of the straight path to ``U_trial`` (``CCD_SAFETY`` of it;
+        ``U_trial`` itself where the path is clean and pairs are only within reach; ``U_prev``
+        without ``U_trial``): on Origami Simulator's miura-ori, 51 -> 10.5 CPU s. Where
         the contact-free solve found no equilibrium (``U_trial`` None) and no pair is within
         reach at ``U_prev``, contact is not why: None, and the fold shortens its step as it
         does without contact (the barrier solve there cost 50 of 86 s on a 2304-panel Miura
         sheet that never touches). The barrier solve takes at most ``4 max_iter`` updates (60 at
         least) and gives up (None) past ``deadline`` (a ``time.perf_counter()`` value)."""
+        U_prev = np.asarray(U_prev, float).reshape(-1, 3)
+        start = U_prev
         if U_trial is not None and np.isfinite(U_trial).all():
-            if self.free_step(U_prev, U_trial) >= 1.0 and self.active(U_trial) == 0:
-                self.last_active = 0
-                self.touched = (0, (-1, -1))
-                return U_trial
+            U_trial = np.asarray(U_trial, float).reshape(-1, 3)
+            free = self.free_step(U_prev, U_trial)
+            if free >= 1.0:
+                if self.active(U_trial) == 0:
+                    self.last_active = 0
+                    self.touched = (0, (-1, -1))
+                    return U_trial
+                start = U_trial  # clean, only within the barrier's reach: start there
+            elif free > 0.0:  # the clean part of the way to the contact-free equilibrium
+                start = U_prev + CCD_SAFETY * free * (U_trial - U_prev)
         elif self.active(U_prev) == 0:
             self.last_active = 0
             self.touched = (0, (-1, -1))
             return None
-        U_prev = np.asarray(U_prev, float).reshape(-1, 3)
-        return self._solve(asm, U_prev, rest, tol, max_iter, deadline)
+        return self._solve(asm, start, rest, tol, max_iter, deadline)
 
     def _solve(self, asm, U, rest, tol, max_iter, deadline=None):
         import time
@@ -319,7 +331,7 @@ class PanelContact:
             if deadline is not None and time.perf_counter() > deadline:
                 return None
             e, f, K = asm.evaluate_reduced(U, rest, dense=False)
-            eb, gb, Hb, n = self.evaluate(U)
+            eb, gb, Hb, n = self.evaluate(U, psd=False)
             self.last_active = n
             if n > self.touched[0]:
                 self.touched = self.touching(U)
@@ -328,10 +340,22 @@ class PanelContact:
                 return U.reshape(-1, 3)
             A = (K + Hb[free][:, free]).tocsc()
             scale = scale or float(np.abs(A.diagonal()).mean())
-            d = self._descent(A, r, mu, scale, sp, splu)
-            if d is None:
-                return None
-            d, mu = d
+            # Newton on the exact Hessian where the whole tangent is positive definite
+            # (quadratic convergence); else the barrier's Hessian projected per pair
+            d = self._cholesky_solve(A, r) if not mu and n else None
+            if d is not None and np.isfinite(d).all() and float(r @ d) > 0:
+                self.exact_updates += 1
+            else:
+                if n:
+                    Hp = self.barrier.hessian(
+                        self._collisions(self._pos(U)), self.mesh, self._pos(U),
+                        self.ipc.PSDProjectionMethod.CLAMP,
+                    )  # fmt: skip
+                    A = (K + Hp[free][:, free]).tocsc()
+                d = self._descent(A, r, mu, scale, sp, splu)
+                if d is None:
+                    return None
+                d, mu = d
             far = float(np.abs(d).max())
             if far > MAX_MOVE * self.size > 0:  # a trust region for near-singular tangents
                 d = d * (MAX_MOVE * self.size / far)

@@ -616,6 +616,10 @@ def fold_pattern(
                 (flows if flowed else snaps).append(done)
                 h = h0
                 continue
+            if time_limit is not None and time.perf_counter() - started > time_limit:
+                # the barrier solve gave up at the deadline: the time ran out, whatever touches
+                stalled = f"the time limit of {time_limit:g} s ran out at {100 * done:.1f} %"
+                break
             if panels is not None and panels.touched[0]:
                 # the barrier holds the panels apart and the actuation cannot fold them on:
                 # the sheet stops where its layers touch (not a stall of the solver)
