@@ -63,15 +63,16 @@ STRIP_ONLY = {
 }
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "fit",
-        help="fit a Miura-like strip to a planar curve and export it",
-        description=__doc__.split("\n\n")[0]
-        + " Curves: a built-in spec (half-circle:radius=2, arc:radius=..,angle=.., "
-        "parabola:span=..,height=.., sine:span=..,amplitude=..,periods=.., "
-        "catenary:span=..,height=..), a CSV of x,z points, or an SVG file[#path-id].",
-    )
+HELP = "fit a Miura-like strip to a planar curve and export it"
+DESCRIPTION = (
+    __doc__.split("\n\n")[0]
+    + " Curves: a built-in spec (half-circle:radius=2, arc:radius=..,angle=.., "
+    "parabola:span=..,height=.., sine:span=..,amplitude=..,periods=.., "
+    "catenary:span=..,height=..), a CSV of x,z points, or an SVG file[#path-id]."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--curve", help="built-in spec, points.csv or drawing.svg[#id]")
     p.add_argument(
         "--surface",
@@ -150,7 +151,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     add_thick_argument(p)
     add_bed_argument(p)
     add_cutter_arguments(p)
-    return p
 
 
 # ---------------------------------------------------------------------- validation

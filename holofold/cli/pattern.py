@@ -67,20 +67,19 @@ def _fabrication_arguments(p) -> None:
     add_cutter_arguments(p)
 
 
-def register(subparsers) -> argparse.ArgumentParser:
+HELP = "generate a crease pattern (miura, tmp, gripper, strip, file, ...) and export it"
+DESCRIPTION = __doc__.split("\n\n")[0]
+EPILOG = "Lengths in metres, angles in degrees."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     from holofold.geometry import pattern_families
 
-    p = subparsers.add_parser(
-        "pattern",
-        help="generate a crease pattern (miura, tmp, gripper, strip, file, ...) and export it",
-        description=__doc__.split("\n\n")[0],
-        epilog="Lengths in metres, angles in degrees.",
-    )
     kinds = p.add_subparsers(dest="kind", metavar="KIND")
     kinds.required = True
     for name, fam in pattern_families().items():
         k = kinds.add_parser(name, help=fam.description, description=fam.description,
-                             epilog="Lengths in metres, angles in degrees.")  # fmt: skip
+                             epilog=EPILOG)  # fmt: skip
         for par in fam.parameters:
             unit = par.given_in or par.unit
             unit = "" if unit in ("-", "text") else f", {unit}"
@@ -89,7 +88,6 @@ def register(subparsers) -> argparse.ArgumentParser:
                            required=par.required, help=f"{par.description}{unit}")  # fmt: skip
         _fabrication_arguments(k)
         k.set_defaults(_family=name)
-    return p
 
 
 def _build(args):
