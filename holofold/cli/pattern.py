@@ -29,14 +29,7 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.cli._fabrication import (
-    add_bed_argument,
-    add_cutter_arguments,
-    add_thick_argument,
-    bed_of,
-    cutter_options,
-    say_part,
-)
+from holofold.cli._fabrication import add_part_arguments, part_options, say_part
 
 
 def _option(name: str) -> str:
@@ -62,9 +55,7 @@ def _fabrication_arguments(p) -> None:
         help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
-    add_thick_argument(p)
-    add_bed_argument(p)
-    add_cutter_arguments(p)
+    add_part_arguments(p)
 
 
 HELP = "generate a crease pattern (miura, tmp, gripper, strip, file, ...) and export it"
@@ -105,8 +96,7 @@ def run(args) -> int:
 
     from holofold.geometry import ParameterError, check_range, write_fabrication_set
 
-    cutter = cutter_options(args)
-    bed = bed_of(args)
+    cutter, bed = part_options(args)
     fam, values, pattern = _build(args)
     check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:
