@@ -43,7 +43,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, integer, positive
+from holofold.design.scenarios.base import Column, Scenario, integer, positive, setting_hooks
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -588,10 +588,7 @@ def strip_scenario(
         kind="strip",
         setting=words,
         source=source,
-        shape=partial(strip_shape, setting),
-        write_files=partial(write_strip_files, setting),
-        view=partial(strip_view, setting),
-        part=partial(strip_part, setting),
+        **setting_hooks(setting, strip_shape, write_strip_files, strip_view, strip_part),
     )
 
 
