@@ -11,7 +11,6 @@ same run with every Newton solve converged tightly (``GripperOptions(converged=T
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import sys
@@ -19,6 +18,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _timing import one_core_repeats
 from threadpoolctl import threadpool_limits
 
 from holofold.design.scenarios.gripper import GripperOptions, simulate
@@ -52,11 +52,9 @@ def _median_time(row: dict, options: GripperOptions, repeat: int) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="holofold gripper benchmark (issue 5, section 5)")
-    ap.add_argument("--repeat", type=int, default=3, help="timed runs per sample (>= 3)")
-    args = ap.parse_args(argv)
-    repeat = max(3, args.repeat)
-    print(f"medians of {repeat} runs, one core (BLAS 1 thread)")
+    repeat = one_core_repeats(
+        "holofold gripper benchmark (issue 5, section 5)", 3, 3, "sample", argv
+    )
     head = (
         f"{'pattern':<16} {'steps':>6} {'total s':>8} {'ms/step':>8} {'target s':>9} "
         f"{'Octave s':>9} {'speed-up':>9} {'converged s':>12}"

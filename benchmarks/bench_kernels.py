@@ -18,10 +18,9 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
-import time
 
 import numpy as np
+from _timing import median_times
 
 from holofold.mechanics import kernels
 from holofold.mechanics.assembly import Assembler
@@ -77,17 +76,6 @@ def miura_model(m: int, n: int) -> Structure | None:
     return s.with_supports(sup)
 
 
-def _median_time(fn, repeat: int) -> tuple[float, float]:
-    fn()  # warm-up (pattern, ordering caches)
-    wall, cpu = [], []
-    for _ in range(repeat):
-        t0, c0 = time.perf_counter(), time.process_time()
-        fn()
-        wall.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-    return statistics.median(wall), statistics.median(cpu)
-
-
 def _path(asm: Assembler) -> str:
     return solver_path(asm.reduction, asm.dense_max)
 
@@ -98,16 +86,16 @@ def bench(name: str, s: Structure, repeat: int) -> str:
     rng = np.random.default_rng(1)
     U = 1e-4 * rng.normal(size=(s.n_nodes, 3)) * ~s.supports
     nf = asm.free_dofs.size
-    t_eval = _median_time(lambda: asm.evaluate_factorized(U), repeat)
-    t_asm = _median_time(lambda: asm.evaluate(U), repeat)
+    t_eval = median_times(lambda: asm.evaluate_factorized(U), repeat)
+    t_asm = median_times(lambda: asm.evaluate(U), repeat)
     rhs = np.ones(nf)
     solve = asm.evaluate_factorized(U)[2]
-    t_sol = _median_time(lambda: solve(rhs), repeat)
+    t_sol = median_times(lambda: solve(rhs), repeat)
     load = np.zeros((s.n_nodes, 3))
     free_nodes = np.flatnonzero(~s.supports.any(axis=1))
     load[free_nodes[-3:], 2] = -1e-3
     res = solve_newton(s, load, increments=3, tol=1e-10, assembler=asm)
-    t_nr = _median_time(
+    t_nr = median_times(
         lambda: solve_newton(s, load, increments=3, tol=1e-10, assembler=asm), repeat
     )
     bw = asm.reduction.band.bandwidth if nf > asm.dense_max else 0

@@ -198,13 +198,14 @@ def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
 
         makers[AMD] = make_amd
 
-    def make_own(ordering=None):
+    def make_own(ordering=None, ldl=False):
         chol = SupernodalCholesky(K.indptr, K.indices, ordering=ordering)
+        factor = chol.factor_ldl if ldl else chol.factor
 
         def own():
-            f = chol.factor(K.data)
+            f = factor(K.data)
             if f is None:
-                raise np.linalg.LinAlgError("not positive definite")
+                raise np.linalg.LinAlgError("LDL^T refused" if ldl else "not positive definite")
             return f.solve(b)
 
         return own
@@ -217,15 +218,7 @@ def path_makers(K: sp.csr_matrix, perm, bw: int, args) -> dict:
     makers[MMD] = make_mmd
 
     def make_ldl():  # holofold's sparse LDL^T: the indefinite tangent's path without LU
-        chol = SupernodalCholesky(K.indptr, K.indices)
-
-        def ldl():
-            f = chol.factor_ldl(K.data)
-            if f is None:
-                raise np.linalg.LinAlgError("LDL^T refused")
-            return f.solve(b)
-
-        return ldl
+        return make_own(ldl=True)
 
     makers[LDL] = make_ldl
     if args.indefinite:  # the Cholesky paths cannot factorise it

@@ -11,11 +11,11 @@ building the models (geometry + bar-and-hinge model), the rest is the nonlinear 
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import sys
 import time
 
+from _timing import one_core_repeats
 from threadpoolctl import threadpool_limits
 
 from holofold.design.scenarios import arch, canopy, single_miura
@@ -68,11 +68,9 @@ def cases():
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="holofold mechanics benchmark (issue 4, section 6)")
-    ap.add_argument("--repeat", type=int, default=7, help="timed runs per case (>= 5)")
-    args = ap.parse_args(argv)
-    repeat = max(5, args.repeat)
-    print(f"medians of {repeat} runs, one core (BLAS 1 thread)")
+    repeat = one_core_repeats(
+        "holofold mechanics benchmark (issue 4, section 6)", 7, 5, "case", argv
+    )
     cols = ("total ms", 10), ("build ms", 9), ("target ms", 10), ("Octave s", 9), ("speed-up", 9)
     head = f"{'case':<20} " + " ".join(f"{c:>{w}}" for c, w in cols)
     print(head)

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import sys
 import time
 import warnings
@@ -26,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from _timing import median_times
 
 from holofold.design.database.tables import read_table
 from holofold.design.rules import FewRulesWarning, ForestRuleMiner
@@ -34,18 +34,6 @@ from holofold.design.rules.targets import parse_target
 
 FEATURES = ["m", "tcrease", "tpanel", "W", "offset", "stripeWidth", "extrude"]
 TARGET = "Zstiff > 800 & Xstiff > 600 & error < 0.1"
-
-
-def _median(fn, repeat: int) -> tuple[float, float]:
-    """Median wall-clock and CPU (all threads of this process) seconds of ``fn()``."""
-    fn()  # warm-up
-    ts, cs = [], []
-    for _ in range(repeat):
-        t, c = time.perf_counter(), time.process_time()
-        fn()
-        ts.append(time.perf_counter() - t)
-        cs.append(time.process_time() - c)
-    return statistics.median(ts), statistics.median(cs)
 
 
 def _prepare(df, seed=0):
@@ -63,7 +51,7 @@ def _mining_time(miner, X, y, train, repeat):
     def mine():
         miner._mine(Z, y_pos, len(miner.estimators_))
 
-    return _median(mine, repeat)
+    return median_times(mine, repeat)
 
 
 def main(argv=None) -> int:
@@ -91,7 +79,7 @@ def main(argv=None) -> int:
         Xtr, ytr = X.iloc[train], y[train]
         for jobs in (1, 2):
             miner = ForestRuleMiner(categorical_features=["m"], random_state=0, n_jobs=jobs)
-            t = _median(lambda m=miner, a=Xtr, b=ytr: m.fit(a, b), args.repeat)
+            t = median_times(lambda m=miner, a=Xtr, b=ytr: m.fit(a, b), args.repeat)
             ref = 0.9 if name == "data3" else 1.7
             rows.append((f"train 100 trees, {name}, {jobs} thread(s)", ref, None, t))
         fitted = ForestRuleMiner(categorical_features=["m"], random_state=0).fit(Xtr, ytr)
@@ -106,7 +94,9 @@ def main(argv=None) -> int:
         m.fit(X.iloc[train], y[train])
         rule_scores(m, X.iloc[test], y[test])
 
-    rows.append(("whole run on data3 (fit + test), 2 threads", 2.7, 0.5, _median(whole_run, 3)))
+    rows.append(
+        ("whole run on data3 (fit + test), 2 threads", 2.7, 0.5, median_times(whole_run, 3))
+    )
 
     if not args.no_grid:
         t = time.perf_counter()

@@ -15,12 +15,13 @@ five parts:
 and the demo (:mod:`~holofold.design.demo`). See docs/rule-miner.md and docs/scenarios.md.
 """
 
-import lazy_loader
+from holofold.geometry.lazy_face import ALL, attach
 
-__getattr__, __dir__, __all__ = lazy_loader.attach(
+__getattr__, __dir__, __all__ = attach(
     __name__,
+    __file__,
     submod_attrs={
-        "demo": ["run_demo", "DEMO_TARGET"],
+        "demo": ALL,
         "loop.acquisition": ["likely_designs"],
         "database.folder_lock": ["folder_lock", "FolderBusyError"],
         "loop.design_loop": [
@@ -67,7 +68,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "HoldoutResult",
         ],
         "rules.mining": ["mine_rules", "MinedRules"],
-        "report.page": ["write_report_page", "report_page_html"],
+        "report.page": ALL,
         "rules.report": [
             "rules_to_text",
             "mining_summary",
@@ -105,13 +106,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         ],
         "database.row_status": ["failed_rows", "converged_rows", "row_statuses", "with_state"],
         "database.faults": ["as_environment_fault"],
-        "database.pattern_batch": [
-            "pattern_files",
-            "file_sha256",
-            "recorded_files",
-            "check_pattern_file",
-            "run_pattern_batch",
-        ],
+        "database.pattern_batch": ALL,
         "database.row_limits": [
             "RowTimeout",
             "ON_INVALID",
@@ -147,15 +142,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "ColumnRoles",
         ],
         "rules.targets": ["parse_target", "Target", "TargetError"],
-        "rules.verify": [
-            "verify_rule",
-            "verify_rules",
-            "write_verification",
-            "Verification",
-            "rule_mask",
-            "rule_ranges",
-            "as_rule",
-            "rule_key",
-        ],
+        "rules.verify": ALL,
     },
 )

@@ -14,19 +14,13 @@ fit) and :mod:`~holofold.fitting.surface_files` (its files). Imports only from
 holofold.geometry.
 """
 
-import lazy_loader
+from holofold.geometry.lazy_face import ALL, attach
 
-__getattr__, __dir__, __all__ = lazy_loader.attach(
+__getattr__, __dir__, __all__ = attach(
     __name__,
+    __file__,
     submod_attrs={
-        "auto": [
-            "AutoFit",
-            "FitNotFoundError",
-            "fit_auto",
-            "ThickCheck",
-            "DEFAULT_M_RANGE",
-            "PUBLISHED_MAX_WARP",
-        ],
+        "auto": ALL,
         "curves": [
             "BUILTIN_CURVES",
             "CurveError",
@@ -34,26 +28,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "builtin_curve",
             "parse_curve_spec",
         ],
-        "curve_files": [
-            "CurveUnitWarning",
-            "CurveSelectionWarning",
-            "CurveColumnsWarning",
-            "CurveClosedWarning",
-            "MAX_SVG_BYTES",
-            "MAX_SVG_NESTING",
-            "MAX_SVG_ELEMENTS",
-            "MAX_SVG_POINTS",
-            "MAX_CSV_POINTS",
-            "PLAUSIBLE_SIZE",
-            "check_curve_size",
-            "read_points_csv",
-            "read_svg_curve",
-            "load_curve",
-        ],
+        "curve_files": ALL,
         "error": ["ClosestPointError", "closest_point_error", "index_matched_error", "paper_error"],
         "strip": ["SAMPLINGS", "MAX_M", "StripGeometry", "strip_geometry"],
-        "strip_files": ["export_strip_files", "write_strip_set"],
-        "strip_fit": ["StripFit", "fit_strip"],
+        "strip_files": ALL,
+        "strip_fit": ALL,
         "surfaces": [
             "BUILTIN_SURFACES",
             "MESH_SURFACE_TYPES",
@@ -67,14 +46,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "read_surface",
         ],
         "quadmesh": ["QuadGrid", "develop", "sector_angles", "quad_warp"],
-        "surface_files": ["export_surface_files"],
-        "surface_fit": [
-            "CONSTRAINT_TOL",
-            "Placement",
-            "SurfaceFit",
-            "SurfaceFitError",
-            "fit_surface",
-            "starting_tiling",
-        ],
+        "surface_files": ALL,
+        "surface_fit": ALL,
     },
 )

@@ -187,30 +187,27 @@ def _height_builtin(name, f, grad, hess, params, width, depth) -> TargetSurface:
                          closest, chart)  # fmt: skip
 
 
-def _saddle(radius: float, width: float | None = None, depth: float | None = None):
+def _quadric(name: str, sx: int, sy: int, radius, width, depth) -> TargetSurface:
+    """The height field z = (sx x^2 + sy y^2) / (2 R), sx and sy +1 or -1 (curvatures +-1/R),
+    over a ``width`` x ``depth`` rectangle centred on its apex (default R by R), m."""
     R = check_range("radius", radius, 0.0, None, low_open=True)
     w = R if width is None else width
     d = w if depth is None else depth
     return _height_builtin(
-        "saddle",
-        lambda x, y: (x * x - y * y) / (2 * R),
-        lambda x, y: (x / R, -y / R),
-        lambda x, y: (np.full_like(x, 1 / R), np.zeros_like(x), np.full_like(x, -1 / R)),
+        name,
+        lambda x, y: (sx * x * x + sy * y * y) / (2 * R),
+        lambda x, y: (sx * x / R, sy * y / R),
+        lambda x, y: (np.full_like(x, sx / R), np.zeros_like(x), np.full_like(x, sy / R)),
         {"radius": R}, w, d,
     )  # fmt: skip
+
+
+def _saddle(radius: float, width: float | None = None, depth: float | None = None):
+    return _quadric("saddle", 1, -1, radius, width, depth)
 
 
 def _paraboloid(radius: float, width: float | None = None, depth: float | None = None):
-    R = check_range("radius", radius, 0.0, None, low_open=True)
-    w = R if width is None else width
-    d = w if depth is None else depth
-    return _height_builtin(
-        "paraboloid",
-        lambda x, y: -(x * x + y * y) / (2 * R),
-        lambda x, y: (-x / R, -y / R),
-        lambda x, y: (np.full_like(x, -1 / R), np.zeros_like(x), np.full_like(x, -1 / R)),
-        {"radius": R}, w, d,
-    )  # fmt: skip
+    return _quadric("paraboloid", -1, -1, radius, width, depth)
 
 
 def _wave(amplitude: float, wavelength: float, width: float | None = None,

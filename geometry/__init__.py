@@ -5,10 +5,11 @@ The first layer: it imports nothing from the others. Lengths in metres, angles i
 (meshes in millimetres unless asked otherwise, SVG in millimetres, FOLD in metres).
 """
 
-import lazy_loader
+from holofold.geometry.lazy_face import ALL, attach
 
-__getattr__, __dir__, __all__ = lazy_loader.attach(
+__getattr__, __dir__, __all__ = attach(
     __name__,
+    __file__,
     submod_attrs={
         "errors": [
             "ParameterError",
@@ -28,7 +29,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "MESH_TYPES",
             "MAX_MESH_FACES",
         ],
-        "export": ["export", "EXPORT_TYPES", "Format", "FORMATS", "register_format"],
+        "export": ALL,
         "fabrication": [
             "FabricationFile",
             "FabricationSet",
@@ -46,12 +47,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "get_profile",
             "register_profile",
         ],
-        "cutter_preview": [
-            "write_cutter_preview",
-            "needs_preview",
-            "PREVIEW_LINE_PT",
-            "HAIRLINE_MM",
-        ],
+        "cutter_preview": ALL,
         "dxf": ["DXF_LAYERS", "export_dxf"],
         "thick": [
             "TECHNIQUES",
@@ -63,13 +59,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "thick_panel_mesh",
         ],
         "thick_part": ["thick_printable"],
-        "thick_choice": [
-            "THICK_CHOICES",
-            "THICK_CODES",
-            "ThicknessChoice",
-            "choose_thickness",
-            "thick_name",
-        ],
+        "thick_choice": ALL,
         "facets": ["split_faces", "nonconvex_faces", "SPLIT_MODES"],
         "families": [
             "Parameter",
@@ -80,46 +70,17 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "register_family",
             "FAMILIES",
         ],
-        "registry": ["Registry"],
+        "registry": ALL,
         "fold_io": ["export_fold", "fold_dict", "load_fold", "read_fold", "FoldWarning"],
-        "fold_frames": ["fold_path_dict", "export_fold_path"],
-        "gripper": [
-            "GripperPattern",
-            "gripper_pattern",
-            "miura_based_gripper",
-            "splitted_miura_gripper",
-            "two_panel_gripper",
-            "DEFAULT_RANGE",
-            "GRIPPER_NAMES",
-        ],
+        "fold_frames": ALL,
+        "gripper": ALL,
         "bed": ["Bed", "DEFAULT_BED", "BedFit", "bed_fit", "place_on_bed", "print_time_text"],
-        "segments": [
-            "Segment",
-            "Segmentation",
-            "segment_part",
-            "assembly_sheet",
-            "write_segments",
-            "clear_segments",
-        ],
-        "clearance": ["Printability", "printability", "panel_overlap", "panel_clearance"],
+        "segments": ALL,
+        "clearance": ALL,
         "mesh": ["folded_mesh", "flat_mesh", "fan_triangulation", "MESH_UNITS"],
-        "miura": [
-            "miura_cell",
-            "miura_sheet",
-            "miura_sheet_paper",
-            "miura_nodes",
-            "miura_nodes_batch",
-            "miura_faces",
-        ],
-        "inputs": ["check_input_file", "path_kind"],
-        "outputs": [
-            "check_output_path",
-            "check_output_folder",
-            "check_writable_folder",
-            "atomic_write",
-            "write_text",
-            "write_json",
-        ],
+        "miura": ALL,
+        "inputs": ALL,
+        "outputs": ALL,
         "pattern": ["CreasePattern", "ASSIGNMENTS", "MAX_PANELS", "non_simple_faces"],
         "readers": [
             "read_pattern",
@@ -144,7 +105,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "solid": ["thick_solid", "panel_solids", "shrunk_panels", "SolidWarning"],
         "svg": ["export_svg", "load_svg", "polylines_svg"],
         "tmp": ["tmp_sheet", "tmp_nodes", "tmp_faces"],
-        "units": ["LENGTH_UNITS", "length_factor"],
-        "vertex_sets": ["VertexSet", "parse_vertex_set", "VERTEX_SET_KINDS"],
+        "units": ALL,
+        "vertex_sets": ALL,
     },
 )

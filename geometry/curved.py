@@ -18,11 +18,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from holofold.geometry.arrangement import REL_TOL
 from holofold.geometry.errors import ParameterError
 
 __all__ = [
     "Curve",
     "discretise",
+    "cut_curves",
     "curve_edges",
     "curve_from_svg_segment",
     "CHORD_DEFAULT",
@@ -168,6 +170,28 @@ def discretise(
     P = curve.point([0.0, 1.0])
     split(0.0, 1.0, P[0], P[1], 0)
     return curve.point(np.array(ts))
+
+
+def cut_curves(kept, segs, codes, angles, *, chord=None, length=None) -> tuple[int, float, float]:
+    """Cut the ``kept`` curves into straight pieces appended to ``segs`` (with their
+    assignment to ``codes`` and fold angle to ``angles``): chord deviation ``chord`` and piece
+    length ``length`` (default :data:`CHORD_DEFAULT` and :data:`LENGTH_DEFAULT` x the larger
+    side of the drawing: the curves and the segments already there), no piece finer than the
+    merge tolerance; (pieces, chord, length)."""
+    pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
+    pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
+    size = float(np.ptp(np.concatenate(pts), axis=0).max()) or 1.0
+    chord = CHORD_DEFAULT * size if chord is None else chord
+    length = LENGTH_DEFAULT * size if length is None else length
+    n = 0
+    for c in kept:
+        cp = discretise(c, chord=chord, length=length, shortest=REL_TOL * size)
+        n += len(cp) - 1
+        for a, b in zip(cp[:-1], cp[1:], strict=True):
+            segs.append([a, b])
+            codes.append(c.assignment)
+            angles.append(c.fold_angle)
+    return n, chord, length
 
 
 def curve_edges(xy, edges, assignment, curves, *, tol: float, samples: int = 65) -> np.ndarray:

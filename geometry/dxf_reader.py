@@ -36,9 +36,8 @@ from collections import Counter
 
 import numpy as np
 
-from holofold.geometry.arrangement import REL_TOL
 from holofold.geometry.bounded import check_dxf_pattern, read_source, source_name
-from holofold.geometry.curved import CHORD_DEFAULT, LENGTH_DEFAULT, Curve, discretise
+from holofold.geometry.curved import Curve, cut_curves
 from holofold.geometry.errors import EnvironmentFault, FormatError, ParameterError
 from holofold.geometry.line_drawing import LineDrawing, pattern_from_drawing
 
@@ -251,7 +250,7 @@ def dxf_drawing(source, *, curves: str = "keep") -> LineDrawing:
     if flattened:
         notes.append(f"{flattened} curved piece(s) flattened into segments")
     if kept:
-        n_pieces, chord, length = _cut_curves(kept, segs, codes, angles)
+        n_pieces, chord, length = cut_curves(kept, segs, codes, angles)
         notes.append(
             f"{len(kept)} curve(s) kept, cut into {n_pieces} piece(s) (chord deviation "
             f"{chord:.3g}, piece length {length:.3g} drawing units)"
@@ -330,25 +329,6 @@ def _kept_curves(e, p, code: str, ang: float):
     if len(cur) >= 2:
         lines.append(np.array(cur))
     return curves_out, lines
-
-
-def _cut_curves(kept, segs, codes, angles) -> tuple[int, float, float]:
-    """Cut the kept curves into pieces appended to ``segs`` (as the SVG reader does: chord
-    deviation and piece length relative to the drawing's larger side, no piece finer than the
-    merge tolerance); (pieces, chord, length)."""
-    pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
-    pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
-    size = float(np.ptp(np.concatenate(pts), axis=0).max()) or 1.0
-    chord, length = CHORD_DEFAULT * size, LENGTH_DEFAULT * size
-    n = 0
-    for c in kept:
-        cp = discretise(c, chord=chord, length=length, shortest=REL_TOL * size)
-        n += len(cp) - 1
-        for a, b in zip(cp[:-1], cp[1:], strict=True):
-            segs.append([a, b])
-            codes.append(c.assignment)
-            angles.append(c.fold_angle)
-    return n, chord, length
 
 
 def dxf_lines(path, *, curves: str = "keep"):

@@ -47,39 +47,38 @@ def _cross(a, b):
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
+def _faces_where(xy, faces, test) -> np.ndarray:
+    """Ids of the faces of more than three corners for whose corners ``xy[f]`` (k, 2)
+    ``test`` is true."""
+    xy = np.asarray(xy, float)
+    return np.array([k for k, f in enumerate(faces) if len(f) > 3 and test(xy[f])], np.intp)
+
+
 def nonconvex_faces(xy, faces, rel_tol: float = 1e-9) -> np.ndarray:
     """Ids of the counter-clockwise faces with a reflex corner (turning clockwise by more than
     ``rel_tol`` x the squared size of the face; straight corners count as convex)."""
-    xy = np.asarray(xy, float)
-    bad = []
-    for k, f in enumerate(faces):
-        if len(f) <= 3:
-            continue
-        p = xy[f]
+
+    def reflex(p) -> bool:
         d_in = p - np.roll(p, 1, axis=0)
         d_out = np.roll(p, -1, axis=0) - p
         size2 = float(np.ptp(p, axis=0).max()) ** 2
-        if (_cross(d_in, d_out) < -rel_tol * size2).any():
-            bad.append(k)
-    return np.array(bad, np.intp)
+        return bool((_cross(d_in, d_out) < -rel_tol * size2).any())
+
+    return _faces_where(xy, faces, reflex)
 
 
 def unfannable_faces(xy, faces, rel_area: float = 1e-3) -> np.ndarray:
     """Ids of the counter-clockwise faces that the fan from the mean of their corners does not
     cover: a fan triangle (mean, corner, next corner) with less than ``rel_area`` x the face's
     area divided by its corner count (turning the wrong way, or a sliver)."""
-    xy = np.asarray(xy, float)
-    bad = []
-    for k, f in enumerate(faces):
-        if len(f) <= 3:
-            continue
-        p = xy[f]
+
+    def thin_fan(p) -> bool:
         c = p.mean(axis=0)
         tri = 0.5 * _cross(p - c, np.roll(p, -1, axis=0) - c)
         total = float(tri.sum())
-        if total <= 0 or (tri < rel_area * total / len(f)).any():
-            bad.append(k)
-    return np.array(bad, np.intp)
+        return total <= 0 or bool((tri < rel_area * total / len(p)).any())
+
+    return _faces_where(xy, faces, thin_fan)
 
 
 def split_faces(

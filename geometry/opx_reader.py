@@ -73,22 +73,19 @@ def opx_drawing(source) -> LineDrawing:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
         raise FormatError(f"{name}: not well-formed XML ({exc})") from None
-    segs, codes = [], []
-    aux = 0
-    for obj in root.iter("object"):
-        if not str(obj.get("class", "")).endswith("OriLineProxy"):
-            continue
-        try:
-            t = _value(obj, "type", int, 0)
-            x0, y0, x1, y1 = (_value(obj, k, float, 0.0) for k in ("x0", "y0", "x1", "y1"))
-        except FormatError as exc:
-            raise FormatError(f"{name}: {exc}") from None
-        if t not in ORIPA_TYPES:
-            aux += 1
-            continue
-        segs.append([[x0, -y0], [x1, -y1]])
-        codes.append(ORIPA_TYPES[t])
-    return _finish(name, segs, codes, aux)
+
+    def lines():
+        for obj in root.iter("object"):
+            if not str(obj.get("class", "")).endswith("OriLineProxy"):
+                continue
+            try:
+                t = _value(obj, "type", int, 0)
+                x0, y0, x1, y1 = (_value(obj, k, float, 0.0) for k in ("x0", "y0", "x1", "y1"))
+            except FormatError as exc:
+                raise FormatError(f"{name}: {exc}") from None
+            yield t, x0, y0, x1, y1
+
+    return _drawing(name, lines())
 
 
 def cp_drawing(source) -> LineDrawing:
@@ -99,19 +96,30 @@ def cp_drawing(source) -> LineDrawing:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise FormatError(f"{name}: not a text file") from None
+
+    def lines():
+        for k, line in enumerate(text.splitlines(), start=1):
+            parts = line.split()
+            if not parts:
+                continue
+            try:
+                t = int(parts[0])
+                x0, y0, x1, y1 = (float(v) for v in parts[1:5])
+            except (ValueError, IndexError):
+                raise FormatError(
+                    f"{name}: line {k} is not 'type x0 y0 x1 y1' (five numbers)"
+                ) from None
+            yield t, x0, y0, x1, y1
+
+    return _drawing(name, lines())
+
+
+def _drawing(name: str, lines) -> LineDrawing:
+    """The drawing of ``lines``, (ORIPA type, x0, y0, x1, y1) with y down; lines of a type
+    that is not a crease or a cut (auxiliary lines) are counted, not drawn."""
     segs, codes = [], []
     aux = 0
-    for k, line in enumerate(text.splitlines(), start=1):
-        parts = line.split()
-        if not parts:
-            continue
-        try:
-            t = int(parts[0])
-            x0, y0, x1, y1 = (float(v) for v in parts[1:5])
-        except (ValueError, IndexError):
-            raise FormatError(
-                f"{name}: line {k} is not 'type x0 y0 x1 y1' (five numbers)"
-            ) from None
+    for t, x0, y0, x1, y1 in lines:
         if t not in ORIPA_TYPES:
             aux += 1
             continue

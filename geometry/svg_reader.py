@@ -32,14 +32,8 @@ from collections import Counter
 
 import numpy as np
 
-from holofold.geometry.arrangement import REL_TOL
 from holofold.geometry.bounded import check_svg_pattern, read_source, source_name
-from holofold.geometry.curved import (
-    CHORD_DEFAULT,
-    LENGTH_DEFAULT,
-    curve_from_svg_segment,
-    discretise,
-)
+from holofold.geometry.curved import curve_from_svg_segment, cut_curves
 from holofold.geometry.errors import FormatError, ParameterError
 from holofold.geometry.line_drawing import LineDrawing, check_unit, pattern_from_drawing
 
@@ -254,20 +248,9 @@ def svg_drawing(
                 codes.append(code)
                 angles.append(ang)
     if kept:
-        pts = [np.asarray(c.point(np.linspace(0, 1, 9))) for c in kept]
-        pts += [np.asarray(segs, float).reshape(-1, 2)] if segs else []
-        allp = np.concatenate(pts)
-        size = float(np.ptp(allp, axis=0).max()) or 1.0
-        chord = CHORD_DEFAULT * size if curve_chord is None else curve_chord
-        length = LENGTH_DEFAULT * size if curve_length is None else curve_length
-        n_pieces = 0
-        for c in kept:
-            cp = discretise(c, chord=chord, length=length, shortest=REL_TOL * size)
-            n_pieces += len(cp) - 1
-            for a, b in zip(cp[:-1], cp[1:], strict=True):
-                segs.append([a, b])
-                codes.append(c.assignment)
-                angles.append(c.fold_angle)
+        n_pieces, chord, length = cut_curves(
+            kept, segs, codes, angles, chord=curve_chord, length=curve_length
+        )
     if curved_creases:
         raise FormatError(
             f"{name}: {len(curved_creases)} curved crease(s) (first: {curved_creases[0]}); "

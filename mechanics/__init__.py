@@ -12,22 +12,14 @@ a computation, and every paper quirk in :mod:`~holofold.mechanics.compat`. See
 docs/bar-and-hinge.md and docs/electro-thermal.md. Imports only geometry and fitting.
 """
 
-import lazy_loader
+from holofold.geometry.lazy_face import ALL, attach
 
-__getattr__, __dir__, __all__ = lazy_loader.attach(
+__getattr__, __dir__, __all__ = attach(
     __name__,
+    __file__,
     submodules=["kernels"],
     submod_attrs={
-        "analyses": [
-            "LoadGroup",
-            "load_group",
-            "load_along",
-            "secant_stiffness",
-            "secant_stiffness_batch",
-            "StiffnessResult",
-            "snap_check_mgdcm",
-            "SnapCheck",
-        ],
+        "analyses": ALL,
         "assembly": ["Assembler", "BatchAssembler", "SingularSystemError"],
         "kernels": [
             "KERNEL_PATHS",
@@ -39,14 +31,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         "bars": ["bar_forces", "bar_strain"],
         "compat": ["Profile", "PAPER", "PHYSICAL"],
         "contact": ["PanelContact", "contact_model", "has_ipctk"],
-        "fold_check": [
-            "FoldCheck",
-            "check_fold",
-            "aligned_deviation",
-            "FOLD_TOLERANCE",
-            "FOLD_STEP_DEG",
-            "FOLD_TIME_LIMIT",
-        ],
+        "fold_check": ALL,
         "folding": [
             "fold_pattern",
             "FoldSettings",
@@ -68,21 +53,14 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "pattern_mass",
         ],
         "hinges": ["build_concentrated", "build_compliant", "crease_rest_targets"],
-        "materials": ["Material", "MATERIALS", "get_material"],
-        "measures": ["model_energy", "ModelEnergy"],
-        "modal": ["lumped_mass", "natural_frequencies", "eigenvalues"],
-        "solvers": [
-            "solve_newton",
-            "solve_newton_batch",
-            "solve_displacement",
-            "solve_mgdcm",
-            "solve_selffold",
-            "SolveResult",
-        ],
+        "materials": ALL,
+        "measures": ALL,
+        "modal": ALL,
+        "solvers": ALL,
         "springs": ["dihedral_angle", "dihedral_derivatives", "spring_forces"],
         "status": ["Status", "Outcome", "CONVERGED", "failed_mask", "converged_mask"],
         "structure": ["Structure", "CreaseModel", "BarType", "SpringRole", "support_mask"],
-        "threads": ["single_thread", "single_threaded"],
+        "threads": ALL,
         "thermal": [
             "ThermalModel",
             "thermal_model",

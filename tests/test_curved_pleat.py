@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _scenario_texts import pattern_scenario
 
 from holofold.geometry import ParameterError, get_family
 from holofold.geometry.curved_pleat import CurvedPleat, curved_pleat
@@ -173,41 +174,13 @@ def test_chequered_diagonals_soften_the_bending_more_as_they_refine():
     assert all(1.3 < c < 1.6 for c in column)
 
 
-SCENARIO = """
-kind = "pattern"
-name = "pleat"
-
-[pattern]
-family = "curved-pleat"
-inner_radius = 0.1
-creases = 2
-sector = 90
-pieces = 8
-{extra}
-
-[material]
-E = 2.0e9
-nu = 0.38
-density = 1270.0
-
-[supports]
-at = ["side:-y"]
-
-[[load]]
-name = "tip"
-at = "side:-x"
-direction = [0, 0, -1]
-force = 0.05
-
-[features]
-pleat_width = [0.015, 0.03]
-fold_angle = [0.5, 1.0]
-tpanel = 0.3e-3
-tcrease = 0.3e-3
-W = 1e-3
-fold = 1.0
-scale = 1.0
-"""
+SCENARIO = pattern_scenario(
+    "pleat",
+    'family = "curved-pleat"\ninner_radius = 0.1\ncreases = 2\nsector = 90\npieces = 8\n{extra}',
+    "side:-y", "side:-x", "0.05",
+    "pleat_width = [0.015, 0.03]\nfold_angle = [0.5, 1.0]\ntpanel = 0.3e-3\ntcrease = 0.3e-3\n"
+    "W = 1e-3\nfold = 1.0\nscale = 1.0",
+)  # fmt: skip
 
 
 def test_family_in_a_scenario_file(tmp_path):

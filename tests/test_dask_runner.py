@@ -12,6 +12,7 @@ from contextlib import contextmanager
 import numpy as np
 import pandas as pd
 import pytest
+from _toy import toy_scenario
 
 distributed = pytest.importorskip("distributed")
 pytestmark = pytest.mark.processes
@@ -23,7 +24,7 @@ import holofold.design.database.store as store  # noqa: E402
 from holofold.cli import main  # noqa: E402
 from holofold.design.database.runner import check_scheduler, evaluate_designs  # noqa: E402
 from holofold.design.database.sampling import sample_designs  # noqa: E402
-from holofold.design.scenarios import Column, Scenario, get_scenario  # noqa: E402
+from holofold.design.scenarios import Scenario, get_scenario  # noqa: E402
 
 
 def _toy_evaluate(row):
@@ -36,14 +37,7 @@ def _toy_evaluate(row):
     return {"double": 2 * row["a"], "status": "converged"}
 
 
-TOY = Scenario(
-    name="toy",
-    description="doubles a",
-    features=(Column("a", "m", "a length", 1.0, 10.0),),
-    performance=(Column("double", "m", "2 a"),),
-    check=lambda row: [],
-    evaluate=_toy_evaluate,
-)
+TOY = toy_scenario(_toy_evaluate)
 
 
 @pytest.fixture(scope="module")

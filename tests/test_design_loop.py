@@ -307,13 +307,8 @@ def _cheap(row):
 
 
 def test_a_rare_target_is_refined_around_its_hits_before_any_rule_exists(tmp_path):
-    from holofold.design import Column, Scenario
 
-    cheap = Scenario(
-        name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
-        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
-        performance=(Column("double", "m"),),
-    )  # fmt: skip
+    cheap = _cheap_scenario(_cheap, ("double",), name="cheap")
     said = []
     res = run_design(cheap, "double > 1.94", tmp_path / "o", samples=100, rounds=2, refine=60,
                      verify=10, top=1, workers=1, progress=False, files=False, strategy="around",
@@ -356,12 +351,13 @@ def _two(row):
             "overlap": max(0.0, row["b"] - 0.8) * 1e-6, "status": CONVERGED}  # fmt: skip
 
 
-def _cheap_scenario(evaluate=_two, performance=("double", "mass", "overlap")):
+def _cheap_scenario(evaluate=_two, performance=("double", "mass", "overlap"), name="cheap2"):
+    """A scenario of two lengths a, b in [0, 1] m, simulated by ``evaluate`` in no time."""
     from holofold.design import Column, Scenario
 
     units = {"double": "m", "mass": "kg", "overlap": "m^3"}
     return Scenario(
-        name="cheap2", description="cheap", check=lambda row: [], evaluate=evaluate,
+        name=name, description="cheap", check=lambda row: [], evaluate=evaluate,
         features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
         performance=tuple(Column(n, units[n]) for n in performance),
     )  # fmt: skip
@@ -582,14 +578,9 @@ def test_hits_too_few_to_mine_are_refined_around_instead_of_ending_the_loop(tmp_
     """A rare target's few hits can all fall into the held-out rows (OneClassSplit): the loop
     samples around them, as with hits but no rule, instead of stopping with an error."""
     import holofold.design.loop.design_loop as loop
-    from holofold.design import Column, Scenario
     from holofold.design.rules.mining import OneClassSplit
 
-    cheap = Scenario(
-        name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
-        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
-        performance=(Column("double", "m"),),
-    )  # fmt: skip
+    cheap = _cheap_scenario(_cheap, ("double",), name="cheap")
     real, calls = loop.mine_rules, []
 
     def first_fails(*a, **k):
@@ -699,13 +690,8 @@ def test_a_round_after_one_without_a_rule_says_it_samples_around_the_hits(tmp_pa
     # issue 34 (validation/last_mile): a round after one whose miner found no rule announced
     # "half inside the best rule" although the box was that of the designs meeting the target
     import holofold.design.loop.design_loop as loop
-    from holofold.design import Column, Scenario
 
-    cheap = Scenario(
-        name="cheap", description="cheap", check=lambda row: [], evaluate=_cheap,
-        features=(Column("a", "m", "", 0.0, 1.0), Column("b", "m", "", 0.0, 1.0)),
-        performance=(Column("double", "m"),),
-    )  # fmt: skip
+    cheap = _cheap_scenario(_cheap, ("double",), name="cheap")
     real, calls = loop.mined_rules, []
 
     def none_first(*a, **k):

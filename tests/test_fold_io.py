@@ -83,31 +83,38 @@ def test_structural_errors(miura, change, message):
         load_fold(_bad(miura, **change))
 
 
-def test_edge_level_errors(miura):
+def _edge_change(d: dict, what: str) -> None:
+    """Spoil one edge of FOLD dict ``d`` in place (``what`` names the mistake)."""
+    v = d["edges_assignment"].index("V")
+    if what == "circular":
+        d["edges_vertices"][0] = [d["edges_vertices"][0][0]] * 2
+    elif what == "duplicate":
+        d["edges_vertices"][1] = d["edges_vertices"][0]
+    elif what == "sign":
+        d["edges_foldAngle"][v] = -30.0
+    elif what == "range":
+        d["edges_foldAngle"][v] = 200.0
+    elif what == "assignment":
+        d["edges_assignment"][0] = "X"
+    elif what == "coincide":
+        d["vertices_coords"][1] = d["vertices_coords"][0]
+
+
+@pytest.mark.parametrize(
+    "what, message",
+    [
+        ("circular", "circular"),
+        ("duplicate", "duplicate edge"),
+        ("sign", "does not match fold angle"),
+        ("range", r"\[-180, 180\]"),
+        ("assignment", "allowed: M V B F C J U"),
+        ("coincide", "coincide"),
+    ],
+)
+def test_edge_level_errors(miura, what, message):
     d = fold_dict(miura)
-    d["edges_vertices"][0] = [d["edges_vertices"][0][0]] * 2
-    with pytest.raises(FormatError, match="circular"):
-        load_fold(d)
-    d = fold_dict(miura)
-    d["edges_vertices"][1] = d["edges_vertices"][0]
-    with pytest.raises(FormatError, match="duplicate edge"):
-        load_fold(d)
-    d = fold_dict(miura)
-    i = d["edges_assignment"].index("V")
-    d["edges_foldAngle"][i] = -30.0
-    with pytest.raises(FormatError, match="does not match fold angle"):
-        load_fold(d)
-    d = fold_dict(miura)
-    d["edges_foldAngle"][i] = 200.0
-    with pytest.raises(FormatError, match=r"\[-180, 180\]"):
-        load_fold(d)
-    d = fold_dict(miura)
-    d["edges_assignment"][0] = "X"
-    with pytest.raises(FormatError, match="allowed: M V B F C J U"):
-        load_fold(d)
-    d = fold_dict(miura)
-    d["vertices_coords"][1] = d["vertices_coords"][0]
-    with pytest.raises(FormatError, match="coincide"):
+    _edge_change(d, what)
+    with pytest.raises(FormatError, match=message):
         load_fold(d)
 
 

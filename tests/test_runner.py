@@ -7,9 +7,10 @@ import logging
 import numpy as np
 import pandas as pd
 import pytest
+from _toy import toy_scenario
 
 from holofold.design.database.runner import DesignTableError, evaluate_designs, validate_designs
-from holofold.design.scenarios import Column, Scenario, get_scenario
+from holofold.design.scenarios import Scenario, get_scenario
 from holofold.mechanics.status import Status
 
 
@@ -23,14 +24,7 @@ def _toy_evaluate(row):
     return {"double": 2 * row["a"], "status": "converged"}
 
 
-TOY = Scenario(
-    name="toy",
-    description="doubles a",
-    features=(Column("a", "m", "a length", 1.0, 10.0),),
-    performance=(Column("double", "m", "2 a"),),
-    check=_toy_check,
-    evaluate=_toy_evaluate,
-)
+TOY = toy_scenario(_toy_evaluate, _toy_check)
 
 
 def test_missing_column_is_reported():

@@ -5,6 +5,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from _scenario_texts import waterbomb_scenario
 
 import holofold.geometry as g
 from holofold.geometry.bed import Bed
@@ -13,39 +14,12 @@ from holofold.geometry.errors import ParameterError
 
 OS = Path(__file__).parent / "data" / "origami-simulator"
 
-SCENARIO = """
-kind = "pattern"
-name = "waterbomb"
-
-[pattern]
-file = "wb.svg"
-size = 0.1
-
-[material]
-E = 2.0e9
-nu = 0.38
-density = 1270.0
-
-[supports]
-at = ["{at}"]
-
-[[load]]
-name = "tip"
-at = "side:+x"
-direction = [0, 0, -1]
-force = 0.1
-
-[features]
-tpanel = [0.5e-3, 2e-3]
-fold = [0.3, 0.6]
-"""
-
 
 def _scenario(tmp_path, at):
     from holofold.design import read_scenario
 
     shutil.copy(OS / "waterbombBase.svg", tmp_path / "wb.svg")
-    (tmp_path / "wb.toml").write_text(SCENARIO.format(at=at), encoding="utf-8")
+    (tmp_path / "wb.toml").write_text(waterbomb_scenario(at), encoding="utf-8")
     return read_scenario(tmp_path / "wb.toml")
 
 

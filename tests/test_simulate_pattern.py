@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _scenario_texts import waterbomb_scenario
 
 import holofold.geometry as g
 from holofold.cli import main
@@ -252,32 +253,7 @@ def test_a_sheet_too_small_for_its_creases_is_refused_not_given_a_negative_mass(
 
 
 # ------------------------------------------------------------------ scenario kind
-SCENARIO = """
-kind = "pattern"
-name = "waterbomb"
-
-[pattern]
-file = "wb.svg"
-size = 0.1
-
-[material]
-E = 2.0e9
-nu = 0.38
-density = 1270.0
-
-[supports]
-at = ["side:-x"]
-
-[[load]]
-name = "tip"
-at = "side:+x"
-direction = [0, 0, -1]
-force = 0.1
-
-[features]
-tpanel = [0.5e-3, 2e-3]
-fold = [0.3, 0.6]
-"""
+SCENARIO = waterbomb_scenario()
 
 
 def test_pattern_scenario_file(tmp_path):

@@ -27,6 +27,14 @@ def _random_config(rng):
             return x
 
 
+def _nudged(x, a, h):
+    """``x`` (4, 3) with its flat coordinate ``a`` moved by +h and by -h (central differences)."""
+    xp, xm = x.ravel().copy(), x.ravel().copy()
+    xp[a] += h
+    xm[a] -= h
+    return xp.reshape(4, 3), xm.reshape(4, 3)
+
+
 def test_gradient_and_hessian_match_central_differences():
     rng = np.random.default_rng(10)
     h = 1e-6
@@ -37,10 +45,7 @@ def test_gradient_and_hessian_match_central_differences():
         g_fd = np.zeros(12)
         H_fd = np.zeros((12, 12))
         for a in range(12):
-            xp, xm = x.ravel().copy(), x.ravel().copy()
-            xp[a] += h
-            xm[a] -= h
-            xp, xm = xp.reshape(4, 3), xm.reshape(4, 3)
+            xp, xm = _nudged(x, a, h)
             g_fd[a] = _wrap(dihedral_angle(xp, SPR)[0] - dihedral_angle(xm, SPR)[0]) / (2 * h)
             H_fd[:, a] = (dihedral_gradient(xp, SPR)[1][0] - dihedral_gradient(xm, SPR)[1][0]) / (
                 2 * h
@@ -64,10 +69,7 @@ def test_spring_force_and_tangent_match_energy_differences():
         f_fd = np.zeros(12)
         k_fd = np.zeros((12, 12))
         for a in range(12):
-            xp, xm = x.ravel().copy(), x.ravel().copy()
-            xp[a] += h
-            xm[a] -= h
-            xp, xm = xp.reshape(4, 3), xm.reshape(4, 3)
+            xp, xm = _nudged(x, a, h)
             rp = spring_forces(xp, SPR, k, theta0, tangent=False)
             rm = spring_forces(xm, SPR, k, theta0, tangent=False)
             f_fd[a] = (rp.energy[0] - rm.energy[0]) / (2 * h)

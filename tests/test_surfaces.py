@@ -84,13 +84,18 @@ def test_user_height_function_matches_builtin():
     assert np.allclose(user.distance(p), ref.distance(p), atol=1e-7 * ref.size)
 
 
-def test_mesh_file_in_mm_matches_the_sphere(tmp_path):
-    """A fine spherical cap written in mm and read with units='mm' is the sphere in metres."""
+def _dome_in_mm(path):
+    """The built-in spherical cap (radius 1 m, rim 0.4) and its mesh written to ``path`` in mm."""
     s = builtin_surface("sphere-cap", radius=1.0, rim=0.4)
     mesh = s.mesh.copy()
     mesh.apply_scale(1000.0)
-    path = tmp_path / "dome.stl"
     mesh.export(path)
+    return s, path
+
+
+def test_mesh_file_in_mm_matches_the_sphere(tmp_path):
+    """A fine spherical cap written in mm and read with units='mm' is the sphere in metres."""
+    s, path = _dome_in_mm(tmp_path / "dome.stl")
     m = read_surface(path, units="mm")
     assert m.kind == "mesh" and m.units == "mm"
     assert math.isclose(m.size, s.size, rel_tol=1e-6)
@@ -106,11 +111,7 @@ def test_mesh_file_in_mm_matches_the_sphere(tmp_path):
 
 
 def test_mesh_units_warning_and_refusals(tmp_path):
-    s = builtin_surface("sphere-cap", radius=1.0, rim=0.4)
-    mesh = s.mesh.copy()
-    mesh.apply_scale(1000.0)
-    path = tmp_path / "dome_mm.stl"
-    mesh.export(path)
+    s, path = _dome_in_mm(tmp_path / "dome_mm.stl")
     with pytest.warns(SurfaceUnitWarning, match="units='mm'"):
         read_surface(path)  # metres: 800 m across
     closed = tmp_path / "ball.stl"

@@ -62,13 +62,15 @@ def rel_err(ours, ref) -> np.ndarray:
     return np.abs(ours - ref) / np.abs(ref)
 
 
-def stats_line(label: str, e: np.ndarray) -> str:
+def stats_line(label: str, e: np.ndarray, *, width: int = 28, count_width: int = 5) -> str:
+    """One line of the finite relative errors ``e``: count, median, p90, p99 and max, the
+    label in ``width`` columns and the count in ``count_width``."""
     e = e[np.isfinite(e)] if e.size else e
     if e.size == 0:
-        return f"  {label:<28} (no rows)"
+        return f"  {label:<{width}} (no rows)"
     q = np.percentile(e, [50, 90, 99])
     return (
-        f"  {label:<28} n={e.size:<5d} median {q[0]:.2e}  p90 {q[1]:.2e}  "
+        f"  {label:<{width}} n={e.size:<{count_width}d} median {q[0]:.2e}  p90 {q[1]:.2e}  "
         f"p99 {q[2]:.2e}  max {e.max():.2e}"
     )
 

@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from reproduce import load, reference_folder
+from reproduce import stats_line as reproduce_stats_line
 
 from holofold.design.scenarios.gripper import QLOAD, GripperOptions, simulate
 from holofold.geometry.gripper import DEFAULT_RANGE
@@ -241,14 +242,8 @@ def sensitivity(P: int, ref: pd.DataFrame, ours: pd.DataFrame, other: pd.DataFra
 
 
 def stats_line(label: str, e: np.ndarray) -> str:
-    e = e[np.isfinite(e)]
-    if e.size == 0:
-        return f"  {label:<10} (no rows)"
-    q = np.percentile(e, [50, 90, 99])
-    return (
-        f"  {label:<10} n={e.size:<4d} median {q[0]:.2e}  p90 {q[1]:.2e}  p99 {q[2]:.2e}  "
-        f"max {e.max():.2e}"
-    )
+    """:func:`reproduce.stats_line` in this script's narrower columns."""
+    return reproduce_stats_line(label, e, width=10, count_width=4)
 
 
 def quartiles(x) -> str:

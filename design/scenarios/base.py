@@ -27,6 +27,7 @@ __all__ = [
     "ROW_TIMEOUTS",
     "DISPLAY_UNITS",
     "format_value",
+    "setting_hooks",
 ]
 
 #: SI unit -> the display units it may be shown in, with the factor (display value = SI value x
@@ -403,3 +404,14 @@ def integer(row: Mapping[str, float], name: str, low: int = 1) -> list[str]:
     if v is None or not math.isfinite(v) or v != round(v) or v < low:
         return [f"{name} = {v!r} must be an integer >= {low}"]
     return []
+
+
+def setting_hooks(setting, shape, write_files, view, part) -> dict:
+    """A kind's :class:`Scenario` hooks ``shape``, ``write_files``, ``view`` and ``part``, each
+    bound to the scenario's ``setting`` (partials: picklable for worker processes)."""
+    return {
+        "shape": partial(shape, setting),
+        "write_files": partial(write_files, setting),
+        "view": partial(view, setting),
+        "part": partial(part, setting),
+    }

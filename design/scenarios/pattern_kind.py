@@ -27,7 +27,7 @@ from functools import partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, positive
+from holofold.design.scenarios.base import Column, Scenario, positive, setting_hooks
 from holofold.design.scenarios.config import (
     Section,
     read_features,
@@ -305,10 +305,7 @@ def pattern_scenario(
         kind="pattern",
         setting=words,
         source=source,
-        shape=partial(pattern_shape, setting),
-        write_files=partial(write_pattern_files, setting),
-        view=partial(pattern_view, setting),
-        part=partial(pattern_part, setting),
+        **setting_hooks(setting, pattern_shape, write_pattern_files, pattern_view, pattern_part),
         row_timeout=PATTERN_ROW_TIMEOUT,
     )
 

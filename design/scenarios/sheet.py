@@ -53,7 +53,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, integer, positive
+from holofold.design.scenarios.base import Column, Scenario, integer, positive, setting_hooks
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -657,10 +657,7 @@ def sheet_scenario(
         kind="sheet",
         setting=words,
         source=source,
-        shape=partial(sheet_shape, setting),
-        write_files=partial(write_sheet_files, setting),
-        view=partial(sheet_view, setting),
-        part=partial(sheet_part, setting),
+        **setting_hooks(setting, sheet_shape, write_sheet_files, sheet_view, sheet_part),
     )
 
 

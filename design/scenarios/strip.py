@@ -43,7 +43,7 @@ from functools import lru_cache, partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, integer, positive
+from holofold.design.scenarios.base import Column, Scenario, integer, positive, setting_hooks
 from holofold.design.scenarios.config import (
     Section,
     load_name,
@@ -250,6 +250,16 @@ def _topology(m: int) -> CreasePattern:
     return CreasePattern.from_faces(g.nodes, list(g.faces))
 
 
+def _strip_args(row) -> tuple[int, float, float, float]:
+    """Design ``row``'s (m, offset, stripeWidth, extrude), in the order the strip takes them."""
+    return int(row["m"]), float(row["offset"]), float(row["stripeWidth"]), float(row["extrude"])
+
+
+def _row_geometry(setting: StripSetting, row):
+    """The analytic strip of design ``row`` on the setting's curve and sampling."""
+    return strip_geometry(setting.curve, *_strip_args(row), setting.curve_sampling)
+
+
 def loaded_node(setting: StripSetting, m: int, at: float, t: np.ndarray | None = None) -> int:
     """Centre-line node nearest to the arc-length fraction ``at`` (node m for 0.5)."""
     if t is None:
@@ -285,17 +295,7 @@ def strip_model(setting: StripSetting, row, *, profile=PAPER):
 def strip_models(setting: StripSetting, rows, *, profile=PAPER) -> list[tuple]:
     """:func:`strip_model` of several designs, the models of each ``m`` built together
     (:func:`~holofold.mechanics.hinges.build_concentrated_batch`, bit for bit the same)."""
-    geoms = []
-    for row in rows:
-        g = strip_geometry(
-            setting.curve,
-            int(row["m"]),
-            float(row["offset"]),
-            float(row["stripeWidth"]),
-            float(row["extrude"]),
-            setting.curve_sampling,
-        )
-        geoms.append(g)
+    geoms = [_row_geometry(setting, row) for row in rows]
     out: list = [None] * len(rows)
     by_m: dict = {}
     for i, g in enumerate(geoms):
@@ -448,14 +448,7 @@ def strip_shape(setting: StripSetting, row) -> CreasePattern:
 
 
 def _fit(setting: StripSetting, row):
-    return fit_strip(
-        setting.curve,
-        int(row["m"]),
-        float(row["offset"]),
-        float(row["stripeWidth"]),
-        float(row["extrude"]),
-        sampling=setting.curve_sampling,
-    )
+    return fit_strip(setting.curve, *_strip_args(row), sampling=setting.curve_sampling)
 
 
 def strip_view(setting: StripSetting, row):
@@ -465,14 +458,7 @@ def strip_view(setting: StripSetting, row):
 
     fit = _fit(setting, row)
     pat = fit.flat_pattern if fit.flat is not None else fit.pattern
-    g = strip_geometry(
-        setting.curve,
-        int(row["m"]),
-        float(row["offset"]),
-        float(row["stripeWidth"]),
-        float(row["extrude"]),
-        setting.curve_sampling,
-    )
+    g = _row_geometry(setting, row)
     ends = {
         "ends": g.ends,
         "centre-ends": g.centre[[0, -1]],
@@ -602,10 +588,7 @@ def strip_scenario(
         kind="strip",
         setting=words,
         source=source,
-        shape=partial(strip_shape, setting),
-        write_files=partial(write_strip_files, setting),
-        view=partial(strip_view, setting),
-        part=partial(strip_part, setting),
+        **setting_hooks(setting, strip_shape, write_strip_files, strip_view, strip_part),
     )
 
 

@@ -32,7 +32,7 @@ from functools import partial
 
 import numpy as np
 
-from holofold.design.scenarios.base import Column, Scenario, positive
+from holofold.design.scenarios.base import Column, Scenario, positive, setting_hooks
 from holofold.design.scenarios.config import (
     Section,
     read_features,
@@ -320,10 +320,7 @@ def surface_scenario(
         kind="surface",
         setting=words,
         source=source,
-        shape=partial(surface_shape, setting),
-        write_files=partial(write_surface_files, setting),
-        view=partial(surface_view, setting),
-        part=partial(surface_part, setting),
+        **setting_hooks(setting, surface_shape, write_surface_files, surface_view, surface_part),
         row_timeout=SURFACE_ROW_TIMEOUT,
     )
 

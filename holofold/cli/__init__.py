@@ -1,9 +1,11 @@
 """The ``holofold`` command line.
 
-Each sub-command lives in its own module of this package and exposes two names:
+Each sub-command lives in its own module of this package and declares:
 
-``register(subparsers) -> argparse.ArgumentParser``
-    adds the sub-command's parser (with ``help=`` and its own ``--help``);
+``HELP`` (a string literal), ``DESCRIPTION``, optionally ``EPILOG`` and ``FORMATTER``
+    the sub-command's help line, its ``--help`` text and argparse formatter class;
+``add_arguments(parser) -> None``
+    adds its arguments to the parser :func:`build_parser` made from those declarations;
 ``run(args) -> int``
     does the work and returns the exit status.
 
@@ -51,19 +53,34 @@ def _command_modules():
 
 
 def _help_line(name: str) -> str | None:
-    """The literal ``help=`` of the ``add_parser`` call in command ``name``'s source, read
-    without importing it (the commands import the library, which ``holofold --help`` must
-    not pay for), or None if it is not a string literal."""
+    """The literal ``HELP = "..."`` of command ``name``'s source, read without importing it
+    (the commands import the library, which ``holofold --help`` must not pay for), or None
+    if it is not a string literal."""
     try:
         tree = ast.parse((Path(__file__).parent / f"{name}.py").read_text(encoding="utf-8"))
     except (OSError, SyntaxError):
         return None
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Call) and getattr(node.func, "attr", None) == "add_parser":
-            for kw in node.keywords:
-                if kw.arg == "help" and isinstance(kw.value, ast.Constant):
-                    return kw.value.value if isinstance(kw.value.value, str) else None
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(
+            getattr(t, "id", "") == "HELP" for t in node.targets
+        ):
+            v = node.value
+            return v.value if isinstance(v, ast.Constant) and isinstance(v.value, str) else None
     return None
+
+
+def _add_command(sub, name: str, mod) -> argparse.ArgumentParser:
+    """Command ``name``'s parser, made from module ``mod``'s declarations (module docstring)."""
+    p = sub.add_parser(
+        name,
+        help=mod.HELP,
+        description=mod.DESCRIPTION,
+        epilog=getattr(mod, "EPILOG", None),
+        formatter_class=getattr(mod, "FORMATTER", argparse.HelpFormatter),
+    )
+    mod.add_arguments(p)
+    p.set_defaults(_run=mod.run)
+    return p
 
 
 def _command_of(argv: list[str]) -> str | None:
@@ -94,9 +111,7 @@ def build_parser(command: str | None = None, *, lazy: bool = False) -> argparse.
     for name in _command_names():
         line = _help_line(name) if lazy and name != command else None
         if line is None:
-            mod = importlib.import_module(f"{__name__}.{name}")
-            p = mod.register(sub)
-            p.set_defaults(_run=mod.run)
+            _add_command(sub, name, importlib.import_module(f"{__name__}.{name}"))
         else:
             sub.add_parser(name, help=line)
     return parser

@@ -11,6 +11,8 @@ __all__ = [
     "add_bed_argument",
     "bed_of",
     "say_part",
+    "add_part_arguments",
+    "part_options",
 ]
 
 
@@ -88,3 +90,16 @@ def say_part(files, bed, part, units: str, root) -> dict | None:
     fit = part_fit(path, bed, units=units, root=root, part=part)
     print(fit.line())
     return fit.to_json()
+
+
+def add_part_arguments(p) -> None:
+    """The options of the commands that write a printable part (pattern, fit): ``--thick``,
+    ``--bed`` and the cutter options, in that order."""
+    add_thick_argument(p)
+    add_bed_argument(p)
+    add_cutter_arguments(p)
+
+
+def part_options(args):
+    """(:func:`cutter_options`, :func:`bed_of`) of the arguments, both checked."""
+    return cutter_options(args), bed_of(args)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import sys
 
-from holofold.cli._fabrication import bed_of, cutter_options, say_part
+from holofold.cli._fabrication import part_options, say_part
 from holofold.geometry import MAX_PANELS, ParameterError, check_range
 
 __all__ = ["SURFACE_ONLY", "add_surface_arguments", "run_surface"]
@@ -96,8 +96,7 @@ def run_surface(args) -> int:
     from holofold.fitting import Placement, export_surface_files, fit_surface, load_surface
 
     cells = _cells(args.cells)
-    cutter = cutter_options(args)
-    bed = bed_of(args)
+    cutter, bed = part_options(args)
     gamma = check_range("--gamma", args.gamma, 0.0, 90.0, low_open=True, high_open=True)
     check_range("--ext", args.ext, 0.0, 1.0, low_open=True, high_open=True)
     angle = math.radians(check_range("--angle", args.angle, -360.0, 360.0))

@@ -13,17 +13,16 @@ TARGET = "Zstiff > 100 & error < 0.1"
 DEMO_TIME = "about 20 s on two cores"
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "demo",
-        help="end-to-end demo: 'holofold design' on the paper's arch (about 20 s on two cores)",
-        description=(
-            "Run the design loop on the shipped arch scenario (a Miura strip over a half "
-            "circle of radius 2 m): a database of arch designs, rules for the target, their "
-            "verification by fresh simulations, one refinement round, the chosen design with "
-            "its fabrication files, pictures and report.html."
-        ),
-    )
+HELP = "end-to-end demo: 'holofold design' on the paper's arch (about 20 s on two cores)"
+DESCRIPTION = (
+    "Run the design loop on the shipped arch scenario (a Miura strip over a half "
+    "circle of radius 2 m): a database of arch designs, rules for the target, their "
+    "verification by fresh simulations, one refinement round, the chosen design with "
+    "its fabrication files, pictures and report.html."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--output", default="holofold-demo", help="output folder")
     p.add_argument("-n", "--samples", type=int, default=200, help="designs in the database")
     p.add_argument("--verify", type=int, default=30, help="fresh designs per verified rule")
@@ -31,7 +30,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--target", default=TARGET, help=f"target expression (default {TARGET!r})")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    return p
 
 
 def run(args) -> int:

@@ -8,41 +8,40 @@ from pathlib import Path
 
 from holofold.cli._fabrication import add_cutter_arguments, cutter_options
 
-__all__ = ["register", "run"]
+__all__ = ["HELP", "DESCRIPTION", "EPILOG", "FORMATTER", "add_arguments", "run"]
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "design",
-        help="design end to end: database, rules, verification, the best design and its files",
-        description=(
-            "Build (or reuse and extend) a database of the scenario, a pilot batch first (the "
-            "run stops after it, saying what the designs reach, only when no pilot design "
-            "meets the target and a condition is out of reach: the pilot's top tail, "
-            "extrapolated, expects less than one design meeting it within --budget; a rare "
-            "target goes on), "
-            "mine design rules for the target, verify the best rules with fresh simulations, "
-            "refine where the forest expects the target and mine again until a rule is verified "
-            "or --budget simulations are spent, and choose from every simulated "
-            "design the best under --objective inside the best verified rule of all rounds "
-            "(without one: the best design meeting the target; without that: the nearest, with "
-            "its shortfall). Designs whose thick panels overlap are not chosen unless "
-            "--allow-overlap. Always writes OUT/design.json and OUT/report.html, and the "
-            "design's fabrication files (FOLD, SVG, STL, OBJ, printable part) with its fit on "
-            "the printer's bed. Re-running resumes; a larger -n, --budget or --verify extends "
-            "the folder. Exit status 0: the chosen design meets the target; 1: no simulated "
-            "design does (the nearest is shown); 2: bad input."
-        ),
-        epilog=(
-            "examples:\n"
-            "  holofold scenarios show arch > my_arch.toml   # then edit curve, loads, ranges\n"
-            "  holofold describe my_arch.toml                # what the designs reach\n"
-            "  holofold design my_arch.toml --target 'Zstiff > 100 & error < 0.05' -o out\n"
-            "  holofold design arch --target 'Zstiff > 60 & error < 0.08' -o out --rounds 2 \\\n"
-            "      --objective 'min mass' --bed 250x210"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+HELP = "design end to end: database, rules, verification, the best design and its files"
+DESCRIPTION = (
+    "Build (or reuse and extend) a database of the scenario, a pilot batch first (the "
+    "run stops after it, saying what the designs reach, only when no pilot design "
+    "meets the target and a condition is out of reach: the pilot's top tail, "
+    "extrapolated, expects less than one design meeting it within --budget; a rare "
+    "target goes on), "
+    "mine design rules for the target, verify the best rules with fresh simulations, "
+    "refine where the forest expects the target and mine again until a rule is verified "
+    "or --budget simulations are spent, and choose from every simulated "
+    "design the best under --objective inside the best verified rule of all rounds "
+    "(without one: the best design meeting the target; without that: the nearest, with "
+    "its shortfall). Designs whose thick panels overlap are not chosen unless "
+    "--allow-overlap. Always writes OUT/design.json and OUT/report.html, and the "
+    "design's fabrication files (FOLD, SVG, STL, OBJ, printable part) with its fit on "
+    "the printer's bed. Re-running resumes; a larger -n, --budget or --verify extends "
+    "the folder. Exit status 0: the chosen design meets the target; 1: no simulated "
+    "design does (the nearest is shown); 2: bad input."
+)
+EPILOG = (
+    "examples:\n"
+    "  holofold scenarios show arch > my_arch.toml   # then edit curve, loads, ranges\n"
+    "  holofold describe my_arch.toml                # what the designs reach\n"
+    "  holofold design my_arch.toml --target 'Zstiff > 100 & error < 0.05' -o out\n"
+    "  holofold design arch --target 'Zstiff > 60 & error < 0.08' -o out --rounds 2 \\\n"
+    "      --objective 'min mass' --bed 250x210"
+)
+FORMATTER = argparse.RawDescriptionHelpFormatter
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scenario", help="scenario name (holofold scenarios) or a scenario file .toml")
     p.add_argument("--target", required=True, help="target over the performance columns")
     p.add_argument("-o", "--output", type=Path, required=True, help="output folder")
@@ -127,7 +126,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     add_cutter_arguments(p)
-    return p
 
 
 def run(args) -> int:

@@ -20,7 +20,7 @@ from holofold.cli._parallel import (
 )
 from holofold.design import SCENARIO_NAMES
 
-__all__ = ["register", "run"]
+__all__ = ["HELP", "DESCRIPTION", "EPILOG", "FORMATTER", "add_arguments", "run"]
 
 _EPILOG = "<the scenarios' columns>"
 
@@ -33,19 +33,18 @@ class _EpilogFormatter(argparse.RawDescriptionHelpFormatter):
         super().add_text(_epilog() if text is _EPILOG else text)
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "evaluate",
-        help="simulate a table of designs (single Miura cell, canopy, arch)",
-        description=(
-            "Simulate every row of a design table with one of the paper's scenarios and write "
-            "the performance columns and a status per row. Input: CSV or Parquet with the "
-            "published feature names as header (SI units: metres, radians, pascals), or a "
-            "published headerless data*_*.txt (names from the *_FeatureName.txt next to it)."
-        ),
-        epilog=_EPILOG,
-        formatter_class=_EpilogFormatter,
-    )
+HELP = "simulate a table of designs (single Miura cell, canopy, arch)"
+DESCRIPTION = (
+    "Simulate every row of a design table with one of the paper's scenarios and write "
+    "the performance columns and a status per row. Input: CSV or Parquet with the "
+    "published feature names as header (SI units: metres, radians, pascals), or a "
+    "published headerless data*_*.txt (names from the *_FeatureName.txt next to it)."
+)
+EPILOG = _EPILOG
+FORMATTER = _EpilogFormatter
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "scenario",
         help="scenario to simulate: " + ", ".join(SCENARIO_NAMES) + ", or a scenario file .toml",
@@ -57,7 +56,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     add_parallel_arguments(p)
     add_row_arguments(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar even on a terminal")
-    return p
 
 
 def _epilog() -> str:

@@ -33,14 +33,7 @@ import argparse
 import math
 from pathlib import Path
 
-from holofold.cli._fabrication import (
-    add_bed_argument,
-    add_cutter_arguments,
-    add_thick_argument,
-    bed_of,
-    cutter_options,
-    say_part,
-)
+from holofold.cli._fabrication import add_part_arguments, part_options, say_part
 from holofold.cli._surface_fit import SURFACE_ONLY, add_surface_arguments, run_surface
 from holofold.fitting import DEFAULT_M_RANGE, MAX_M, PUBLISHED_MAX_WARP, SAMPLINGS
 from holofold.geometry import LENGTH_UNITS, ParameterError, check_range
@@ -63,15 +56,16 @@ STRIP_ONLY = {
 }
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "fit",
-        help="fit a Miura-like strip to a planar curve and export it",
-        description=__doc__.split("\n\n")[0]
-        + " Curves: a built-in spec (half-circle:radius=2, arc:radius=..,angle=.., "
-        "parabola:span=..,height=.., sine:span=..,amplitude=..,periods=.., "
-        "catenary:span=..,height=..), a CSV of x,z points, or an SVG file[#path-id].",
-    )
+HELP = "fit a Miura-like strip to a planar curve and export it"
+DESCRIPTION = (
+    __doc__.split("\n\n")[0]
+    + " Curves: a built-in spec (half-circle:radius=2, arc:radius=..,angle=.., "
+    "parabola:span=..,height=.., sine:span=..,amplitude=..,periods=.., "
+    "catenary:span=..,height=..), a CSV of x,z points, or an SVG file[#path-id]."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--curve", help="built-in spec, points.csv or drawing.svg[#id]")
     p.add_argument(
         "--surface",
@@ -147,10 +141,7 @@ def register(subparsers) -> argparse.ArgumentParser:
         "a --surface file, the unit of its numbers too (the errors and meshes are in it)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder (created if needed)")
-    add_thick_argument(p)
-    add_bed_argument(p)
-    add_cutter_arguments(p)
-    return p
+    add_part_arguments(p)
 
 
 # ---------------------------------------------------------------------- validation
@@ -267,8 +258,7 @@ def run(args) -> int:
     )
 
     opts = _validate(args)
-    cutter = cutter_options(args)
-    bed = bed_of(args)
+    cutter, bed = part_options(args)
     scaled = args.curve_scale != 1.0
     curve = load_curve(args.curve, units=args.curve_units, check_size=not scaled)
     if scaled:

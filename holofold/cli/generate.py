@@ -12,17 +12,15 @@ from holofold.cli._parallel import (
 )
 from holofold.design import SCENARIO_NAMES
 
+HELP = "sample designs and simulate them into a resumable Parquet database"
+DESCRIPTION = (
+    "Sample N designs of a scenario inside the paper's ranges (or yours) and simulate "
+    "them into FOLDER (chunked Parquet; re-running the same command resumes an "
+    "interrupted run without losing or duplicating rows)."
+)
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "generate",
-        help="sample designs and simulate them into a resumable Parquet database",
-        description=(
-            "Sample N designs of a scenario inside the paper's ranges (or yours) and simulate "
-            "them into FOLDER (chunked Parquet; re-running the same command resumes an "
-            "interrupted run without losing or duplicating rows)."
-        ),
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "scenario", help="scenario: " + ", ".join(SCENARIO_NAMES) + ", or a scenario file .toml"
     )
@@ -48,7 +46,6 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="simulate the stored failed rows again (a resume always simulates again the rows "
         "whose stored failure was the environment's, not the design's)",
     )
-    return p
 
 
 def _parse_ranges(items):

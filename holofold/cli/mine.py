@@ -7,7 +7,7 @@ import re
 import sys
 import warnings
 
-__all__ = ["register", "run"]
+__all__ = ["HELP", "DESCRIPTION", "add_arguments", "run"]
 
 _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 #: ForestRuleMiner parameter -> the argument that sets it (--trees sets n_estimators, ...)
@@ -48,20 +48,19 @@ def _names(text: str | None) -> list[str] | None:
     return None if text is None else [t for t in text.replace(",", " ").split() if t]
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "mine",
-        help="mine interpretable design rules for a target from a database",
-        description=(
-            "Train a forest of decision trees on a hold-out training split of a performance "
-            "database, turn its leaves into axis-aligned design rules, and print the best "
-            "rules with their estimated precision (95 % interval), their train and held-out "
-            "precision, recall and support, and the features the target does not depend on. "
-            "The split is train_test_split(test_size=0.4, random_state=SEED) over the rows in "
-            "file order. The paper's method: --scoring train --ranking fbeta (the default "
-            "ranking, without tightening)."
-        ),
-    )
+HELP = "mine interpretable design rules for a target from a database"
+DESCRIPTION = (
+    "Train a forest of decision trees on a hold-out training split of a performance "
+    "database, turn its leaves into axis-aligned design rules, and print the best "
+    "rules with their estimated precision (95 % interval), their train and held-out "
+    "precision, recall and support, and the features the target does not depend on. "
+    "The split is train_test_split(test_size=0.4, random_state=SEED) over the rows in "
+    "file order. The paper's method: --scoring train --ranking fbeta (the default "
+    "ranking, without tightening)."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("database", metavar="DB", help="CSV/Parquet with a header, or published .txt")
     p.add_argument(
         "--target",
@@ -166,7 +165,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=int, default=None, help="threads for training")
     p.add_argument("--json", metavar="PATH", help="write the rules (best first) as JSON")
     p.add_argument("--plot", metavar="PATH", help="write box charts of the rules (.png/.pdf/.svg)")
-    return p
 
 
 def _in_option_terms(exc: ValueError) -> ValueError:

@@ -29,14 +29,7 @@ from __future__ import annotations
 
 import argparse
 
-from holofold.cli._fabrication import (
-    add_bed_argument,
-    add_cutter_arguments,
-    add_thick_argument,
-    bed_of,
-    cutter_options,
-    say_part,
-)
+from holofold.cli._fabrication import add_part_arguments, part_options, say_part
 
 
 def _option(name: str) -> str:
@@ -62,25 +55,22 @@ def _fabrication_arguments(p) -> None:
         help="length unit of the STL/OBJ files (default mm, as slicers and CAD read them)",
     )
     p.add_argument("-o", "--output", required=True, help="output folder")
-    add_thick_argument(p)
-    add_bed_argument(p)
-    add_cutter_arguments(p)
+    add_part_arguments(p)
 
 
-def register(subparsers) -> argparse.ArgumentParser:
+HELP = "generate a crease pattern (miura, tmp, gripper, strip, file, ...) and export it"
+DESCRIPTION = __doc__.split("\n\n")[0]
+EPILOG = "Lengths in metres, angles in degrees."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     from holofold.geometry import pattern_families
 
-    p = subparsers.add_parser(
-        "pattern",
-        help="generate a crease pattern (miura, tmp, gripper, strip, file, ...) and export it",
-        description=__doc__.split("\n\n")[0],
-        epilog="Lengths in metres, angles in degrees.",
-    )
     kinds = p.add_subparsers(dest="kind", metavar="KIND")
     kinds.required = True
     for name, fam in pattern_families().items():
         k = kinds.add_parser(name, help=fam.description, description=fam.description,
-                             epilog="Lengths in metres, angles in degrees.")  # fmt: skip
+                             epilog=EPILOG)  # fmt: skip
         for par in fam.parameters:
             unit = par.given_in or par.unit
             unit = "" if unit in ("-", "text") else f", {unit}"
@@ -89,7 +79,6 @@ def register(subparsers) -> argparse.ArgumentParser:
                            required=par.required, help=f"{par.description}{unit}")  # fmt: skip
         _fabrication_arguments(k)
         k.set_defaults(_family=name)
-    return p
 
 
 def _build(args):
@@ -107,8 +96,7 @@ def run(args) -> int:
 
     from holofold.geometry import ParameterError, check_range, write_fabrication_set
 
-    cutter = cutter_options(args)
-    bed = bed_of(args)
+    cutter, bed = part_options(args)
     fam, values, pattern = _build(args)
     check_range("--crease-width", args.crease_width, 0.0, None)
     if args.thickness is not None:

@@ -12,24 +12,22 @@ from holofold.design import (
     shipped_text,
 )
 
-__all__ = ["register", "run"]
+__all__ = ["HELP", "DESCRIPTION", "EPILOG", "add_arguments", "run"]
 
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "scenarios",
-        help="list the scenarios; 'show NAME' prints a scenario file to copy and edit",
-        description=(
-            "List the paper's scenarios and the scenario files shipped with holofold, or print "
-            "one file (TOML) to copy and edit for your own problem: your curve, material, "
-            "supports, loads and feature ranges. Every command that takes a scenario name also "
-            "takes the path of such a file."
-        ),
-        epilog="example: holofold scenarios show arch > my_arch.toml",
-    )
+HELP = "list the scenarios; 'show NAME' prints a scenario file to copy and edit"
+DESCRIPTION = (
+    "List the paper's scenarios and the scenario files shipped with holofold, or print "
+    "one file (TOML) to copy and edit for your own problem: your curve, material, "
+    "supports, loads and feature ranges. Every command that takes a scenario name also "
+    "takes the path of such a file."
+)
+EPILOG = "example: holofold scenarios show arch > my_arch.toml"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("action", nargs="?", choices=("list", "show"), default="list")
     p.add_argument("name", nargs="?", help="shipped scenario to print (with 'show')")
-    return p
 
 
 def run(args) -> int:

@@ -28,16 +28,16 @@ from __future__ import annotations
 
 import argparse
 
+HELP = "fold a crease pattern file (FOLD, SVG, DXF, ORIPA), load it, write the results"
+DESCRIPTION = __doc__.split("\n\n")[0]
+EPILOG = (
+    "Lengths in metres, forces in newtons. Exit status 1 when the fold stops short "
+    "of --fold (the status line says where), 2 on bad input; with several patterns 0 once "
+    "every one has its line (failed ones too), 2 on bad input."
+)
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "simulate",
-        help="fold a crease pattern file (FOLD, SVG, DXF, ORIPA), load it, write the results",
-        description=__doc__.split("\n\n")[0],
-        epilog="Lengths in metres, forces in newtons. Exit status 1 when the fold stops short "
-        "of --fold (the status line says where), 2 on bad input; with several patterns 0 once "
-        "every one has its line (failed ones too), 2 on bad input.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "pattern", nargs="+",
         help="crease pattern file: .fold, .svg, .dxf, .opx or .cp; several files or a folder "
@@ -103,7 +103,6 @@ def register(subparsers) -> argparse.ArgumentParser:
         help="several patterns: seconds per pattern, past which its line says 'timeout' and "
         "the batch goes on (default: none)",
     )  # fmt: skip
-    return p
 
 
 def _per_load(values, n, name, default):

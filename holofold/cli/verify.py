@@ -14,19 +14,17 @@ from holofold.cli._parallel import (
 )
 from holofold.design import SCENARIO_NAMES
 
+HELP = "simulate new designs inside each mined rule and report how many meet the target"
+DESCRIPTION = (
+    "Read the rules written by `holofold mine --json`, sample N fresh designs inside "
+    "each rule's box (within the scenario's ranges), simulate them and report the "
+    "fraction meeting the target, with a 95 % Wilson interval. With -o the designs are "
+    "simulated into resumable databases OUT/rule{i}-{key}/ (the design loop's own "
+    "verification): an interrupted run resumes, and a larger -n adds designs."
+)
 
-def register(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "verify",
-        help="simulate new designs inside each mined rule and report how many meet the target",
-        description=(
-            "Read the rules written by `holofold mine --json`, sample N fresh designs inside "
-            "each rule's box (within the scenario's ranges), simulate them and report the "
-            "fraction meeting the target, with a 95 % Wilson interval. With -o the designs are "
-            "simulated into resumable databases OUT/rule{i}-{key}/ (the design loop's own "
-            "verification): an interrupted run resumes, and a larger -n adds designs."
-        ),
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "scenario", help="scenario: " + ", ".join(SCENARIO_NAMES) + ", or a scenario file .toml"
     )
@@ -40,7 +38,6 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("-o", "--output",
                    help="folder for verify.json, the simulated designs and their resumable "
                         "databases")  # fmt: skip
-    return p
 
 
 def run(args) -> int:
