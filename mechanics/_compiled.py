@@ -31,6 +31,7 @@ __all__ = [
     "assemble_batch",
     "band_newton_step",
     "small_newton_step",
+    "selffold_increments",
     "lapack_addresses",
     "thermal_sides",
     "thermal_system",
@@ -476,6 +477,79 @@ def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
             for d in range(nd):
                 U_hist[j, row, d] = Uflat[s, d]
                 mv = max(mv, abs(Uflat[s, d] - start[d]))
+            moved[j, row] = mv
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j, 0] = code
+                failed[j, 1] = i
+                failed[j, 2] = step
+                break
+
+
+@njit(**_OPTS)
+def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
+    """Rest-angle control of each sample ``s = idx[j]`` (dense-path models), every increment
+    and iteration in this one call (:func:`holofold.mechanics.solvers.solve_selffold`'s
+    semantics, its steps those of :func:`small_newton_step`).
+
+    At increment ``i = 1..increments`` the rest angles ``m.theta0[s]`` (written here) are
+    ``(1 - i/n) start[s] + (i/n) target[s]``; iterate ``r = (F0 - f_int)[free]``, ``U[free]
+    += K_ff^-1 r``, ``R = ||r||`` (the residual before the update, the update applied even
+    when R meets the tolerance) while ``step < max_iter`` and ``R > tol``. Each increment
+    starts on the Cholesky and keeps the LU once the tangent was not positive definite.
+    Records per increment (row ``i - 1``): ``U[j]`` (ndof), ``conv[j]`` (R <= tol),
+    ``iters[j]`` (steps - 1), ``res[j]`` (the last R) and ``moved[j]`` (max |U - U at the
+    increment's start|). A failed step stops the sample: ``failed[j] = (code, increment,
+    step)`` with code 1 (singular) or 2 (a non-finite solution, U not updated), that
+    increment recorded with the last U and R, not converged.
+
+    ``lists``, ``fac``: those of :func:`small_newton_step`; ``drive`` a :class:`~holofold.
+    mechanics.kernel_args.RestControl`; ``rec`` an ``IncrementRecords``."""
+    F0, start, target, increments, tol, max_iter = drive
+    U_hist, conv, iters, res, moved, failed = rec
+    free = fac[0]
+    nf = free.shape[0]
+    nd = Uflat.shape[1]
+    ns = start.shape[1]
+    one = np.empty(1, np.intp)
+    dU = np.empty((1, nf))
+    info = np.zeros(1, np.int8)
+    r = np.empty((1, nf))
+    lu = np.zeros(1, np.int8)
+    out = (dU, info, r, lu)
+    first = np.empty(nd)
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        one[0] = s
+        theta0 = m.theta0[s]
+        failed[j, 0] = 0
+        for i in range(1, increments + 1):
+            t = i / increments
+            for k in range(ns):
+                theta0[k] = (1.0 - t) * start[s, k] + t * target[s, k]
+            for d in range(nd):
+                first[d] = Uflat[s, d]
+            lu[0] = 0
+            step = 1
+            R = np.inf
+            code = 0
+            while step < max_iter and R > tol:
+                small_newton_step(m, one, sc, lists, F0, fac, Uflat, out)
+                if info[0] != 0:
+                    code = info[0]
+                    break
+                R2 = 0.0
+                for q in range(nf):
+                    R2 += r[0, q] * r[0, q]
+                R = math.sqrt(R2)
+                step += 1
+            row = i - 1
+            mv = 0.0
+            for d in range(nd):
+                U_hist[j, row, d] = Uflat[s, d]
+                mv = max(mv, abs(Uflat[s, d] - first[d]))
             moved[j, row] = mv
             iters[j, row] = step - 1
             res[j, row] = R

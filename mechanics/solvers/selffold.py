@@ -31,6 +31,8 @@ import math
 import numpy as np
 
 from holofold.mechanics.assembly import Assembler, SingularSystemError
+from holofold.mechanics.linear import NON_FINITE, SINGULAR
+from holofold.mechanics.newton_step import selffold_increments
 from holofold.mechanics.solvers._common import (
     History,
     check_controls,
@@ -100,8 +102,13 @@ def solve_selffold(
     F0v = nodal_array("F0", F0, nn).ravel()
     U = nodal_array("U0", U0, nn).ravel()
     free = asm.free_dofs
-    r = np.empty(free.size)
     hist = History(increments, nn)
+    if not line_search:  # every increment in one kernel call where the dense step applies
+        rec = selffold_increments(asm, U, F0v, start, target, increments, tol, max_iter)
+        if rec is not None:
+            _records(hist, rec, increments)
+            return hist.result(tol, "||r||", F0v, target, "solve_selffold")
+    r = np.empty(free.size)
     for i in range(1, increments + 1):
         s = i / increments
         rest = (1.0 - s) * start + s * target
@@ -135,6 +142,22 @@ def solve_selffold(
             break
         hist.record(U, s, R <= tol, step - 1, R)
     return hist.result(tol, "||r||", F0v, target, "solve_selffold")
+
+
+def _records(hist: History, rec, increments: int) -> None:
+    """Fill ``hist`` from :func:`~holofold.mechanics.newton_step.selffold_increments`'
+    records of one sample, as the increment loop records them."""
+    code, i, step = (int(v) for v in rec.failed[0])
+    n = i if code else increments
+    hist.U[:n] = rec.U[0, :n].reshape(n, -1, 3)
+    hist.lam[:n] = np.arange(1, n + 1) / increments
+    hist.conv[:n] = rec.conv[0, :n]
+    hist.iters[:n] = rec.iters[0, :n]
+    hist.res[:n] = rec.res[0, :n]
+    hist.count = n
+    if code:
+        msg = SINGULAR if code == 1 else NON_FINITE
+        hist.failure = f"increment {i}, iteration {step}: {msg}"
 
 
 #: Armijo constant of the line search, and its smallest step fraction
