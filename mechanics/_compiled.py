@@ -35,6 +35,7 @@ __all__ = [
     "lapack_addresses",
     "thermal_sides",
     "thermal_system",
+    "thermal_steady",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -626,3 +627,69 @@ def thermal_system(cos, sin, pieces, area, A, Gq):
             for j in range(L):
                 Gq[i, j] += data[jj] * links[idx[jj], j]
     return True
+
+
+@njit(**_OPTS)
+def _pairwise_sum(a):
+    """``a.sum()`` of a contiguous (n,) array, n <= 128, in numpy's order (its pairwise sum:
+    eight running sums below 128 entries, combined as a tree, the tail added last)."""
+    n = a.shape[0]
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[0], a[1], a[2], a[3]
+    r4, r5, r6, r7 = a[4], a[5], a[6], a[7]
+    i = 8
+    while i < n - n % 8:
+        r0 += a[i]
+        r1 += a[i + 1]
+        r2 += a[i + 2]
+        r3 += a[i + 3]
+        r4 += a[i + 4]
+        r5 += a[i + 5]
+        r6 += a[i + 6]
+        r7 += a[i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[i]
+        i += 1
+    return res
+
+
+@njit(**_OPTS)
+def thermal_steady(cos, sin, pieces, q, RT, addrs, area, A, T):
+    """The small model's steady temperature (reference geometry) from the angles' ``cos``,
+    ``sin`` (nt,) in one call: :func:`thermal_system` (``area`` (nt,) out, ``A`` flat nn^2
+    work), the air chains' series conductance ``G`` (nn,) as ``thermal._series`` (0 where a
+    node has no positive link; numpy's summation order), then ``(A + diag(G)) T = q + G RT``
+    by the Cholesky of the upper triangle (``addrs``: dpotrf, dpotrs) into ``T`` (nn,) °C;
+    ``q`` (nn,) W, ``RT`` °C. Returns 0, -1 (an area <= 0: nothing solved) or the order of
+    the leading minor that is not positive definite. The numbers of ``steady_temperature``'s
+    numpy path to round-off (the same operations in the same order)."""
+    n = T.shape[0]
+    L = pieces.side.shape[1]
+    A[:] = 0.0
+    Gq = np.empty((n, L))
+    if not thermal_system(cos, sin, pieces, area, A, Gq):
+        return -1
+    inv = np.empty(L)
+    for i in range(n):
+        for j in range(L):
+            g = Gq[i, j]
+            inv[j] = 1.0 / g if g > 0.0 else np.inf
+        s = _pairwise_sum(inv) if L <= 128 else inv.sum()
+        G = 1.0 / s if np.isfinite(s) else 0.0
+        A[i * (n + 1)] += G
+        T[i] = q[i] + G * RT
+    c_u = np.array([ord("U")], np.uint8)
+    n_ = np.array([n], np.int32)
+    one = np.array([1], np.int32)
+    info = np.zeros(1, np.int32)
+    _fcall(addrs[0], (c_u, n_, A, n_, info))
+    if info[0] != 0:
+        return info[0]
+    _fcall(addrs[1], (c_u, n_, one, A, n_, T, n_, info))
+    return 0
