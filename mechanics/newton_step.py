@@ -11,6 +11,7 @@ angle, banded tangents that are not positive definite) the batch falls back to
 
 from __future__ import annotations
 
+import weakref
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -106,13 +107,13 @@ def selffold_increments(asm: Assembler, U, F0, start, target, increments, tol, m
     None where the assembler is off the dense path or uses the reference's arccos angle."""
     if asm.arccos or asm.solver != "dense":
         return None
-    red = asm.reduction
-    path = kernels.active()
-    scratch = asm._buffers()
-    one = asm.inputs.batch_of_one()
-    chol, full, perm, bw, addrs = _small_args(red, path.module)
+    module = kernels.active().module
+    fixed = _STATIC.get(asm)
+    if fixed is None or fixed[0] is not module:
+        fixed = _STATIC[asm] = (module, *_selffold_args(asm, module))
+    _, one, k_nonneg, scatter, lists, factor = fixed
     theta0 = np.empty((1, len(start)))
-    model = one.model(U.reshape(1, -1, 3), theta0, np.array([asm.k_nonneg]))
+    model = one.model(U.reshape(1, -1, 3), theta0, k_nonneg)
     drive = RestControl(
         np.ascontiguousarray(F0, dtype=float).reshape(1, -1),
         np.ascontiguousarray(start, dtype=float).reshape(1, -1),
@@ -120,11 +121,27 @@ def selffold_increments(asm: Assembler, U, F0, start, target, increments, tol, m
         int(increments), float(tol), int(max_iter),
     )  # fmt: skip
     rec = IncrementRecords.empty(1, int(increments), U.size)
-    path.module.selffold_increments(
-        model, _ONE, Scatter(asm.pattern.force_sums, scratch, scratch.flat()), (chol, full),
-        drive, Factor(red.free, perm, bw, addrs), U.reshape(1, -1), rec,
+    module.selffold_increments(
+        model, _ONE, scatter, lists, drive, factor, U.reshape(1, -1), rec
     )  # fmt: skip
     return rec
+
+
+#: per assembler: (kernel module, the fixed arguments of selffold_increments), made once
+_STATIC: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _selffold_args(asm: Assembler, module):
+    """The arguments of ``selffold_increments`` that do not change between calls: the batch
+    of one's inputs, ``k_nonneg``, the scatter, the sum lists and the factor record."""
+    red = asm.reduction
+    scratch = asm._buffers()
+    chol, full, perm, bw, addrs = _small_args(red, module)
+    return (
+        asm.inputs.batch_of_one(), np.array([asm.k_nonneg]),
+        Scatter(asm.pattern.force_sums, scratch, scratch.flat()), (chol, full),
+        Factor(red.free, perm, bw, addrs),
+    )  # fmt: skip
 
 
 def _small_args(red, module):
