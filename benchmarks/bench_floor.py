@@ -363,24 +363,28 @@ def solver_path(red) -> str:
 
 class forced_lu:
     """Context: the dense path's Newton steps factorise by LU, as before issue 37 (each
-    :class:`~holofold.mechanics.newton_step.DenseStepper` starts with its LU flag set)."""
+    :class:`~holofold.mechanics.newton_step.DenseStepper` starts with its LU flag set; the
+    self-fold stages take the per-increment loop of steppers, not the one-call kernel)."""
 
     def __enter__(self):
         from holofold.mechanics import newton_step
 
         self.orig = orig = newton_step.DenseStepper.__init__
+        self.orig_self = selffold_solver.selffold_increments
 
         def init(step, *args, **kwargs):
             orig(step, *args, **kwargs)
             step.lu[0] = 1
 
         newton_step.DenseStepper.__init__ = init
+        selffold_solver.selffold_increments = lambda *args: None
         return self
 
     def __exit__(self, *exc):
         from holofold.mechanics import newton_step
 
         newton_step.DenseStepper.__init__ = self.orig
+        selffold_solver.selffold_increments = self.orig_self
 
 
 class Floor:
