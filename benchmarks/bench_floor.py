@@ -68,6 +68,7 @@ from holofold import mechanics as threads
 from holofold.design.scenarios import arch, canopy, gripper, single_miura
 from holofold.mechanics import linear, sparse_cholesky
 from holofold.mechanics.solvers import newton as newton_solvers
+from holofold.mechanics.solvers import selffold as selffold_solver
 
 ROOT = Path(__file__).resolve().parents[1]
 REF = Path(os.environ.get("HOLOFOLD_REFERENCE_DATA", ROOT.parent / "shared" / "reference-data"))
@@ -173,6 +174,20 @@ class Capture:
             return rec
 
         newton_solvers.batch_newton_increments = spy_incr
+        self.orig_self = selffold_solver.selffold_increments
+
+        def spy_self(asm, U, F0, start, target, increments, tol, max_iter):
+            rec = cap.orig_self(asm, U, F0, start, target, increments, tol, max_iter)
+            if rec is not None:  # each increment's iterations at its own rest angles
+                code, at = int(rec.failed[0, 0]), int(rec.failed[0, 1])
+                for i in range(1, (at if code else increments) + 1):
+                    t = i / increments
+                    rest = (1.0 - t) * np.asarray(start) + t * np.asarray(target)
+                    for _ in range(int(rec.iters[0, i - 1])):
+                        cap._record(asm, rec.U[0, i - 1].reshape(-1, 3), rest)
+            return rec
+
+        selffold_solver.selffold_increments = spy_self
 
         def spy(asm, U, spring_rest=None):
             cap._record(asm, U, spring_rest)
@@ -226,6 +241,7 @@ class Capture:
     def __exit__(self, *exc):
         assembly.Assembler.evaluate_factorized = self.orig
         newton_solvers.batch_newton_increments = self.orig_incr
+        selffold_solver.selffold_increments = self.orig_self
         if self.orig_stepper is not None:
             assembly.Assembler.dense_stepper = self.orig_stepper
         if getattr(assembly, "BatchAssembler", None) is not None:
@@ -347,24 +363,28 @@ def solver_path(red) -> str:
 
 class forced_lu:
     """Context: the dense path's Newton steps factorise by LU, as before issue 37 (each
-    :class:`~holofold.mechanics.newton_step.DenseStepper` starts with its LU flag set)."""
+    :class:`~holofold.mechanics.newton_step.DenseStepper` starts with its LU flag set; the
+    self-fold stages take the per-increment loop of steppers, not the one-call kernel)."""
 
     def __enter__(self):
         from holofold.mechanics import newton_step
 
         self.orig = orig = newton_step.DenseStepper.__init__
+        self.orig_self = selffold_solver.selffold_increments
 
         def init(step, *args, **kwargs):
             orig(step, *args, **kwargs)
             step.lu[0] = 1
 
         newton_step.DenseStepper.__init__ = init
+        selffold_solver.selffold_increments = lambda *args: None
         return self
 
     def __exit__(self, *exc):
         from holofold.mechanics import newton_step
 
         newton_step.DenseStepper.__init__ = self.orig
+        selffold_solver.selffold_increments = self.orig_self
 
 
 class Floor:

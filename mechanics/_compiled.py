@@ -31,9 +31,11 @@ __all__ = [
     "assemble_batch",
     "band_newton_step",
     "small_newton_step",
+    "selffold_increments",
     "lapack_addresses",
     "thermal_sides",
     "thermal_system",
+    "thermal_steady",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -487,6 +489,79 @@ def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
                 break
 
 
+@njit(**_OPTS)
+def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
+    """Rest-angle control of each sample ``s = idx[j]`` (dense-path models), every increment
+    and iteration in this one call (:func:`holofold.mechanics.solvers.solve_selffold`'s
+    semantics, its steps those of :func:`small_newton_step`).
+
+    At increment ``i = 1..increments`` the rest angles ``m.theta0[s]`` (written here) are
+    ``(1 - i/n) start[s] + (i/n) target[s]``; iterate ``r = (F0 - f_int)[free]``, ``U[free]
+    += K_ff^-1 r``, ``R = ||r||`` (the residual before the update, the update applied even
+    when R meets the tolerance) while ``step < max_iter`` and ``R > tol``. Each increment
+    starts on the Cholesky and keeps the LU once the tangent was not positive definite.
+    Records per increment (row ``i - 1``): ``U[j]`` (ndof), ``conv[j]`` (R <= tol),
+    ``iters[j]`` (steps - 1), ``res[j]`` (the last R) and ``moved[j]`` (max |U - U at the
+    increment's start|). A failed step stops the sample: ``failed[j] = (code, increment,
+    step)`` with code 1 (singular) or 2 (a non-finite solution, U not updated), that
+    increment recorded with the last U and R, not converged.
+
+    ``lists``, ``fac``: those of :func:`small_newton_step`; ``drive`` a :class:`~holofold.
+    mechanics.kernel_args.RestControl`; ``rec`` an ``IncrementRecords``."""
+    F0, start, target, increments, tol, max_iter = drive
+    U_hist, conv, iters, res, moved, failed = rec
+    free = fac[0]
+    nf = free.shape[0]
+    nd = Uflat.shape[1]
+    ns = start.shape[1]
+    one = np.empty(1, np.intp)
+    dU = np.empty((1, nf))
+    info = np.zeros(1, np.int8)
+    r = np.empty((1, nf))
+    lu = np.zeros(1, np.int8)
+    out = (dU, info, r, lu)
+    first = np.empty(nd)
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        one[0] = s
+        theta0 = m.theta0[s]
+        failed[j, 0] = 0
+        for i in range(1, increments + 1):
+            t = i / increments
+            for k in range(ns):
+                theta0[k] = (1.0 - t) * start[s, k] + t * target[s, k]
+            for d in range(nd):
+                first[d] = Uflat[s, d]
+            lu[0] = 0
+            step = 1
+            R = np.inf
+            code = 0
+            while step < max_iter and R > tol:
+                small_newton_step(m, one, sc, lists, F0, fac, Uflat, out)
+                if info[0] != 0:
+                    code = info[0]
+                    break
+                R2 = 0.0
+                for q in range(nf):
+                    R2 += r[0, q] * r[0, q]
+                R = math.sqrt(R2)
+                step += 1
+            row = i - 1
+            mv = 0.0
+            for d in range(nd):
+                U_hist[j, row, d] = Uflat[s, d]
+                mv = max(mv, abs(Uflat[s, d] - first[d]))
+            moved[j, row] = mv
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j, 0] = code
+                failed[j, 1] = i
+                failed[j, 2] = step
+                break
+
+
 # ------------------------------------------------------------------------ thermal
 # The small-model steady temperature of :mod:`holofold.mechanics.thermal` (reference
 # geometry) without its forty array operations per heating step (the numpy path keeps
@@ -552,3 +627,69 @@ def thermal_system(cos, sin, pieces, area, A, Gq):
             for j in range(L):
                 Gq[i, j] += data[jj] * links[idx[jj], j]
     return True
+
+
+@njit(**_OPTS)
+def _pairwise_sum(a):
+    """``a.sum()`` of a contiguous (n,) array, n <= 128, in numpy's order (its pairwise sum:
+    eight running sums below 128 entries, combined as a tree, the tail added last)."""
+    n = a.shape[0]
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[0], a[1], a[2], a[3]
+    r4, r5, r6, r7 = a[4], a[5], a[6], a[7]
+    i = 8
+    while i < n - n % 8:
+        r0 += a[i]
+        r1 += a[i + 1]
+        r2 += a[i + 2]
+        r3 += a[i + 3]
+        r4 += a[i + 4]
+        r5 += a[i + 5]
+        r6 += a[i + 6]
+        r7 += a[i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[i]
+        i += 1
+    return res
+
+
+@njit(**_OPTS)
+def thermal_steady(cos, sin, pieces, q, RT, addrs, area, A, T):
+    """The small model's steady temperature (reference geometry) from the angles' ``cos``,
+    ``sin`` (nt,) in one call: :func:`thermal_system` (``area`` (nt,) out, ``A`` flat nn^2
+    work), the air chains' series conductance ``G`` (nn,) as ``thermal._series`` (0 where a
+    node has no positive link; numpy's summation order), then ``(A + diag(G)) T = q + G RT``
+    by the Cholesky of the upper triangle (``addrs``: dpotrf, dpotrs) into ``T`` (nn,) °C;
+    ``q`` (nn,) W, ``RT`` °C. Returns 0, -1 (an area <= 0: nothing solved) or the order of
+    the leading minor that is not positive definite. The numbers of ``steady_temperature``'s
+    numpy path to round-off (the same operations in the same order)."""
+    n = T.shape[0]
+    L = pieces.side.shape[1]
+    A[:] = 0.0
+    Gq = np.empty((n, L))
+    if not thermal_system(cos, sin, pieces, area, A, Gq):
+        return -1
+    inv = np.empty(L)
+    for i in range(n):
+        for j in range(L):
+            g = Gq[i, j]
+            inv[j] = 1.0 / g if g > 0.0 else np.inf
+        s = _pairwise_sum(inv) if L <= 128 else inv.sum()
+        G = 1.0 / s if np.isfinite(s) else 0.0
+        A[i * (n + 1)] += G
+        T[i] = q[i] + G * RT
+    c_u = np.array([ord("U")], np.uint8)
+    n_ = np.array([n], np.int32)
+    one = np.array([1], np.int32)
+    info = np.zeros(1, np.int32)
+    _fcall(addrs[0], (c_u, n_, A, n_, info))
+    if info[0] != 0:
+        return info[0]
+    _fcall(addrs[1], (c_u, n_, one, A, n_, T, n_, info))
+    return 0

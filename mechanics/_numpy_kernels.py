@@ -25,6 +25,7 @@ __all__ = [
     "band_newton_step",
     "small_newton_step",
     "newton_increments",
+    "selffold_increments",
     "lapack_addresses",
 ]
 
@@ -199,6 +200,43 @@ def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
             row = i - 1
             U_hist[j, row] = Uflat[s]
             moved[j, row] = np.abs(Uflat[s] - start).max(initial=0.0)
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j] = (code, i, step)
+                break
+
+
+def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
+    """Rest-angle control of each sample, every increment in this call, each step a
+    :func:`small_newton_step` (the compiled twin's semantics and records; see
+    ``_compiled.selffold_increments``)."""
+    F0, start, target, increments, tol, max_iter = drive
+    U_hist, conv, iters, res, moved, failed = rec
+    nf = fac[0].shape[0]
+    out = (np.empty((1, nf)), np.zeros(1, np.int8), np.empty((1, nf)), np.zeros(1, np.int8))
+    _, info, r, lu = out
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        one = np.array([s], np.intp)
+        failed[j] = 0
+        for i in range(1, increments + 1):
+            t = i / increments
+            m.theta0[s] = (1.0 - t) * start[s] + t * target[s]
+            first = Uflat[s].copy()
+            lu[0] = 0
+            step, R, code = 1, np.inf, 0
+            while step < max_iter and R > tol:
+                small_newton_step(m, one, sc, lists, F0, fac, Uflat, out)
+                if info[0] != 0:
+                    code = int(info[0])
+                    break
+                R = float(np.sqrt(r[0] @ r[0]))
+                step += 1
+            row = i - 1
+            U_hist[j, row] = Uflat[s]
+            moved[j, row] = np.abs(Uflat[s] - first).max(initial=0.0)
             iters[j, row] = step - 1
             res[j, row] = R
             conv[j, row] = code == 0 and R <= tol

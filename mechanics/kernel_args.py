@@ -22,6 +22,7 @@ __all__ = [
     "BandOut",
     "Increments",
     "IncrementRecords",
+    "RestControl",
 ]
 
 #: the most arguments a kernel takes (issue 35: "at most about 8 arguments per kernel")
@@ -99,6 +100,20 @@ class Increments(NamedTuple):
 
     F0: np.ndarray
     P: np.ndarray
+    increments: int
+    tol: float
+    max_iter: int
+
+
+class RestControl(NamedTuple):
+    """Rest-angle control (``solve_selffold``): at increment ``i = 1..increments`` the rest
+    angles are ``(1 - i/increments) start[s] + (i/increments) target[s]`` ((S, ns) rad) under
+    the applied force ``F0`` ((S, ndof) N); Newton iterates while ``step < max_iter`` and the
+    residual norm before the update ``||(F0 - f_int)[free]||`` exceeds ``tol`` (N)."""
+
+    F0: np.ndarray
+    start: np.ndarray
+    target: np.ndarray
     increments: int
     tol: float
     max_iter: int

@@ -11,6 +11,7 @@ angle, banded tangents that are not positive definite) the batch falls back to
 
 from __future__ import annotations
 
+import weakref
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -21,6 +22,7 @@ from holofold.mechanics.kernel_args import (
     Factor,
     IncrementRecords,
     Increments,
+    RestControl,
     Scatter,
     StepOut,
 )
@@ -35,7 +37,13 @@ from holofold.mechanics.linear import (
 if TYPE_CHECKING:
     from holofold.mechanics.assembly import Assembler, BatchAssembler
 
-__all__ = ["DenseStepper", "NewtonRecords", "batch_newton_step", "batch_newton_increments"]
+__all__ = [
+    "DenseStepper",
+    "NewtonRecords",
+    "batch_newton_step",
+    "batch_newton_increments",
+    "selffold_increments",
+]
 
 _LAPACK = {"banded": ("dpbtrf", "dpbtrs"), "dense": ("dgetrf", "dgetrs")}
 #: the LAPACK routines of the whole-solve call (dense: LU's for the fallback, Cholesky's)
@@ -86,6 +94,54 @@ class DenseStepper:
         if self.info[0]:
             raise _error(int(self.info[0]))
         return self.dU[0]
+
+
+def selffold_increments(asm: Assembler, U, F0, start, target, increments, tol, max_iter):
+    """Every increment and iteration of :func:`~holofold.mechanics.solvers.solve_selffold`
+    (rest angles from ``start`` to ``target`` (ns,) rad, force ``F0`` (ndof,) N kept applied)
+    in one kernel call, each step that of :class:`DenseStepper`: ``U`` (ndof,) C-contiguous,
+    updated in place; returns an :class:`~holofold.mechanics.kernel_args.IncrementRecords` of
+    one sample (``U`` (1, increments, ndof), ``conv``, ``iters``, ``res`` (the last
+    ``||r||``, N), ``moved`` and ``failed`` (1, 3): (code, increment, step), code 0 none, 1
+    singular, 2 a non-finite solution; rows after a failing increment are undefined), or
+    None where the assembler is off the dense path or uses the reference's arccos angle."""
+    if asm.arccos or asm.solver != "dense":
+        return None
+    module = kernels.active().module
+    fixed = _STATIC.get(asm)
+    if fixed is None or fixed[0] is not module:
+        fixed = _STATIC[asm] = (module, *_selffold_args(asm, module))
+    _, one, k_nonneg, scatter, lists, factor = fixed
+    theta0 = np.empty((1, len(start)))
+    model = one.model(U.reshape(1, -1, 3), theta0, k_nonneg)
+    drive = RestControl(
+        np.ascontiguousarray(F0, dtype=float).reshape(1, -1),
+        np.ascontiguousarray(start, dtype=float).reshape(1, -1),
+        np.ascontiguousarray(target, dtype=float).reshape(1, -1),
+        int(increments), float(tol), int(max_iter),
+    )  # fmt: skip
+    rec = IncrementRecords.empty(1, int(increments), U.size)
+    module.selffold_increments(
+        model, _ONE, scatter, lists, drive, factor, U.reshape(1, -1), rec
+    )  # fmt: skip
+    return rec
+
+
+#: per assembler: (kernel module, the fixed arguments of selffold_increments), made once
+_STATIC: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _selffold_args(asm: Assembler, module):
+    """The arguments of ``selffold_increments`` that do not change between calls: the batch
+    of one's inputs, ``k_nonneg``, the scatter, the sum lists and the factor record."""
+    red = asm.reduction
+    scratch = asm._buffers()
+    chol, full, perm, bw, addrs = _small_args(red, module)
+    return (
+        asm.inputs.batch_of_one(), np.array([asm.k_nonneg]),
+        Scatter(asm.pattern.force_sums, scratch, scratch.flat()), (chol, full),
+        Factor(red.free, perm, bw, addrs),
+    )  # fmt: skip
 
 
 def _small_args(red, module):

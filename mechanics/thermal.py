@@ -426,6 +426,31 @@ def _compiled_system(model: ThermalModel, x: np.ndarray):
     return A.reshape(n, n), _series(Gq)
 
 
+def _compiled_steady(model: ThermalModel, x: np.ndarray, q: np.ndarray, ck) -> np.ndarray:
+    """:func:`steady_temperature`'s small-model path: numpy's angles (einsum, arctan2, cos,
+    sin, as :func:`_compiled_system`), the rest in one compiled call
+    (``_compiled.thermal_steady``): the numpy path's numbers to round-off."""
+    tri = model.triangles
+    nt, n = len(tri), model.n_nodes
+    x = np.ascontiguousarray(x, dtype=float)
+    u, v, cross = np.empty((nt, 3)), np.empty((nt, 3)), np.empty(nt)
+    ck.thermal_sides(x, tri, u, v, cross)
+    alpha = np.arctan2(cross, np.einsum("ij,ij->i", u, v))
+    area, T = np.empty(nt), np.empty(n)
+    info = ck.thermal_steady(
+        np.cos(alpha), np.sin(alpha), model.compiled_pieces, np.ascontiguousarray(q, float),
+        float(model.room_temperature), ck.lapack_addresses("dpotrf", "dpotrs"), area,
+        np.empty(n * n), T,
+    )  # fmt: skip
+    if info < 0:
+        _element_matrices(model, None, area)  # raises, naming the triangle
+    if info > 0:
+        raise np.linalg.LinAlgError(
+            f"{info}-th leading minor of the array is not positive definite"
+        )
+    return T
+
+
 @single_threaded
 def steady_temperature(
     model: ThermalModel,
@@ -448,8 +473,9 @@ def steady_temperature(
     RT = model.room_temperature
     if K_cond is None and G is None and n <= _DENSE_MAX and not len(model.room_temp_nodes):
         # fast path for small models: one geometry pass, dense assembly, Cholesky
-        if model.reference_geometry and kernels.active().compiled:
-            A, G = _compiled_system(model, x)
+        path = kernels.active()
+        if model.reference_geometry and path.compiled:
+            return _compiled_steady(model, x, q, path.module)
         else:
             geo = triangle_edges(model, x)
             G = chain_conductance(model, x, _geometry=geo)

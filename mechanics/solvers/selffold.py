@@ -31,14 +31,19 @@ import math
 import numpy as np
 
 from holofold.mechanics.assembly import Assembler, SingularSystemError
+from holofold.mechanics.linear import NON_FINITE, SINGULAR
+from holofold.mechanics.newton_step import selffold_increments
 from holofold.mechanics.solvers._common import (
     History,
     check_controls,
+    describe,
     get_assembler,
+    logger,
     nodal_array,
     spring_array,
 )
 from holofold.mechanics.solvers.result import SolveResult
+from holofold.mechanics.status import CONVERGED
 from holofold.mechanics.structure import Structure
 from holofold.mechanics.threads import single_threaded
 
@@ -99,9 +104,13 @@ def solve_selffold(
         start = spring_array("start_rest", start_rest, ns)
     F0v = nodal_array("F0", F0, nn).ravel()
     U = nodal_array("U0", U0, nn).ravel()
+    if not line_search:  # every increment in one kernel call where the dense step applies
+        rec = selffold_increments(asm, U, F0v, start, target, increments, tol, max_iter)
+        if rec is not None:
+            return _result(rec, increments, tol, F0v, target)
     free = asm.free_dofs
-    r = np.empty(free.size)
     hist = History(increments, nn)
+    r = np.empty(free.size)
     for i in range(1, increments + 1):
         s = i / increments
         rest = (1.0 - s) * start + s * target
@@ -135,6 +144,29 @@ def solve_selffold(
             break
         hist.record(U, s, R <= tol, step - 1, R)
     return hist.result(tol, "||r||", F0v, target, "solve_selffold")
+
+
+def _result(rec, increments: int, tol: float, F0v, target) -> SolveResult:
+    """The :class:`SolveResult` of :func:`~holofold.mechanics.newton_step.selffold_increments`'
+    records of one sample: what the increment loop's :class:`History` gives (the records'
+    rows as the histories, not copies)."""
+    code, i, step = rec.failed[0].tolist()
+    n = i if code else increments
+    conv, iters, res = rec.conv[0, :n], rec.iters[0, :n], rec.res[0, :n]
+    if code:
+        failure = f"increment {i}, iteration {step}: {SINGULAR if code == 1 else NON_FINITE}"
+    else:
+        failure = None
+    if failure is None and conv.all():
+        status = CONVERGED  # what describe() gives
+    else:
+        status = describe(conv, iters, res, tol, "||r||", failure)
+        logger.info("%s: %s", "solve_selffold", status)
+    return SolveResult(
+        U_history=rec.U[0, :n].reshape(n, -1, 3), load_factor=np.arange(1, n + 1) / increments,
+        converged=conv, iterations=iters, residual=res, status=status,
+        applied_force=F0v.reshape(-1, 3).copy(), spring_rest=target,
+    )  # fmt: skip
 
 
 #: Armijo constant of the line search, and its smallest step fraction
