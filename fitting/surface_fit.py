@@ -388,8 +388,14 @@ class _KKT:
         # keeps the factorisation positive definite in floating point (SPDFactor raises it
         # from at least 1e-11 of the largest diagonal entry while Cholesky breaks down)
         B = sp.vstack([Jb, math.sqrt(_RHO) * Jc], format="csr")
+        structure = None
+        if self.block.sparse and self.n_factor == 0:  # the product's full pattern (no entry
+            # cancels in a product of ones): one symbolic factorisation for the whole fit
+            ones = B.copy()
+            ones.data[:] = 1.0
+            structure = ones.T @ ones
         try:
-            self.block.factor((B.T @ B).tocsr(), mu)
+            self.block.factor((B.T @ B).tocsr(), mu, structure)
         except np.linalg.LinAlgError:
             raise SurfaceFitError(
                 "the fit's linear systems are singular (the pattern degenerated)"
