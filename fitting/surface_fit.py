@@ -437,7 +437,7 @@ class _KKT:
 
 
 def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time_limit: float,
-           t0: float, mu_r: float):  # fmt: skip
+           t0: float, mu_r: float, rms_goal: float | None = None):  # fmt: skip
     """Restoration, then feasible Gauss-Newton SQP steps. ``mu_r`` damps the restoration
     steps (min |d|_H onto the constraints with H = J_s^T J_s + mu_r I: small keeps the fitted
     side on the target and moves the other side freely, large moves every vertex alike).
@@ -546,11 +546,19 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
     if why:
         return X, False, why, its, kkt
     ro, Jo = problem.objective(X)
+    ks = len(problem.grid.side)
+
+    def reached() -> bool:  # the side's RMS distance (ro's first rows are n . (x - foot) / h)
+        return rms_goal is not None and h * math.sqrt(float(np.mean(ro[:ks] ** 2))) <= rms_goal
+
     # ---- phase 2: feasible Gauss-Newton with second-order corrections
     mu = _MU_START
     F = float(ro @ ro)
     message = f"stopped after {max_iter} Gauss-Newton iterations (the distance was still falling)"
     for _ in range(max_iter):
+        if reached():
+            message = f"reached the RMS goal ({rms_goal:.3g} m)"
+            break
         if time.perf_counter() - t0 > time_limit:
             message = f"stopped at the time limit ({time_limit:g} s)"
             break
@@ -606,6 +614,9 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
         if gain < ftol:
             message = f"converged (the last step lowered the squared distance by {gain:.2g})"
             break
+    else:
+        if reached():
+            message = f"reached the RMS goal ({rms_goal:.3g} m)"
     # ---- polish the constraints to the tolerance
     X, c, Jc, k, why = restore(X, c, Jc, 10)
     its += k
@@ -626,6 +637,7 @@ def fit_surface(
     max_iter: int = 6,
     ftol: float = 0.05,
     time_limit: float = 600.0,
+    rms_goal: float | None = None,
     units: str | None = None,
 ) -> SurfaceFit:
     """Fit an m x n generalised Miura-ori to ``surface`` (docs/surface-fit.md).
@@ -651,6 +663,10 @@ def fit_surface(
         Gauss-Newton iterations at most; stop when a step lowers the squared distance by less
         than ``ftol`` (relative), or when the next step's linear model predicts less than that
         (the step is then not taken); wall time limit, s.
+    rms_goal : float, optional
+        Stop at the first iterate that meets the constraints with an RMS distance of the
+        fitted side to the target at most this, m (the restored start, then after each
+        Gauss-Newton step): a fit to a given accuracy rather than the best one.
 
     Returns
     -------
@@ -666,6 +682,8 @@ def fit_surface(
         raise ParameterError(f"side must be 'below' or 'above', got {side!r}")
     check_range("fairness", fairness, 0.0, None)
     max_iter = check_count("max_iter", max_iter, 0)
+    if rms_goal is not None:
+        check_range("rms_goal", rms_goal, 0.0, None)
     placement = placement or Placement()
     grid = QuadGrid(m, n)
     X0 = starting_tiling(target, m, n, placement, gamma, ext, side)
@@ -674,7 +692,8 @@ def fit_surface(
     with threadpool_limits(1):  # one core: BLAS threads only contend on these small vectors
         for mu_r in RESTORATION_DAMPING:  # the next only where the last could not restore
             X, ok, message, its, kkt = _solve(problem, X0.copy(), max_iter=max_iter, ftol=ftol,
-                                              time_limit=time_limit, t0=t0, mu_r=mu_r)  # fmt: skip
+                                              time_limit=time_limit, t0=t0, mu_r=mu_r,
+                                              rms_goal=rms_goal)  # fmt: skip
             first = first or message
             if ok and np.isfinite(X).all():
                 break
@@ -688,6 +707,7 @@ def fit_surface(
         "ext": ext,
         "side": side,
         "fairness": fairness,
+        **({"rms_goal": rms_goal} if rms_goal is not None else {}),
         "placement": {"centre": c.tolist(), "size": s.tolist(), "angle_deg": math.degrees(a)},
         "restoration_damping": mu_r,
         "factorisations": kkt.n_factor,
