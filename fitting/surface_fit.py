@@ -365,6 +365,17 @@ class _Problem:
         return c, J
 
 
+class _Normal:
+    """``J^T J + mu I`` as an operator (``H @ x``), not formed: two sparse products per
+    MINRES iteration instead of a sparse matrix product and sum per step."""
+
+    def __init__(self, J: sp.csr_matrix, mu: float):
+        self.J, self.JT, self.mu = J, J.T, float(mu)
+
+    def __matmul__(self, x: np.ndarray) -> np.ndarray:
+        return self.JT @ (self.J @ x) + self.mu * x
+
+
 class _KKT:
     """Saddle-point solves min 1/2 d^T H d + g^T d s.t. Jc d = -c by preconditioned MINRES."""
 
@@ -393,20 +404,20 @@ class _KKT:
             # cancels in a product of ones): one symbolic factorisation for the whole fit
             ones = B.copy()
             ones.data[:] = 1.0
-            structure = ones.T @ ones
-        try:
-            self.block.factor((B.T @ B).tocsr(), mu, structure)
+            structure = ones.T.tocsr() @ ones
+        try:  # B^T in CSR (one conversion), then a CSR product: no conversion of the result
+            self.block.factor(B.T.tocsr() @ B, mu, structure)
         except np.linalg.LinAlgError:
             raise SurfaceFitError(
                 "the fit's linear systems are singular (the pattern degenerated)"
             ) from None
         self.n_factor += 1
 
-    def solve(self, H: sp.csr_matrix, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
+    def solve(self, H: _Normal, Jc: sp.csr_matrix, g: np.ndarray, c: np.ndarray,
               tol: float = _TOL_STEP) -> tuple[np.ndarray, int]:  # fmt: skip
         if self._pending is not None:
             self._factor()
-        n, m = H.shape[0], Jc.shape[0]
+        n, m = Jc.shape[1], Jc.shape[0]
         if Jc is not self._jc:
             self._jc, self._jct = Jc, Jc.T.tocsr()
         JcT = self._jct
@@ -446,7 +457,6 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
     iterations and the KKT solver (for its statistics)."""
     h = problem.h
     ndof = 3 * problem.grid.nv
-    eye = sp.identity(ndof, format="csr")
     kkt = _KKT(problem.grid)
     refactor_after = 12  # MINRES iterations that call for a fresh factorisation
 
@@ -471,7 +481,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                 if Jc is None:
                     c, Jc = problem.constraints(X)
                 _, Jo = problem.objective(X)
-                H = (Jo.T @ Jo + mu_r * eye).tocsr()
+                H = _Normal(Jo, mu_r)
                 kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
                 Jref, renew, fresh = Jc, False, True
             g = zero
@@ -483,7 +493,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                 if Jc is None:
                     c, Jc = problem.constraints(X)
                 _, Jo = problem.objective(X)
-                H = (Jo.T @ Jo + mu_r * eye).tocsr()
+                H = _Normal(Jo, mu_r)
                 kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
                 Jref, fresh = Jc, True
                 d, n_it = kkt.solve(H, Jref, g, c, tol=_TOL_PROJECT)
@@ -564,12 +574,11 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
             break
         its += 1
         g = Jo.T @ ro
-        JtJ = (Jo.T @ Jo).tocsr()
         cm = float(np.abs(c).max())
         accepted, first, predicted = False, True, None
         while mu <= 1e6:
             kkt.refactor(Jo[problem.base_rows], Jc, mu)
-            H = JtJ + mu * eye
+            H = _Normal(Jo, mu)
             d, _ = kkt.solve(H, Jc, g, c, tol=_TOL_STEP)
             if d is None:
                 mu *= 10
