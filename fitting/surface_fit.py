@@ -476,6 +476,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
             return X, c, Jc, 0, ""
         zero = np.zeros(ndof)
         renew, fresh, Jref, H = True, False, Jc, None
+        use_sqp = sqp
         for k in range(1, steps + 1):
             # met; below the tolerance the chord steps go on (no new factorisation) while they
             # contract fast, to _TOL_AIM: the residuals of d289d47's fits, 1e-12 to 1e-10
@@ -489,7 +490,7 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                 kkt.refactor(Jo[problem.base_rows], Jc, mu_r)
                 Jref, renew, fresh = Jc, False, True
             g = zero
-            if sqp and cm > _SQP_UNTIL:
+            if use_sqp and cm > _SQP_UNTIL:
                 ro, Jo = problem.objective(X)
                 g = Jo.T @ ro
             d, n_it = kkt.solve(H, Jref, g, c, tol=_TOL_PROJECT)
@@ -511,6 +512,9 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                 if float(ct @ ct) < c2:
                     break
             else:
+                if g is not zero:  # the distance's pull: the constraints alone from here
+                    use_sqp = False
+                    continue
                 if not fresh:  # the chord's direction: renew the Jacobian and try again
                     renew = True
                     continue
@@ -525,6 +529,13 @@ def _solve(problem: _Problem, X: np.ndarray, *, max_iter: int, ftol: float, time
                         "cells"
                     ),
                 )
+            if g is not zero and (alpha < 1 or float(np.abs(ct).max()) > 2 * cm):
+                # an SQP step that must be shortened or that doubles the largest residual
+                # (large sheets: the distance's pull fights the constraints, 0.16 -> 2.1 rad at
+                # 10,000 panels): the step is redone on the constraints alone (the same
+                # factorisation), and so are the next ones
+                use_sqp = False
+                continue
             cm_old = cm
             X, c, Jc = Xt, ct, None  # the Jacobian at X is computed only when needed
             cm = float(np.abs(c).max())
