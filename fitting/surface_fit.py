@@ -8,7 +8,8 @@ height), then solves for the folded vertex positions X (nv, 3):
     subject to every quad planar, angle sum 2 pi and Kawasaki at every interior vertex
 
 by Gauss-Newton sequential quadratic programming with analytic Jacobians: a restoration phase
-(Newton steps onto the constraints from the tiling) then feasible Gauss-Newton steps, each with
+(Newton steps onto the constraints from the tiling, which also take the distance's Gauss-Newton
+model while the constraints are far from met) then feasible Gauss-Newton steps, each with
 second-order corrections back onto the constraints, damped Levenberg-Marquardt style. Each
 linear step is a saddle-point (KKT) system, solved by MINRES preconditioned with the augmented
 Lagrangian block ``J_s^T J_s + mu I + rho J_c^T J_c`` (a banded Cholesky factorisation, reused
@@ -75,8 +76,8 @@ _TOL_STEP = 1e-9
 _TOL_PROJECT = 1e-6
 #: the restoration's Newton steps also take the Gauss-Newton model of the distance (SQP steps
 #: from an infeasible point) while the largest constraint residual is above this (rad), then
-#: only the constraints: at 4096 panels the restored cap's RMS falls from 1.56e-4 to 8.7e-5 at
-#: the same number of factorisations, and the Gauss-Newton phase after it has little to do
+#: only the constraints: at 4096 panels the restored cap's RMS falls from 1.56e-4 to 8.7e-5
+#: (6 factorisations instead of 5), and the Gauss-Newton phase after it has little to do
 _SQP_UNTIL = 1e-4
 #: the restoration's aim once the constraints are met (CONSTRAINT_TOL), by chord steps only
 _TOL_AIM = 1e-10
