@@ -808,8 +808,8 @@ def electrothermal_stage(
         rest_prev = target
         if res.failed:
             break
-    new = state.replace(
-        U=U.reshape(nn, 3), q=state.q + q_stage, T=T, crease_angle=theta,
+    new = ThermalState(
+        U=U.reshape(nn, 3), force=state.force, q=state.q + q_stage, T=T, crease_angle=theta,
         spring_rest=np.array(rest_prev),
     )  # fmt: skip
     return new, results
