@@ -188,6 +188,19 @@ class Capture:
             return rec
 
         selffold_solver.selffold_increments = spy_self
+        self.orig_load = getattr(newton_solvers, "load_increments", None)
+        if self.orig_load is not None:  # one design's load control in one kernel call
+
+            def spy_load(asm, U, F0, P, increments, tol, max_iter):
+                rec = cap.orig_load(asm, U, F0, P, increments, tol, max_iter)
+                if rec is not None:  # each increment's iterations at its end state
+                    code, at = int(rec.failed[0, 0]), int(rec.failed[0, 1])
+                    count = at if code else increments
+                    Us = rec.U[0, :count].reshape(count, -1, 3)
+                    cap._record_iterations(asm, Us, rec.iters[0, :count])
+                return rec
+
+            newton_solvers.load_increments = spy_load
 
         def spy(asm, U, spring_rest=None):
             cap._record(asm, U, spring_rest)
@@ -242,6 +255,8 @@ class Capture:
         assembly.Assembler.evaluate_factorized = self.orig
         newton_solvers.batch_newton_increments = self.orig_incr
         selffold_solver.selffold_increments = self.orig_self
+        if self.orig_load is not None:
+            newton_solvers.load_increments = self.orig_load
         if self.orig_stepper is not None:
             assembly.Assembler.dense_stepper = self.orig_stepper
         if getattr(assembly, "BatchAssembler", None) is not None:
@@ -364,7 +379,8 @@ def solver_path(red) -> str:
 class forced_lu:
     """Context: the dense path's Newton steps factorise by LU, as before issue 37 (each
     :class:`~holofold.mechanics.newton_step.DenseStepper` starts with its LU flag set; the
-    self-fold stages take the per-increment loop of steppers, not the one-call kernel)."""
+    self-fold stages and load control take the per-increment loop of steppers, not the
+    one-call kernels)."""
 
     def __enter__(self):
         from holofold.mechanics import newton_step
@@ -378,6 +394,9 @@ class forced_lu:
 
         newton_step.DenseStepper.__init__ = init
         selffold_solver.selffold_increments = lambda *args: None
+        self.orig_load = getattr(newton_solvers, "load_increments", None)
+        if self.orig_load is not None:
+            newton_solvers.load_increments = lambda *args: None
         return self
 
     def __exit__(self, *exc):
@@ -385,6 +404,8 @@ class forced_lu:
 
         newton_step.DenseStepper.__init__ = self.orig
         selffold_solver.selffold_increments = self.orig_self
+        if self.orig_load is not None:
+            newton_solvers.load_increments = self.orig_load
 
 
 class Floor:

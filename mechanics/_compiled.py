@@ -32,6 +32,7 @@ __all__ = [
     "band_newton_step",
     "small_newton_step",
     "selffold_increments",
+    "load_increments",
     "lapack_addresses",
     "thermal_sides",
     "thermal_system",
@@ -545,6 +546,70 @@ def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
                 for q in range(nf):
                     R2 += r[0, q] * r[0, q]
                 R = math.sqrt(R2)
+                step += 1
+            row = i - 1
+            mv = 0.0
+            for d in range(nd):
+                U_hist[j, row, d] = Uflat[s, d]
+                mv = max(mv, abs(Uflat[s, d] - first[d]))
+            moved[j, row] = mv
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j, 0] = code
+                failed[j, 1] = i
+                failed[j, 2] = step
+                break
+
+
+@njit(**_OPTS)
+def load_increments(m, idx, sc, lists, load, fac, Uflat, rec):
+    """Newton-Raphson load control of each sample ``s = idx[j]`` (dense-path models), every
+    increment and iteration in this one call, each step that of :func:`small_newton_step`
+    (:func:`holofold.mechanics.solvers.solve_newton`'s semantics with one ``DenseStepper`` per
+    increment: each increment starts on the Cholesky and keeps the LU once the tangent was not
+    positive definite).
+
+    At increment ``i = 1..increments`` the force is ``F0[s] + i P[s]``; iterate ``U[free] +=
+    dU`` while ``step < max_iter`` and ``R = ||dU|| > tol`` (``R`` by BLAS ``ddot``, as numpy's
+    ``dU @ dU``). Records as :func:`newton_increments` (``res`` the last ||dU||, m); a failed
+    step stops the sample: ``failed[j] = (code, increment, step)``, code 1 singular, 2 a
+    non-finite solution (U not updated). ``lists``, ``fac``: those of
+    :func:`small_newton_step`; ``load`` an :class:`~holofold.mechanics.kernel_args.Increments`;
+    ``rec`` an ``IncrementRecords``."""
+    F0, P, increments, tol, max_iter = load
+    U_hist, conv, iters, res, moved, failed = rec
+    free = fac[0]
+    nf = free.shape[0]
+    nd = Uflat.shape[1]
+    one = np.empty(1, np.intp)
+    dU = np.empty((1, nf))
+    info = np.zeros(1, np.int8)
+    r = np.empty((1, nf))
+    lu = np.zeros(1, np.int8)
+    out = (dU, info, r, lu)
+    Fi = np.empty_like(F0)
+    first = np.empty(nd)
+    x = dU[0]
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        one[0] = s
+        failed[j, 0] = 0
+        for i in range(1, increments + 1):
+            for d in range(nd):
+                Fi[s, d] = F0[s, d] + i * P[s, d]
+                first[d] = Uflat[s, d]
+            lu[0] = 0
+            step = 1
+            R = np.inf
+            code = 0
+            while step < max_iter and R > tol:
+                small_newton_step(m, one, sc, lists, Fi, fac, Uflat, out)
+                if info[0] != 0:
+                    code = info[0]
+                    break
+                R = math.sqrt(np.dot(x, x))
                 step += 1
             row = i - 1
             mv = 0.0

@@ -26,6 +26,7 @@ __all__ = [
     "small_newton_step",
     "newton_increments",
     "selffold_increments",
+    "load_increments",
     "lapack_addresses",
 ]
 
@@ -233,6 +234,43 @@ def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
                     code = int(info[0])
                     break
                 R = float(np.sqrt(r[0] @ r[0]))
+                step += 1
+            row = i - 1
+            U_hist[j, row] = Uflat[s]
+            moved[j, row] = np.abs(Uflat[s] - first).max(initial=0.0)
+            iters[j, row] = step - 1
+            res[j, row] = R
+            conv[j, row] = code == 0 and R <= tol
+            if code:
+                failed[j] = (code, i, step)
+                break
+
+
+def load_increments(m, idx, sc, lists, load, fac, Uflat, rec):
+    """Newton-Raphson load control of each sample, every increment in this call, each step a
+    :func:`small_newton_step` (the compiled twin's semantics and records; see
+    ``_compiled.load_increments``)."""
+    F0, P, increments, tol, max_iter = load
+    U_hist, conv, iters, res, moved, failed = rec
+    nf = fac[0].shape[0]
+    out = (np.empty((1, nf)), np.zeros(1, np.int8), np.empty((1, nf)), np.zeros(1, np.int8))
+    dU, info, _, lu = out
+    Fi = np.empty_like(F0)
+    for j in range(idx.shape[0]):
+        s = idx[j]
+        one = np.array([s], np.intp)
+        failed[j] = 0
+        for i in range(1, increments + 1):
+            Fi[s] = F0[s] + i * P[s]
+            first = Uflat[s].copy()
+            lu[0] = 0
+            step, R, code = 1, np.inf, 0
+            while step < max_iter and R > tol:
+                small_newton_step(m, one, sc, lists, Fi, fac, Uflat, out)
+                if info[0] != 0:
+                    code = int(info[0])
+                    break
+                R = float(np.sqrt(dU[0] @ dU[0]))
                 step += 1
             row = i - 1
             U_hist[j, row] = Uflat[s]

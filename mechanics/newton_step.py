@@ -43,6 +43,7 @@ __all__ = [
     "batch_newton_step",
     "batch_newton_increments",
     "selffold_increments",
+    "load_increments",
 ]
 
 _LAPACK = {"banded": ("dpbtrf", "dpbtrs"), "dense": ("dgetrf", "dgetrs")}
@@ -124,6 +125,32 @@ def selffold_increments(asm: Assembler, U, F0, start, target, increments, tol, m
     module.selffold_increments(
         model, _ONE, scatter, lists, drive, factor, U.reshape(1, -1), rec
     )  # fmt: skip
+    return rec
+
+
+def load_increments(asm: Assembler, U, F0, P, increments, tol, max_iter):
+    """Every increment and iteration of :func:`~holofold.mechanics.solvers.solve_newton`
+    (force ``F0 + i P`` (ndof,) N at increment ``i``, the rest angles ``asm.theta0``) in one
+    kernel call, each step that of :class:`DenseStepper`: ``U`` (ndof,) C-contiguous, updated
+    in place; returns an :class:`~holofold.mechanics.kernel_args.IncrementRecords` of one
+    sample (``res`` the last ``||dU||``, m; ``failed`` (1, 3): (code, increment, step)), or
+    None where the assembler is off the dense path or uses the reference's arccos angle."""
+    if asm.arccos or asm.solver != "dense":
+        return None
+    module = kernels.active().module
+    fixed = _STATIC.get(asm)
+    if fixed is None or fixed[0] is not module:
+        fixed = _STATIC[asm] = (module, *_selffold_args(asm, module))
+    _, one, k_nonneg, scatter, lists, factor = fixed
+    theta0 = np.ascontiguousarray(asm.theta0, dtype=float).reshape(1, -1)
+    model = one.model(U.reshape(1, -1, 3), theta0, k_nonneg)
+    load = Increments(
+        np.ascontiguousarray(F0, dtype=float).reshape(1, -1),
+        np.ascontiguousarray(P, dtype=float).reshape(1, -1),
+        int(increments), float(tol), int(max_iter),
+    )  # fmt: skip
+    rec = IncrementRecords.empty(1, int(increments), U.size)
+    module.load_increments(model, _ONE, scatter, lists, load, factor, U.reshape(1, -1), rec)
     return rec
 
 

@@ -40,7 +40,13 @@ except ImportError:  # pragma: no cover - depends on the scipy release
 from holofold.mechanics import kernels
 from holofold.mechanics.compat import Profile
 from holofold.mechanics.hinges import crease_rest_targets
-from holofold.mechanics.solvers import solve_selffold
+from holofold.mechanics.solvers._common import (
+    check_controls,
+    get_assembler,
+    nodal_array,
+    spring_array,
+)
+from holofold.mechanics.solvers.selffold import solve_selffold_checked
 from holofold.mechanics.threads import single_threaded
 
 __all__ = [
@@ -711,6 +717,7 @@ def initial_thermal_state(structure, room_temperature: float = 21.0) -> ThermalS
 
 
 @single_threaded
+@single_threaded
 def electrothermal_stage(
     structure,
     model: ThermalModel,
@@ -774,37 +781,35 @@ def electrothermal_stage(
         matrices = HeatMatrices.of(structure)
     H, A = matrices.heat, matrices.temperature
     q_stage = _csr_times(H, Q)
-    U = state.U.copy()
+    # the solves' arguments checked once for the stage (solve_selffold_checked does not)
+    asm = get_assembler(structure, assembler)
+    increments, tol, max_iter = check_controls(increments, tol, max_iter)
+    nn, ns = structure.n_nodes, len(structure.springs)
+    F0v = nodal_array("F0", state.force, nn).ravel()
+    U = nodal_array("U0", state.U, nn).ravel()  # a copy, updated in place by the solves
+    rest_prev = spring_array("start_rest", state.spring_rest, ns)
+    stage_start = rest_prev
     T = state.T
     theta = state.crease_angle
-    rest_prev = state.spring_rest
     full = np.full(int(cid.max()) + 1 if nci else 0, np.pi)
     results = []
     for s in range(1, steps + 1):
         q = state.q + (s / steps) * q_stage
-        T = steady_temperature(model, structure.nodes + U, q)
+        T = steady_temperature(model, structure.nodes + U.reshape(nn, 3), q)
         dTc = _csr_times(A, T - state.T)
         theta = state.crease_angle + bimorph.fold_increment(dTc)
         full[cid] = theta
         target = crease_rest_targets(structure, full, profile=profile)
-        start = state.spring_rest if profile.thermal_reinterpolate_from_stage_start else rest_prev
-        res = solve_selffold(
-            structure,
-            target,
-            increments=increments,
-            tol=tol,
-            max_iter=max_iter,
-            U0=U,
-            F0=state.force,
-            start_rest=start,
-            assembler=assembler,
-        )
+        if target.shape != (ns,) or not np.isfinite(target).all():
+            spring_array("target_rest", target, ns)  # raises, naming the problem
+        start = stage_start if profile.thermal_reinterpolate_from_stage_start else rest_prev
+        res = solve_selffold_checked(asm, U, F0v, start, target, increments, tol, max_iter)
         results.append(res)
-        U = res.U.copy()
         rest_prev = target
         if res.failed:
             break
-    new = state.replace(
-        U=U, q=state.q + q_stage, T=T, crease_angle=theta, spring_rest=np.array(rest_prev)
-    )
+    new = ThermalState(
+        U=U.reshape(nn, 3), force=state.force, q=state.q + q_stage, T=T, crease_angle=theta,
+        spring_rest=np.array(rest_prev),
+    )  # fmt: skip
     return new, results

@@ -656,8 +656,8 @@ def run_heating(model: GripperModel, start: ThermalState, options: GripperOption
             **options.tolerance(tol, "force"), assembler=asm, matrices=matrices,
         )  # fmt: skip
         unconverged += sum(int(not r.ok) for r in results)
-        x = s.nodes + state.U
-        dist.append(float(np.linalg.norm(x[a] - x[b])))
+        d = (s.nodes[a] + state.U[a]) - (s.nodes[b] + state.U[b])
+        dist.append(math.sqrt(d.dot(d)))  # = np.linalg.norm(d): sqrt of the same dot
         tmax.append(float(state.T.max()))
         if results[-1].failed:
             status = Status.failed(f"heating step {step}: {results[-1].status}")

@@ -29,7 +29,11 @@ import numpy as np
 from holofold.geometry.errors import ParameterError
 from holofold.mechanics.assembly import Assembler, BatchAssembler, SingularSystemError
 from holofold.mechanics.linear import NON_FINITE, SINGULAR
-from holofold.mechanics.newton_step import batch_newton_increments
+from holofold.mechanics.newton_step import (
+    NewtonRecords,
+    batch_newton_increments,
+    load_increments,
+)
 from holofold.mechanics.solvers._common import (
     RESOLUTION,
     History,
@@ -95,6 +99,11 @@ def solve_newton(
     free = asm.free_dofs
     hist = History(increments, nn)
     floor = RESOLUTION * model_size(structure) if np.any(P[free]) else 0.0
+    # every increment in one kernel call where the dense step applies
+    rec = load_increments(asm, U, F0v, P, increments, tol, max_iter)
+    if rec is not None:
+        one = NewtonRecords(rec.U, rec.conv, rec.iters, rec.res, rec.moved, rec.failed, None)
+        return _from_records(one, 0, structure, tol, floor, F0v, P)
     i = 0
     for i in range(1, increments + 1):
         Fi = F0v + i * P

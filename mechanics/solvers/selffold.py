@@ -146,6 +146,26 @@ def solve_selffold(
     return hist.result(tol, "||r||", F0v, target, "solve_selffold")
 
 
+def solve_selffold_checked(
+    asm: Assembler, U, F0v, start, target, increments: int, tol: float, max_iter: int
+) -> SolveResult:
+    """:func:`solve_selffold` (full steps) without its argument checks, for a caller that made
+    them once for many solves (:func:`~holofold.mechanics.thermal.electrothermal_stage`):
+    ``asm`` the structure's assembler; ``U`` (ndof,) float C-contiguous, m, updated in place
+    to the last iterate; ``F0v`` (ndof,) N, ``start`` and ``target`` (ns,) rad: finite float
+    arrays (not copied; ``target`` becomes the result's ``spring_rest``); the controls as
+    :func:`~holofold.mechanics.solvers._common.check_controls` returns them."""
+    rec = selffold_increments(asm, U, F0v, start, target, increments, tol, max_iter)
+    if rec is not None:
+        return _result(rec, increments, tol, F0v, target)
+    res = solve_selffold(
+        asm.structure, target, increments=increments, tol=tol, max_iter=max_iter, U0=U,
+        F0=F0v, start_rest=start, assembler=asm,
+    )  # fmt: skip
+    U[:] = res.U.ravel()
+    return res
+
+
 def _result(rec, increments: int, tol: float, F0v, target) -> SolveResult:
     """The :class:`SolveResult` of :func:`~holofold.mechanics.newton_step.selffold_increments`'
     records of one sample: what the increment loop's :class:`History` gives (the records'
