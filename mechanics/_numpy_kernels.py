@@ -154,13 +154,29 @@ def small_newton_step(m, idx, sc, lists, Fi, fac, Uflat, out):
         info[j] = _accept(dU[j], Uflat, s, free)
 
 
+def _record_increment(rec, j, i, U, start, step, R, code, tol) -> bool:
+    """Write increment ``i`` (from 1) of sample row ``j`` into ``rec`` (IncrementRecords):
+    its end displacement ``U`` (ndof,) m, the largest move from ``start`` (m), the iterations
+    (``step - 1``), the last ||dU|| ``R`` (m) and whether it converged to ``tol``; a nonzero
+    ``code`` also fills ``failed[j]``. True where the sample stops there (``code`` nonzero)."""
+    row = i - 1
+    rec.U[j, row] = U
+    rec.moved[j, row] = np.abs(U - start).max(initial=0.0)
+    rec.iters[j, row] = step - 1
+    rec.res[j, row] = R
+    rec.conv[j, row] = code == 0 and R <= tol
+    if code:
+        rec.failed[j] = (code, i, step)
+    return bool(code)
+
+
 def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     """Newton-Raphson load control of each sample, every increment in this call (the
     compiled twin's semantics and records; see ``_compiled.newton_increments``)."""
     tangent_lists, full_lists = lists
     F0, P, increments, tol, max_iter = load
     free, perm, bw, _ = fac
-    U_hist, conv, iters, res, moved, failed = rec
+    failed = rec.failed
     banded = bw >= 0
     nf = free.shape[0]
     a = np.empty((bw + 1) * nf if banded else nf * nf)
@@ -198,14 +214,7 @@ def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
                     break
                 R = float(np.sqrt(x @ x))
                 step += 1
-            row = i - 1
-            U_hist[j, row] = Uflat[s]
-            moved[j, row] = np.abs(Uflat[s] - start).max(initial=0.0)
-            iters[j, row] = step - 1
-            res[j, row] = R
-            conv[j, row] = code == 0 and R <= tol
-            if code:
-                failed[j] = (code, i, step)
+            if _record_increment(rec, j, i, Uflat[s], start, step, R, code, tol):
                 break
 
 
@@ -214,7 +223,7 @@ def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
     :func:`small_newton_step` (the compiled twin's semantics and records; see
     ``_compiled.selffold_increments``)."""
     F0, start, target, increments, tol, max_iter = drive
-    U_hist, conv, iters, res, moved, failed = rec
+    failed = rec.failed
     nf = fac[0].shape[0]
     out = (np.empty((1, nf)), np.zeros(1, np.int8), np.empty((1, nf)), np.zeros(1, np.int8))
     _, info, r, lu = out
@@ -235,14 +244,7 @@ def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
                     break
                 R = float(np.sqrt(r[0] @ r[0]))
                 step += 1
-            row = i - 1
-            U_hist[j, row] = Uflat[s]
-            moved[j, row] = np.abs(Uflat[s] - first).max(initial=0.0)
-            iters[j, row] = step - 1
-            res[j, row] = R
-            conv[j, row] = code == 0 and R <= tol
-            if code:
-                failed[j] = (code, i, step)
+            if _record_increment(rec, j, i, Uflat[s], first, step, R, code, tol):
                 break
 
 

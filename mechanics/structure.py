@@ -88,6 +88,14 @@ def _arr(x, dtype, shape_tail, name, n=None):
     return a
 
 
+def _set_rows(obj, name: str, dtype, fill, n: int) -> None:
+    """Set the frozen field ``name`` of ``obj`` to its (n,) array of ``dtype`` (checked by
+    :func:`_arr`), ``fill`` in every row where the field is None."""
+    x = getattr(obj, name)
+    rows = np.full(n, fill, dtype) if x is None else _arr(x, dtype, (), name, n)
+    object.__setattr__(obj, name, rows)
+
+
 @dataclass(frozen=True, eq=False)
 class CreaseModel:
     """How a :class:`Structure` models the pattern's interior creases (docs/bar-and-hinge.md §3-4).
@@ -188,27 +196,9 @@ class Structure:
         if nb and not (L0 > 0).all():
             raise ValueError(f"bar {int(np.argmin(L0))} has zero rest length")
         s(self, "bar_length", L0)
-        s(
-            self,
-            "bar_type",
-            np.full(nb, 1, np.int8)
-            if self.bar_type is None
-            else _arr(self.bar_type, np.int8, (), "bar_type", nb),
-        )
-        s(
-            self,
-            "spring_role",
-            np.zeros(ns, np.int8)
-            if self.spring_role is None
-            else _arr(self.spring_role, np.int8, (), "spring_role", ns),
-        )
-        s(
-            self,
-            "spring_crease",
-            np.full(ns, -1, np.intp)
-            if self.spring_crease is None
-            else _arr(self.spring_crease, np.intp, (), "spring_crease", ns),
-        )
+        _set_rows(self, "bar_type", np.int8, 1, nb)
+        _set_rows(self, "spring_role", np.int8, 0, ns)
+        _set_rows(self, "spring_crease", np.intp, -1, ns)
         sup = np.zeros((nn, 3), bool) if self.supports is None else np.asarray(self.supports, bool)
         if sup.shape != (nn, 3):
             raise ValueError(f"supports must have shape ({nn}, 3), got {sup.shape}")
@@ -220,27 +210,9 @@ class Structure:
         )
         nt = len(tri)
         s(self, "triangles", tri)
-        s(
-            self,
-            "tri_thickness",
-            np.zeros(nt)
-            if self.tri_thickness is None
-            else _arr(self.tri_thickness, float, (), "tri_thickness", nt),
-        )
-        s(
-            self,
-            "tri_crease",
-            np.full(nt, -1, np.intp)
-            if self.tri_crease is None
-            else _arr(self.tri_crease, np.intp, (), "tri_crease", nt),
-        )
-        s(
-            self,
-            "tri_panel",
-            np.full(nt, -1, np.intp)
-            if self.tri_panel is None
-            else _arr(self.tri_panel, np.intp, (), "tri_panel", nt),
-        )
+        _set_rows(self, "tri_thickness", float, 0, nt)
+        _set_rows(self, "tri_crease", np.intp, -1, nt)
+        _set_rows(self, "tri_panel", np.intp, -1, nt)
         if self.creases is not None and not isinstance(self.creases, CreaseModel):
             raise TypeError(f"creases must be a CreaseModel, got {type(self.creases).__name__}")
         if self.panel_centres is not None:

@@ -8,6 +8,7 @@ import inspect
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from _kernel_paths import NO_COMPILED, path  # noqa: F401  (the kernel-path fixture: numpy, compiled)
 
 from holofold.mechanics import kernels
 from holofold.mechanics.assembly import Assembler, BatchAssembler, sum_into
@@ -27,31 +28,6 @@ def close(a, b, rtol=RTOL):
     scale = np.abs(b).max() if b.size else 0.0
     err = np.abs(a - b).max() if b.size else 0.0
     assert err <= rtol * scale, f"max error {err:.3e} > {rtol:g} x scale {scale:.3e}"
-
-
-def _compiled_available():
-    try:
-        kernels.kernel_path("compiled")
-    except Exception as exc:  # EnvironmentFault: no numba here
-        return str(exc)
-    return None
-
-
-_NO_COMPILED = _compiled_available()
-PATHS = [
-    "numpy",
-    pytest.param(
-        "compiled",
-        marks=pytest.mark.skipif(bool(_NO_COMPILED), reason=f"compiled path: {_NO_COMPILED}"),
-    ),
-]
-
-
-@pytest.fixture(params=PATHS)
-def path(request, monkeypatch):
-    """Run the test on one kernel path (HOLOFOLD_KERNELS)."""
-    monkeypatch.setenv(kernels.ENV, request.param)
-    return kernels.kernel_path(request.param)
 
 
 def _random_model(seed, nn=40, ns=70, nb=110, negative_k=False):
@@ -74,7 +50,7 @@ def _random_model(seed, nn=40, ns=70, nb=110, negative_k=False):
 @pytest.mark.parametrize("element_major", [False, True])
 @pytest.mark.parametrize("negative_k", [False, True])
 @pytest.mark.parametrize("tangent", [True, False])
-def test_spring_elements_are_the_spring_kernel(path, negative_k, tangent, element_major):
+def test_spring_elements_are_the_spring_kernel(path, negative_k, tangent, element_major):  # noqa: F811
     # 70 springs: the compiled loop's vectorised body and its remainder; strided outputs
     # (element-major arrays) take its scalar path
     X, U, sT, k, th0, *_ = _random_model(1, negative_k=negative_k)
@@ -100,7 +76,7 @@ def test_generated_spring_loop_is_current():
     assert _spring_codegen.TARGET.read_text() == _spring_codegen.source()
 
 
-def test_bar_elements_are_the_bar_kernel(path):
+def test_bar_elements_are_the_bar_kernel(path):  # noqa: F811
     X, U, _, _, _, bars, L0, EA = _random_model(2)
     b0, b1 = bars[:, 0].copy(), bars[:, 1].copy()
     D0 = np.ascontiguousarray((X[b1] - X[b0]).T)
@@ -114,7 +90,7 @@ def test_bar_elements_are_the_bar_kernel(path):
 
 
 @pytest.mark.parametrize("n_families", [1, 2, 3])
-def test_scatter_sums_each_target(path, n_families):
+def test_scatter_sums_each_target(path, n_families):  # noqa: F811
     # random targets with many repeats and dropped entries (-1, n), values over 16 decades,
     # written to out[dest[target]] (out is 3n long, zeros elsewhere)
     rng = np.random.default_rng(n_families)
@@ -174,7 +150,7 @@ def _reference_assembly(s, U):
 
 
 @pytest.mark.parametrize("seed", [3, 4])
-def test_assembly_in_every_storage(path, seed):
+def test_assembly_in_every_storage(path, seed):  # noqa: F811
     s, U = _structure(seed)
     asm = Assembler(s)
     energy, f, K, rb, rs = _reference_assembly(s, U)
@@ -199,8 +175,8 @@ def test_assembly_in_every_storage(path, seed):
 
 
 def test_paths_agree_on_a_model(monkeypatch):
-    if _NO_COMPILED:
-        pytest.skip(f"compiled path: {_NO_COMPILED}")
+    if NO_COMPILED:
+        pytest.skip(f"compiled path: {NO_COMPILED}")
     s, U = _structure(6)
     out = {}
     for name in kernels.KERNEL_PATHS:
@@ -217,7 +193,7 @@ def test_paths_agree_on_a_model(monkeypatch):
         close(a, b)
 
 
-def test_element_response_gives_new_arrays(path):
+def test_element_response_gives_new_arrays(path):  # noqa: F811
     s, U = _structure(5)
     asm = Assembler(s)
     rb, rs = asm.element_response(U)
@@ -242,7 +218,7 @@ def test_dense_solver_solves():
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_dense_newton_update_is_the_factorized_step(path, seed):
+def test_dense_newton_update_is_the_factorized_step(path, seed):  # noqa: F811
     # the one kernel call solve_selffold makes per iteration on the dense path
     s, U = _structure(seed)
     asm, ref = Assembler(s), Assembler(s)
@@ -265,7 +241,7 @@ def test_dense_newton_update_is_the_factorized_step(path, seed):
     assert Assembler(s, dense_max=2).dense_newton_update(Ua, F, rest, r) is None
 
 
-def test_dense_newton_update_raises_on_a_singular_tangent(path):
+def test_dense_newton_update_raises_on_a_singular_tangent(path):  # noqa: F811
     s, _ = _structure(3)
     s0 = Structure(
         nodes=s.nodes, bars=s.bars, bar_area=1.0, bar_E=0.0, springs=s.springs, spring_k=0.0,
@@ -279,7 +255,7 @@ def test_dense_newton_update_raises_on_a_singular_tangent(path):
 
 
 @pytest.mark.parametrize("dense_max", [2, 10_000])  # banded and dense batch steps
-def test_batch_newton_step_is_each_designs_own_step(path, dense_max):
+def test_batch_newton_step_is_each_designs_own_step(path, dense_max):  # noqa: F811
     rng = np.random.default_rng(11)
     structures, Us = [], []
     for seed in (3, 3, 4):
@@ -334,7 +310,7 @@ def _parameters(fn) -> list[str]:
     return list(inspect.signature(getattr(fn, "py_func", fn)).parameters)
 
 
-@pytest.mark.skipif(_NO_COMPILED is not None, reason=f"no compiled path: {_NO_COMPILED}")
+@pytest.mark.skipif(NO_COMPILED is not None, reason=f"no compiled path: {NO_COMPILED}")
 def test_both_paths_take_the_same_few_arguments():
     """Issue 35: every kernel the two paths share has the same parameters in both, and no
     kernel (theirs, the thermal and the supernodal Cholesky's) takes more than

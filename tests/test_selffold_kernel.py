@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from _kernel_paths import NO_COMPILED, path  # noqa: F401  (the kernel-path fixture: numpy, compiled)
 
 from holofold.geometry.gripper import two_panel_gripper
 from holofold.mechanics import kernels
@@ -16,30 +17,6 @@ from holofold.mechanics.hinges import build_compliant, crease_rest_targets
 from holofold.mechanics.solvers import selffold as selffold_module
 from holofold.mechanics.solvers import solve_selffold
 from holofold.mechanics.thermal import steady_temperature, thermal_model
-
-
-def _compiled_available():
-    try:
-        kernels.kernel_path("compiled")
-    except Exception as exc:  # EnvironmentFault: no numba here
-        return str(exc)
-    return None
-
-
-_NO_COMPILED = _compiled_available()
-PATHS = [
-    "numpy",
-    pytest.param(
-        "compiled",
-        marks=pytest.mark.skipif(bool(_NO_COMPILED), reason=f"compiled path: {_NO_COMPILED}"),
-    ),
-]
-
-
-@pytest.fixture(params=PATHS)
-def path(request, monkeypatch):
-    monkeypatch.setenv(kernels.ENV, request.param)
-    return kernels.kernel_path(request.param)
 
 
 def _gripper(held: bool = True):
@@ -77,7 +54,7 @@ def _fold(s, increments, max_iter=30, tol=1e-9, loop=False, monkeypatch=None):
 
 
 @pytest.mark.parametrize("increments, max_iter", [(4, 30), (3, 3)])
-def test_the_kernel_folds_as_the_increment_loop(path, increments, max_iter, monkeypatch):
+def test_the_kernel_folds_as_the_increment_loop(path, increments, max_iter, monkeypatch):  # noqa: F811
     """Every increment in one call gives the loop's histories (1e-12 of the displacement),
     iteration counts, convergence flags and status; ``max_iter`` 3 leaves increments above
     the tolerance, named alike."""
@@ -98,7 +75,7 @@ def test_the_kernel_folds_as_the_increment_loop(path, increments, max_iter, monk
     assert type(a.status) is type(b.status)
 
 
-@pytest.mark.skipif(bool(_NO_COMPILED), reason=f"compiled path: {_NO_COMPILED}")
+@pytest.mark.skipif(bool(NO_COMPILED), reason=f"compiled path: {NO_COMPILED}")
 def test_both_kernel_paths_fold_alike(monkeypatch):
     """The compiled and the numpy ``selffold_increments`` agree to 1e-9 on the converged fold."""
     s = _gripper()
@@ -112,7 +89,7 @@ def test_both_kernel_paths_fold_alike(monkeypatch):
     np.testing.assert_array_equal(a.iterations, b.iterations)
 
 
-def test_a_singular_model_fails_as_the_loop_does(path, monkeypatch):
+def test_a_singular_model_fails_as_the_loop_does(path, monkeypatch):  # noqa: F811
     """Bars without stiffness: the first factorisation fails (Cholesky, then the LU); the
     status and histories are the loop's."""
     s = _gripper()
@@ -126,7 +103,7 @@ def test_a_singular_model_fails_as_the_loop_does(path, monkeypatch):
     np.testing.assert_array_equal(a.iterations, b.iterations)
 
 
-@pytest.mark.skipif(bool(_NO_COMPILED), reason=f"compiled path: {_NO_COMPILED}")
+@pytest.mark.skipif(bool(NO_COMPILED), reason=f"compiled path: {NO_COMPILED}")
 def test_thermal_steady_is_the_numpy_path(monkeypatch):
     """steady_temperature's compiled call (``thermal_steady``) gives the numpy path's
     temperatures to 1e-12 of the rise, flat and deformed; a collapsed triangle is named."""

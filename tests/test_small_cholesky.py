@@ -5,8 +5,8 @@ each path on both kernel paths, against the dense LU."""
 
 import numpy as np
 import pytest
+from _kernel_paths import path  # noqa: F401  (the kernel-path fixture: numpy, compiled)
 from scipy.linalg import lu_factor, lu_solve
-from test_kernel_paths import path  # noqa: F401  (the kernel-path fixture: numpy, compiled)
 
 from holofold.design.scenarios.gripper import gripper_model
 from holofold.mechanics.assembly import Assembler

@@ -154,18 +154,18 @@ class _Parser:
         return node
 
     def parse_or(self):
-        args = [self.parse_and()]
-        while self.tok.kind == "punct" and self.tok.text == "|":
-            self.i += 1
-            args.append(self.parse_and())
-        return args[0] if len(args) == 1 else _BoolOp("|", tuple(args))
+        return self.parse_chain("|", self.parse_and)
 
     def parse_and(self):
-        args = [self.parse_atom()]
-        while self.tok.kind == "punct" and self.tok.text == "&":
+        return self.parse_chain("&", self.parse_atom)
+
+    def parse_chain(self, op: str, parse_part):
+        """``part (op part)*``: the one part, or their ``_BoolOp`` (``op`` ``|`` or ``&``)."""
+        args = [parse_part()]
+        while self.tok.kind == "punct" and self.tok.text == op:
             self.i += 1
-            args.append(self.parse_atom())
-        return args[0] if len(args) == 1 else _BoolOp("&", tuple(args))
+            args.append(parse_part())
+        return args[0] if len(args) == 1 else _BoolOp(op, tuple(args))
 
     def parse_atom(self):
         if self.tok.kind == "punct" and self.tok.text == "(":

@@ -14,7 +14,7 @@ as in the published data, and ``status`` names the increments that did not conve
 
 from __future__ import annotations
 
-from holofold.design.scenarios.base import Scenario
+from holofold.design.scenarios.base import paper_scenario
 from holofold.design.scenarios.strip import (
     STRIP_FEATURES,
     StripLoad,
@@ -79,21 +79,13 @@ _STRIP = strip_scenario("arch", "", SETTING, FEATURES, extras=False)
 #: Zstiff, Zsnap, Xstiff (N/m), error (m) and a status
 evaluate = _STRIP.evaluate
 
-SCENARIO = Scenario(
+SCENARIO = paper_scenario(
+    _STRIP,  # its write_files: the same seven files as the shipped arch.toml
     name="arch",
     description=(
         "Miura-like arch fitted to a half circle of radius 2 m: apex stiffness in z and x under "
         "5 N, snap flag and fitting error (Zhu & Filipov 2022, data3)."
     ),
-    features=FEATURES,
-    performance=_STRIP.performance,
     check=check,
-    evaluate=evaluate,
     categorical=("m",),
-    evaluate_batch=_STRIP.evaluate_batch,
-    batch_key=_STRIP.batch_key,
-    shape=_STRIP.shape,
-    view=_STRIP.view,
-    part=_STRIP.part,
-    write_files=_STRIP.write_files,  # the same seven files as the shipped arch.toml
 )

@@ -28,6 +28,7 @@ __all__ = [
     "DISPLAY_UNITS",
     "format_value",
     "setting_hooks",
+    "paper_scenario",
 ]
 
 #: SI unit -> the display units it may be shown in, with the factor (display value = SI value x
@@ -415,3 +416,26 @@ def setting_hooks(setting, shape, write_files, view, part) -> dict:
         "view": partial(view, setting),
         "part": partial(part, setting),
     }
+
+
+def paper_scenario(kind_scenario: Scenario, name: str, description: str, check, **fields):
+    """One of the paper's scenarios on the scenario its kind makes of its setting: that
+    scenario's columns, ``evaluate`` and hooks (batch, shape, view, part, files) under the
+    paper's ``name``, ``description`` and ``check``; ``fields`` are the other
+    :class:`Scenario` fields (``categorical``, ``row_timeout``)."""
+    k = kind_scenario
+    return Scenario(
+        name=name,
+        description=description,
+        features=k.features,
+        performance=k.performance,
+        check=check,
+        evaluate=k.evaluate,
+        evaluate_batch=k.evaluate_batch,
+        batch_key=k.batch_key,
+        shape=k.shape,
+        view=k.view,
+        part=k.part,
+        write_files=k.write_files,
+        **fields,
+    )

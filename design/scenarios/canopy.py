@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from holofold.design.scenarios.base import ROW_TIMEOUTS, Scenario
+from holofold.design.scenarios.base import ROW_TIMEOUTS, paper_scenario
 from holofold.design.scenarios.sheet import MIURA as MIURA
 from holofold.design.scenarios.sheet import TMP as TMP
 from holofold.design.scenarios.sheet import (
@@ -83,23 +83,15 @@ def sheet_models(row, *, profile=PAPER, extensions=EXTENSIONS):
     return [(s, *groups) for s, groups in models]
 
 
-SCENARIO = Scenario(
+SCENARIO = paper_scenario(
+    _SHEET,
     name="canopy",
     description=(
         "Miura-ori or TMP canopy sheet (0.2 m x 0.2 m): bending and axial secant stiffness "
         "under 3 N at extensions 0.3, 0.6, 0.9 (Zhu & Filipov 2022, data1; data4 with "
         "creaseE/panelE)."
     ),
-    features=FEATURES,
-    performance=PERFORMANCE,
     check=check,
-    evaluate=evaluate,
-    evaluate_batch=_SHEET.evaluate_batch,
-    batch_key=_SHEET.batch_key,
-    shape=_SHEET.shape,
-    view=_SHEET.view,
-    part=_SHEET.part,
-    write_files=_SHEET.write_files,
     categorical=("pattern", "m", "n"),
     row_timeout=ROW_TIMEOUTS["sheet"],  # rows take 0.5-1.3 s warm
 )

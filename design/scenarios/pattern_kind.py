@@ -35,7 +35,7 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
-    THICK_COLUMN,
+    FOLDED_COLUMNS,
     crease_view,
     describe_material_and_loads,
     fold_way,
@@ -167,10 +167,7 @@ def pattern_columns(setting: PatternScenarioSetting) -> tuple[Column, ...]:
     ]
     cols += [
         Column("energy", "J", "elastic energy stored by the fold"),
-        Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
-        Column("overlap", "m^3", "intersection volume of the folded thick panels"),
-        Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
-        THICK_COLUMN,
+        *FOLDED_COLUMNS,
         Column("reached", "-", "fold fraction reached"),
     ]
     return tuple(cols)

@@ -39,6 +39,7 @@ __all__ = [
     "crease_view",
     "surface_lines",
     "THICK_COLUMN",
+    "FOLDED_COLUMNS",
     "row_thickness",
     "fold_way",
 ]
@@ -138,6 +139,14 @@ THICK_COLUMN = Column(
     "(the first that folds without collision)", choices=(0.0, 1.0, 2.0),
     names=("centred", "offset", "tapered"),
 )  # fmt: skip
+
+#: the columns :func:`loaded_columns` gives after the stiffnesses: mass, overlap, clearance, thick
+FOLDED_COLUMNS = (
+    Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
+    Column("overlap", "m^3", "intersection volume of the folded thick panels"),
+    Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
+    THICK_COLUMN,
+)
 
 
 def row_thickness(state: CreasePattern, row, path=()):

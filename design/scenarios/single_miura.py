@@ -13,7 +13,7 @@ This is the sheet kind (:mod:`~holofold.design.scenarios.sheet`) with the settin
 
 from __future__ import annotations
 
-from holofold.design.scenarios.base import Scenario
+from holofold.design.scenarios.base import paper_scenario
 from holofold.design.scenarios.sheet import (
     MIURA,
     SheetLoad,
@@ -84,20 +84,12 @@ def cell_models(tcrease, tpanel, W, gama, *, profile=PAPER, extensions=EXTENSION
     return [(s, groups[0]) for s, groups in models]
 
 
-SCENARIO = Scenario(
+SCENARIO = paper_scenario(
+    _SHEET,
     name="single-miura",
     description=(
         "Single Miura-ori cell (L = 0.04 m): axial secant stiffness under 3 N at extensions "
         "0.3, 0.6, 0.9 (Zhu & Filipov 2022, data0)."
     ),
-    features=FEATURES,
-    performance=PERFORMANCE,
     check=check,
-    evaluate=evaluate,
-    evaluate_batch=_SHEET.evaluate_batch,
-    batch_key=_SHEET.batch_key,
-    shape=_SHEET.shape,
-    view=_SHEET.view,
-    part=_SHEET.part,
-    write_files=_SHEET.write_files,
 )

@@ -40,7 +40,7 @@ from holofold.design.scenarios.config import (
     read_solver,
 )
 from holofold.design.scenarios.pattern_loads import (
-    THICK_COLUMN,
+    FOLDED_COLUMNS,
     crease_view,
     describe_material_and_loads,
     loaded_columns,
@@ -138,12 +138,7 @@ def surface_columns(setting: SurfaceScenarioSetting) -> tuple[Column, ...]:
         Column(f"{ld.name}stiff", "N/m", f"secant stiffness under {ld.force:g} N at {ld.at}")
         for ld in setting.loads
     ]
-    cols += [
-        Column("mass", "kg", "mass of the flat sheet (panels and thinned creases)"),
-        Column("overlap", "m^3", "intersection volume of the folded thick panels"),
-        Column("clearance", "m", "smallest gap between folded thick panels sharing no vertex"),
-        THICK_COLUMN,
-    ]
+    cols += FOLDED_COLUMNS
     return tuple(cols)
 
 
