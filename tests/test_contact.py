@@ -325,10 +325,9 @@ def test_the_barrier_solve_takes_exact_newton_updates_and_lands_where_projected_
     """Where the tangent with the barrier's exact Hessian is positive definite, the barrier
     solve's update is Newton's own (quadratic convergence); the per-pair projection to positive
     semi-definite is the fallback. A 4 x 4 Miura sheet folded to Ext 0.1, layers touching from
-    86 %: 30 updates in 9 barrier solves, 29 of them exact (before: 60, every solve started at
-    the last state instead of the clean part of the way to the contact-free equilibrium, and
-    projected; on Origami Simulator's miura_sharpangle the projection alone took 5-39 updates a
-    solve where the exact Hessian takes 3-6); the same folded state."""
+    86 %: 30 updates in 9 barrier solves, all exact (before, every update projected: 60; on
+    Origami Simulator's miura_sharpangle the projected solves took 5-39 updates each where the
+    exact ones take 3-6); the same folded state."""
     folded = miura_sheet(4, 4, a=0.02, b=0.02, gamma=math.radians(60), ext=0.1)
     seen = []
     solve = PanelContact._solve
