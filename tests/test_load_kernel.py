@@ -8,18 +8,13 @@ import dataclasses
 
 import numpy as np
 import pytest
-from test_selffold_kernel import _NO_COMPILED, PATHS, _gripper
+from _kernel_paths import NO_COMPILED, path  # noqa: F401  (the kernel-path fixture: numpy, compiled)
+from test_selffold_kernel import _gripper
 
 from holofold.mechanics import kernels
 from holofold.mechanics.assembly import Assembler
 from holofold.mechanics.solvers import newton as newton_module
 from holofold.mechanics.solvers import solve_newton
-
-
-@pytest.fixture(params=PATHS)
-def path(request, monkeypatch):
-    monkeypatch.setenv(kernels.ENV, request.param)
-    return kernels.kernel_path(request.param)
 
 
 def _pull(s, increments, force=1e-7, tol=1e-11, max_iter=30, loop=False, monkeypatch=None):
@@ -59,7 +54,7 @@ def _same(a, b, exact_status=True):
 
 
 @pytest.mark.parametrize("increments, max_iter", [(4, 30), (3, 2)])
-def test_the_kernel_loads_as_the_increment_loop(path, increments, max_iter, monkeypatch):
+def test_the_kernel_loads_as_the_increment_loop(path, increments, max_iter, monkeypatch):  # noqa: F811
     """Every increment in one call gives the loop's histories (1e-12 of the displacement),
     iteration counts, convergence flags and status; ``max_iter`` 2 (one iteration) leaves
     increments above the tolerance, named alike."""
@@ -70,7 +65,7 @@ def test_the_kernel_loads_as_the_increment_loop(path, increments, max_iter, monk
     assert a.status.converged == (max_iter == 30)
 
 
-def test_an_unresolved_increment_is_named_as_the_loop_names_it(path, monkeypatch):
+def test_an_unresolved_increment_is_named_as_the_loop_names_it(path, monkeypatch):  # noqa: F811
     """A load of 1e-30 N moves the nodes below the round-off resolution: every increment is
     'not converged' with that reason, as in the loop."""
     s = _gripper()
@@ -82,7 +77,7 @@ def test_an_unresolved_increment_is_named_as_the_loop_names_it(path, monkeypatch
     np.testing.assert_array_equal(a.iterations, b.iterations)
 
 
-def test_a_singular_model_fails_as_the_loop_does(path, monkeypatch):
+def test_a_singular_model_fails_as_the_loop_does(path, monkeypatch):  # noqa: F811
     """Bars without stiffness: the first factorisation fails (Cholesky, then the LU); the
     status and histories are the loop's."""
     s = _gripper()
@@ -97,7 +92,7 @@ def test_a_singular_model_fails_as_the_loop_does(path, monkeypatch):
     np.testing.assert_array_equal(a.applied_force, b.applied_force)
 
 
-@pytest.mark.skipif(bool(_NO_COMPILED), reason=f"compiled path: {_NO_COMPILED}")
+@pytest.mark.skipif(bool(NO_COMPILED), reason=f"compiled path: {NO_COMPILED}")
 def test_both_kernel_paths_load_alike(monkeypatch):
     """The compiled and the numpy ``load_increments`` agree to 1e-9 on the converged run."""
     s = _gripper()
