@@ -388,6 +388,30 @@ def small_newton_step(m, idx, sc, lists, Fi, fac, Uflat, out):
 
 
 @njit(**_OPTS)
+def _record_increment(rec, j, i, U, start, step, R, code, tol):
+    """Write increment ``i`` (from 1) of sample row ``j`` into ``rec`` (IncrementRecords): its
+    end displacement ``U`` (ndof,) m, the largest move from ``start`` (m), the iterations
+    (``step - 1``), the last residual ``R`` and whether it met ``tol``; a nonzero ``code``
+    also fills ``failed[j]``. True where the sample stops there (``code`` nonzero)."""
+    U_hist, conv, iters, res, moved, failed = rec
+    row = i - 1
+    mv = 0.0
+    for d in range(U.shape[0]):
+        U_hist[j, row, d] = U[d]
+        mv = max(mv, abs(U[d] - start[d]))
+    moved[j, row] = mv
+    iters[j, row] = step - 1
+    res[j, row] = R
+    conv[j, row] = code == 0 and R <= tol
+    if code:
+        failed[j, 0] = code
+        failed[j, 1] = i
+        failed[j, 2] = step
+        return True
+    return False
+
+
+@njit(**_OPTS)
 def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     """Newton-Raphson load control of each sample ``s = idx[j]``, every increment and
     iteration in this one call (:func:`holofold.mechanics.solvers.solve_newton`'s semantics).
@@ -411,7 +435,7 @@ def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     tangent_lists, full_lists = lists
     F0, P, increments, tol, max_iter = load
     free, perm, bw, addrs = fac
-    U_hist, conv, iters, res, moved, failed = rec
+    failed = rec.failed
     banded = bw >= 0
     nf = free.shape[0]
     nd = Uflat.shape[1]
@@ -474,19 +498,7 @@ def newton_increments(m, idx, sc, lists, load, fac, Uflat, rec):
                     R2 += x[q] * x[q]
                 R = math.sqrt(R2)
                 step += 1
-            row = i - 1
-            mv = 0.0
-            for d in range(nd):
-                U_hist[j, row, d] = Uflat[s, d]
-                mv = max(mv, abs(Uflat[s, d] - start[d]))
-            moved[j, row] = mv
-            iters[j, row] = step - 1
-            res[j, row] = R
-            conv[j, row] = code == 0 and R <= tol
-            if code:
-                failed[j, 0] = code
-                failed[j, 1] = i
-                failed[j, 2] = step
+            if _record_increment(rec, j, i, Uflat[s], start, step, R, code, tol):
                 break
 
 
@@ -510,7 +522,7 @@ def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
     ``lists``, ``fac``: those of :func:`small_newton_step`; ``drive`` a :class:`~holofold.
     mechanics.kernel_args.RestControl`; ``rec`` an ``IncrementRecords``."""
     F0, start, target, increments, tol, max_iter = drive
-    U_hist, conv, iters, res, moved, failed = rec
+    failed = rec.failed
     free = fac[0]
     nf = free.shape[0]
     nd = Uflat.shape[1]
@@ -547,19 +559,7 @@ def selffold_increments(m, idx, sc, lists, drive, fac, Uflat, rec):
                     R2 += r[0, q] * r[0, q]
                 R = math.sqrt(R2)
                 step += 1
-            row = i - 1
-            mv = 0.0
-            for d in range(nd):
-                U_hist[j, row, d] = Uflat[s, d]
-                mv = max(mv, abs(Uflat[s, d] - first[d]))
-            moved[j, row] = mv
-            iters[j, row] = step - 1
-            res[j, row] = R
-            conv[j, row] = code == 0 and R <= tol
-            if code:
-                failed[j, 0] = code
-                failed[j, 1] = i
-                failed[j, 2] = step
+            if _record_increment(rec, j, i, Uflat[s], first, step, R, code, tol):
                 break
 
 
@@ -579,7 +579,7 @@ def load_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     :func:`small_newton_step`; ``load`` an :class:`~holofold.mechanics.kernel_args.Increments`;
     ``rec`` an ``IncrementRecords``."""
     F0, P, increments, tol, max_iter = load
-    U_hist, conv, iters, res, moved, failed = rec
+    failed = rec.failed
     free = fac[0]
     nf = free.shape[0]
     nd = Uflat.shape[1]
@@ -611,19 +611,7 @@ def load_increments(m, idx, sc, lists, load, fac, Uflat, rec):
                     break
                 R = math.sqrt(np.dot(x, x))
                 step += 1
-            row = i - 1
-            mv = 0.0
-            for d in range(nd):
-                U_hist[j, row, d] = Uflat[s, d]
-                mv = max(mv, abs(Uflat[s, d] - first[d]))
-            moved[j, row] = mv
-            iters[j, row] = step - 1
-            res[j, row] = R
-            conv[j, row] = code == 0 and R <= tol
-            if code:
-                failed[j, 0] = code
-                failed[j, 1] = i
-                failed[j, 2] = step
+            if _record_increment(rec, j, i, Uflat[s], first, step, R, code, tol):
                 break
 
 

@@ -253,7 +253,7 @@ def load_increments(m, idx, sc, lists, load, fac, Uflat, rec):
     :func:`small_newton_step` (the compiled twin's semantics and records; see
     ``_compiled.load_increments``)."""
     F0, P, increments, tol, max_iter = load
-    U_hist, conv, iters, res, moved, failed = rec
+    failed = rec.failed
     nf = fac[0].shape[0]
     out = (np.empty((1, nf)), np.zeros(1, np.int8), np.empty((1, nf)), np.zeros(1, np.int8))
     dU, info, _, lu = out
@@ -274,14 +274,7 @@ def load_increments(m, idx, sc, lists, load, fac, Uflat, rec):
                     break
                 R = float(np.sqrt(dU[0] @ dU[0]))
                 step += 1
-            row = i - 1
-            U_hist[j, row] = Uflat[s]
-            moved[j, row] = np.abs(Uflat[s] - first).max(initial=0.0)
-            iters[j, row] = step - 1
-            res[j, row] = R
-            conv[j, row] = code == 0 and R <= tol
-            if code:
-                failed[j] = (code, i, step)
+            if _record_increment(rec, j, i, Uflat[s], first, step, R, code, tol):
                 break
 
 
