@@ -50,6 +50,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from _timing import machine_speed
+
 ROW = "m,tcrease,tpanel,W,offset,stripeWidth,extrude\n12,8e-4,3e-3,2e-3,0.2,0.02,0.1\n"
 ROOT = Path(__file__).resolve().parents[1]
 #: the pattern of the start-up figure: Origami Simulator's waterbomb (330 panels, MIT; issue 37's
@@ -240,6 +242,7 @@ def main() -> None:
     args = ap.parse_args()
     print(f"load average at start: {os.getloadavg()}; {os.cpu_count()} cores; "
           f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")  # fmt: skip
+    print(machine_speed())
     cases: dict[str, Case] = {}
 
     def case(name: str) -> Case:

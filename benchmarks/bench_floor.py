@@ -60,6 +60,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from _timing import machine_speed
 from scipy.linalg import lapack
 from threadpoolctl import threadpool_limits
 
@@ -600,6 +601,7 @@ def main(argv=None) -> int:
         help="only print where one single Miura design's CPU time goes, stage by stage",
     )
     args = ap.parse_args(argv)
+    print(machine_speed())
     if args.stages:
         stages()
         return 0

@@ -73,11 +73,17 @@ def _exercise(structures) -> None:
     US = np.ascontiguousarray(np.tile(U.ravel(), (len(structures), 1)))
     batch.factorized(US.reshape(len(structures), -1, 3), np.ones(len(structures), bool))
     batch.newton_step(US, np.zeros_like(US), np.ones(len(structures), bool))
-    from holofold.mechanics.solvers import solve_newton_batch
+    from holofold.mechanics.solvers import solve_newton, solve_newton_batch, solve_selffold
 
     load = np.zeros((s.n_nodes, 3))
     load[-1, 2] = -1e-3
     solve_newton_batch(structures, [load] * len(structures), increments=2, tol=1e-9)
+    # one structure's load increments in one kernel call (the gripper's prying load)
+    solve_newton(s, load, increments=2, tol=1e-9)
+    # self-folding by rest angles (fold_pattern, the surface fold check, the thermal stages):
+    # every increment in one kernel call on the dense path (missing here, the first fold of a
+    # process compiled it: 17 s CPU, 2026-12-07)
+    solve_selffold(s, s.spring_rest - 0.05, increments=2, tol=1e-9)
 
 
 def _thermal() -> None:

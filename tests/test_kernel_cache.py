@@ -92,6 +92,16 @@ _ROWS = textwrap.dedent(
     first = time.perf_counter() - t0
     sm = get_scenario("single-miura").evaluate(
         {"tcrease": 8e-4, "tpanel": 3e-3, "W": 2e-3, "gama": 1.0})
+    # a gripper: heated, then pried open (one structure's load increments in one kernel call)
+    get_scenario("gripper").evaluate({"Pattern": 3.0, "L1": 4.914e-3, "L2": 2.821e-3,
+        "t1": 2e-7, "t2": 8e-7, "tpanel": 2e-5, "rate": 0.476, "W": 2.65e-4})
+    # a crease pattern folded by its rest angles (fold_pattern: the self-fold kernel)
+    from holofold.geometry import read_pattern
+    from holofold.mechanics import fold_pattern, scaled_pattern
+    p = read_pattern(sys.argv[1])
+    p = scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))
+    fold = fold_pattern(p, 0.5, panel_thickness=1e-3, crease_thickness=2e-4, crease_width=1e-3,
+                        E=1.5e9, nu=0.42)
     misses = []
     if kernels.active().compiled:
         from holofold.mechanics import _compiled, _spring_loop
@@ -101,15 +111,20 @@ _ROWS = textwrap.dedent(
                 if hasattr(fn, "stats") and sum(fn.stats.cache_misses.values()):
                     misses.append(name)
     print(json.dumps({"path": kernels.active().name, "first": first, "misses": misses,
-                      "Zstiff": out["Zstiff"], "single": sm["axialstiff60"]}))
+                      "Zstiff": out["Zstiff"], "single": sm["axialstiff60"],
+                      "fold": float(np.abs(fold.coords[-1]).max())}))
     """
 )
 
 
+#: Origami Simulator's bird base (tests/data, MIT): 8 panels, the dense self-fold path
+_BIRD_BASE = Path(__file__).parent / "data" / "origami-simulator" / "birdBase.svg"
+
+
 def _rows(tmp_path, **env):
     proc = subprocess.run(
-        [sys.executable, "-c", _ROWS], env=_env(tmp_path, **env), capture_output=True,
-        text=True, cwd=tmp_path,
+        [sys.executable, "-c", _ROWS, str(_BIRD_BASE)], env=_env(tmp_path, **env),
+        capture_output=True, text=True, cwd=tmp_path,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1]), proc.stderr
@@ -126,7 +141,7 @@ def test_cold_start_runs_on_numpy_while_compiling_then_a_warm_cache_needs_no_com
         time.sleep(1)
     warm, _ = _rows(tmp_path)
     assert warm["path"] == "compiled" and warm["misses"] == [], warm
-    for key in ("Zstiff", "single"):  # converged outputs: the paths agree to 1e-9
+    for key in ("Zstiff", "single", "fold"):  # converged outputs: the paths agree to 1e-9
         assert warm[key] == pytest.approx(cold[key], rel=1e-9)
     numpy, _ = _rows(tmp_path, HOLOFOLD_KERNELS="numpy")
     assert numpy["path"] == "numpy" and numpy["Zstiff"] == pytest.approx(warm["Zstiff"], rel=1e-9)
