@@ -144,6 +144,8 @@ def pattern_from_lines(
     except FormatError as exc:
         raise FormatError(f"{name}: {exc}") from None
     xy = (arr.vertices - arr.vertices.min(axis=0)) * unit  # lower-left corner at the origin
+    if not curves:
+        notes = [*notes, *_near_merge(arr, default_tolerance(S) if tol is None else tol)]
     pts, ctol = None, 0.0
     if curves and split == "rulings":
         pts, ctol = curve_points_on(arr.vertices, curves, tol)
@@ -159,6 +161,34 @@ def pattern_from_lines(
         ec = curve_edges(pattern.flat, pattern.edges, pattern.assignment, curves, tol=reach)
         pattern = replace(pattern, curves=curves, edge_curve=ec)
     return pattern
+
+
+#: an edge at most this many merge distances long is reported: its ends were likely meant as
+#: one point (Origami Simulator merges within 3 drawing units, holofold within ``tol``)
+NEAR_MERGE = 2.0
+
+
+def _near_merge(arr, tol: float) -> list[str]:
+    """A note on the edges of an arrangement (drawing units) longer than the merge distance
+    ``tol`` but at most :data:`NEAR_MERGE` x it: two ends drawn just apart make a sliver
+    panel triangle, which the fold crushes (Origami Simulator's hypar.svg: one corner drawn
+    2.95 units off at a merge distance of 1.73, a 0.4 mm high triangle on a 200 mm sheet)."""
+    if not len(arr.edges) or not tol > 0:
+        return []
+    V, E = arr.vertices, arr.edges
+    length = np.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=1)
+    near = np.flatnonzero(length <= NEAR_MERGE * tol)
+    if not near.size:
+        return []
+    k = near[np.argmax(length[near])]
+    mid = 0.5 * (V[E[k, 0]] + V[E[k, 1]]) - V.min(axis=0)
+    return [
+        f"{near.size} edge(s) barely longer than the merge distance {tol:.3g} (at most "
+        f"{length[k]:.3g} drawing units, at ({mid[0]:.4g}, {mid[1]:.4g}) from the lower left "
+        f"corner): if their ends are meant as one point, read with tol={1.01 * length[k]:.3g} "
+        f"(--tol {1.01 * length[k]:.3g}) to merge them; kept, they make thin panel triangles "
+        "that a fold may crush"
+    ]
 
 
 def _curve_pieces(S, assignment, curves, tol) -> np.ndarray:

@@ -40,7 +40,11 @@ targets close at every interior vertex, :func:`vertex_closure`) or
 pseudo-transient flow of :mod:`holofold.mechanics.leave_flat` found an equilibrium beyond),
 or ``folds until panels touch`` (a state had panels passing through each other: the fold
 stops at the last clean state; no success verdict is given for an intersecting state, see
-:mod:`holofold.mechanics.intersection`).
+:mod:`holofold.mechanics.intersection`; with contact, the barrier holds the layers apart and
+no equilibrium lies beyond, while the sheet without it has one or the barrier carries at
+least :data:`HELD_SHARE` of the actuation). A panel triangle strained beyond
+:data:`CRUSH_STRAIN` in its plane (a sliver its bars do not hold in shape) is named in the
+note, and a fold that stops there stalls, whatever touches.
 
 Fold angles are tracked through +-180 degrees: each state's angles are unwrapped against the
 previous stored state along the path (the dihedral angle of two panels is only known modulo
@@ -57,9 +61,10 @@ import numpy as np
 
 from holofold.geometry.errors import ParameterError, check_range, record_or_keywords
 from holofold.geometry.pattern import CreasePattern
+from holofold.mechanics.bars import bar_strain
 from holofold.mechanics.compat import PHYSICAL, Profile
 from holofold.mechanics.hinges import build_compliant, build_concentrated, crease_rest_targets
-from holofold.mechanics.measures import ModelEnergy, model_energy
+from holofold.mechanics.measures import ModelEnergy, model_energy, triangle_strain
 from holofold.mechanics.status import CONVERGED, Status
 from holofold.mechanics.structure import Structure
 
@@ -87,6 +92,14 @@ RIGID_STRAIN = 1e-3
 #: a verdict that is not about bending (``stalls``, ``turns against its assignment``) still
 #: names panel bending beyond this, degrees: a stalled fold can hide panels bent by 80 deg
 BEND_NOTE_DEG = 5.0
+#: a fold whose barrier solve fails stops at contact if the sheet without the barrier has an
+#: equilibrium beyond, or if the barrier's force where it stops is at least this share of
+#: the actuation's (the crease springs' force at flat for the full targets)
+HELD_SHARE = 0.01
+#: a panel triangle whose in-plane principal strain passes this is a sliver squeezed or
+#: opened across (its bars change length by a few % or less), not a state of a sheet: the
+#: note names it, and a fold that stops there has not been stopped by contact
+CRUSH_STRAIN = 0.1
 #: a driven crease counts as folded the wrong way beyond this angle of the wrong sign, degrees
 WRONG_WAY_DEG = 10.0
 #: a vertex whose full targets miss closing by more than this (degrees) has no rigid folded
@@ -578,6 +591,7 @@ def fold_pattern(
             )  # fmt: skip
             searched += bool(res.ok)
         accepted = res.U if res.ok and np.isfinite(res.U).all() else None
+        free_found = accepted is not None  # an equilibrium without the barrier
         if panels is not None:  # contact hook: keep the step collision free (issue 32 item 2)
             deadline = None if time_limit is None else started + time_limit
             accepted = panels.step(asm, U, accepted, rest(nxt), tol, max_iter, deadline=deadline)
@@ -600,6 +614,7 @@ def fold_pattern(
                 left = None if time_limit is None else time_limit - (time.perf_counter() - started)
                 flow = flow_to_equilibrium(asm, U, rest(nxt), tol, max_steps=400, time_limit=left)
                 relaxed, flowed = (flow.U, True) if flow.converged else (None, False)
+            free_found = free_found or relaxed is not None
             if panels is not None and relaxed is not None:  # contact hook
                 # a snap is a long descent of the energy: the barrier solve may take
                 # SNAP_UPDATES x as many updates, within the time limit
@@ -620,15 +635,32 @@ def fold_pattern(
                 # the barrier solve gave up at the deadline: the time ran out, whatever touches
                 stalled = f"the time limit of {time_limit:g} s ran out at {100 * done:.1f} %"
                 break
-            if panels is not None and panels.touched[0]:
-                # the barrier holds the panels apart and the actuation cannot fold them on:
-                # the sheet stops where its layers touch (not a stall of the solver)
+            if (
+                panels is not None
+                and panels.touched[0]
+                and (free_found or _barrier_carries(panels, U, asm.free_dofs, scale))
+            ):
+                # without the barrier the sheet has an equilibrium beyond and with it none, or
+                # the barrier carries a share of the actuation where the fold stops: it holds
+                # the panels apart and the actuation cannot fold them on, the sheet stops
+                # where its layers touch (not a stall of the solver)
                 held = panels.touched
                 if math.isnan(contact_from):
                     contact_from = done
                 break
             why = "; ".join(res.status.reasons) or "non-finite displacement"
             stalled = f"step {100 * done:.1f} -> {100 * nxt:.1f} % does not converge ({why})"
+            if panels is not None and panels.touched[0]:
+                # panels within the barrier's reach, but it carries next to nothing where the
+                # fold stops and the sheet finds no equilibrium beyond without it either:
+                # contact is not shown to be what stops it
+                a, b = panels.touched[1]
+                stalled += (
+                    f", with or without contact (panels {a} and {b} come within a panel "
+                    "thickness, but the barrier carries under "
+                    f"{100 * HELD_SHARE:g} % of the actuation and the sheet finds no "
+                    "equilibrium beyond without it either)"
+                )
             break
         h *= 0.5
         halvings += 1
@@ -666,6 +698,14 @@ def fold_pattern(
     share = energy.panel_share if energy.total > 1e-9 * e_flat else 0.0
     bend = float(np.degrees(energy.panel_bend.max(initial=0.0)))
     strain = float(energy.panel_strain.max(initial=0.0))
+    crushed = _crushed_triangle(structure, Uh[-1])
+    if held is not None and crushed:
+        # the barrier solve failed where a sliver is crushed: the mesh, not contact, stops it
+        stalled = (
+            f"no equilibrium beyond {100 * done:.1f} %, where {crushed}; contact is not "
+            "shown to stop the fold"
+        )
+        held = None
     touched = ""
     if held is not None:  # contact on: the layers touch and stop the fold
         a, b = held[1]
@@ -745,6 +785,8 @@ def fold_pattern(
                 f"; panels {a} and {b} touch from {100 * contact_from:.1f} % and are held a "
                 "panel thickness apart"
             )
+    if crushed and crushed not in note:
+        note += f"; {crushed}"
     if flows:
         where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
         note += f"; Newton stalled at {where} % and a pseudo-transient flow carried the fold on"
@@ -760,6 +802,36 @@ def fold_pattern(
         snaps=np.array(snaps), elapsed=np.array(clock), wrong_at=wrong_at,
         touch_at=touch_at, touch_where=touch_where, hinge_angles=hinges,
     )  # fmt: skip
+
+
+def _barrier_carries(panels, U, free, scale: float) -> bool:
+    """True where the barrier's force on the free DOFs at ``U`` is at least
+    :data:`HELD_SHARE` x ``scale`` (N)."""
+    gb = panels.evaluate(np.asarray(U, float).ravel(), psd=False)[1]
+    return bool(np.linalg.norm(gb[free]) >= HELD_SHARE * scale)
+
+
+def _crushed_triangle(structure: Structure, U: np.ndarray) -> str:
+    """A note on the panel triangle most strained in its plane at ``U`` if that passes
+    :data:`CRUSH_STRAIN` (its sides and height in the model, mm), else ""."""
+    on = np.flatnonzero(structure.tri_panel >= 0)
+    if not on.size:
+        return ""
+    tri = structure.triangles[on]
+    ts = triangle_strain(structure.nodes, U, tri)
+    k = int(np.argmax(ts))
+    if ts[k] <= CRUSH_STRAIN:
+        return ""
+    X = structure.nodes[tri[k]]
+    sides = np.linalg.norm(X[[1, 2, 0]] - X, axis=1)
+    height = np.linalg.norm(np.cross(X[1] - X[0], X[2] - X[0])) / sides.max()
+    bars = np.abs(bar_strain(structure.nodes, U, structure.bars, structure.bar_length)).max()
+    return (
+        f"a thin triangle of panel {int(structure.tri_panel[on[k]])} (sides "
+        f"{', '.join(f'{1e3 * x:.3g}' for x in sides)} mm, {1e3 * height:.2g} mm high) is "
+        f"strained {ts[k]:.2f} in its plane while no bar is strained more than {bars:.2g}: "
+        "a sliver its bars do not hold in shape, not a state the sheet can take"
+    )
 
 
 def _wrong_way_cause(pattern: CreasePattern, tgt, angles, wrong) -> str:

@@ -351,3 +351,41 @@ def test_the_barrier_solve_takes_exact_newton_updates_and_lands_where_projected_
     scale = float(np.abs(exact.U[-1]).max())
     assert np.abs(projected.U[-1] - exact.U[-1]).max() <= 1e-6 * scale
     assert not any(intersects(exact.structure, U) for U in exact.U)
+
+
+def _os_pattern(name):
+    import warnings
+
+    from holofold.geometry import read_pattern
+    from holofold.mechanics import scaled_pattern
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        p = read_pattern(Path(__file__).parent / "data" / "origami-simulator" / name)
+    return scaled_pattern(p, 0.2 / float(np.ptp(p.flat, axis=0).max()))
+
+
+_PP = dict(panel_thickness=1e-3, crease_thickness=0.2e-3, crease_width=1e-3, E=1.5e9, nu=0.42)
+
+
+@pytest.mark.slow
+def test_a_contact_stop_is_one_only_where_contact_is_shown_to_stop_the_fold(monkeypatch):
+    """Origami Simulator's map fold and paper airplane (200 mm, 1 mm PP panels). The map fold
+    touches at 70.1 %: the sheet without the barrier has an equilibrium beyond (through its
+    layers), the barrier refuses it: a contact stop. The airplane's layers are held apart from
+    20 % and at 83.6 % no equilibrium lies beyond, with the barrier or without it (from the
+    held state); there the barrier carries 11 % of the actuation's force (34 of 297 N,
+    measured 2026-12-08): a contact stop. With that share ignored, nothing shows contact
+    stops it, and the verdict is a stall "with or without contact"."""
+    from holofold.mechanics import folding
+
+    m = fold_pattern(_os_pattern("mapfold.svg"), 1.0, contact=True, **_PP)
+    assert m.verdict == "folds until panels touch" and m.reached == pytest.approx(0.701, abs=0.01)
+    a = fold_pattern(_os_pattern("airplane.svg"), 1.0, contact=True, **_PP)
+    assert a.verdict == "folds until panels touch", a.summary()
+    assert a.reached == pytest.approx(0.836, abs=0.02)
+    assert not any(intersects(a.structure, U) for U in a.U)
+    monkeypatch.setattr(folding, "_barrier_carries", lambda *args: False)
+    s = fold_pattern(_os_pattern("airplane.svg"), 1.0, contact=True, **_PP)
+    assert s.verdict == "stalls" and s.reached == pytest.approx(a.reached), s.summary()
+    assert "with or without contact" in s.note and "barrier carries under 1 %" in s.note

@@ -276,3 +276,21 @@ def test_recipe_a_line_reader(tmp_path):
         q, _ = _quiet(g.read_pattern, f, unit=1e-2)
         assert abs(float(np.ptp(q.flat[:, 0])) - 0.2) < 1e-14
     assert ".lines" not in g.READERS
+
+
+def test_an_edge_barely_longer_than_the_merge_distance_is_named_with_the_tol_that_merges_it():
+    """A 100 x 100 square with a valley diagonal whose end is drawn 0.3 off the corner (the
+    merge distance is 0.2, 2e-3 of the square): the reader keeps the two points apart, which
+    makes a 0.3-long edge and a sliver panel, and says so with the ``tol`` that merges them;
+    read with that ``tol`` the corner is one vertex and nothing is said."""
+    S = [[[0, 0], [100, 0]], [[100, 0], [100, 100]], [[100, 100], [0, 100]],
+         [[0, 100], [0, 0]], [[0.3, 0], [100, 100]]]  # fmt: skip
+    d = LineDrawing(S, ["B", "B", "B", "B", "V"], [0, 0, 0, 0, 90.0], 1e-3, name="off")
+    p, notes = _quiet(pattern_from_drawing, d)
+    near = [n for n in notes if "barely longer than the merge distance" in n]
+    assert len(near) == 1 and p.n_vertices == 5, notes
+    assert "1 edge(s)" in near[0] and "at most 0.3 drawing units" in near[0]
+    tol = float(re.search(r"tol=([0-9.]+)", near[0]).group(1))
+    assert 0.3 < tol < 0.31
+    q, notes = _quiet(pattern_from_drawing, d, tol=tol)
+    assert q.n_vertices == 4 and not [n for n in notes if "barely longer" in n], notes
