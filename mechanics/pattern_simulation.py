@@ -464,6 +464,7 @@ def _summary(sim: PatternSimulation) -> dict:
             "touch_faces": list(f.touch_where) if f.touch_where[0] >= 0 else None,
             "energy_J": f.energy.total,
             "largest_panel_strain": float(f.energy.panel_strain.max(initial=0.0)),
+            "largest_triangle_strain": float(f.energy.triangle_strain.max(initial=0.0)),
             "largest_panel_bend_deg": float(np.degrees(f.energy.panel_bend.max(initial=0.0))),
         },
         "loads": [

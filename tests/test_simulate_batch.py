@@ -18,7 +18,8 @@ OS = Path(__file__).parent / "data" / "origami-simulator"
 NAMES = ("simpleVertex.svg", "waterbombBase.svg", "popupSimple.svg")
 FIELDS = (
     "file", "path", "sha256", "imported", "reason", "panels", "reached", "verdict", "note",
-    "largest_strain", "progress", "wrong_way_count", "collision", "seconds", "fold",
+    "largest_strain", "largest_triangle_strain", "progress", "wrong_way_count", "collision",
+    "seconds", "fold",
 )  # fmt: skip
 
 
@@ -79,6 +80,10 @@ def test_one_line_per_pattern_with_the_single_file_numbers(patterns, batch, tmp_
         assert r["largest_strain"] == pytest.approx(
             single["largest_panel_strain"], rel=1e-9, abs=1e-15
         )
+        assert r["largest_triangle_strain"] == pytest.approx(
+            single["largest_triangle_strain"], rel=1e-9, abs=1e-15
+        )
+        assert r["largest_triangle_strain"] >= r["largest_strain"] * (1 - 1e-9)
         assert r["fold"]["requested"] == 1.0
         assert r["wrong_way_count"] == len(r["fold"]["wrong_way"])
     assert by_name["simpleVertex.svg"]["panels"] == 4

@@ -146,7 +146,9 @@ def check_pattern_file(path, setting, options=None, size=None, scale=None, time_
 
     Keys: ``file``, ``path`` (resolved), ``sha256``, ``imported`` (bool), ``reason`` (the one
     line why not imported, crashed or timed out; None when it folded), ``panels``,
-    ``reached``, ``verdict``, ``note``, ``largest_strain``, ``progress``, ``wrong_way_count``,
+    ``reached``, ``verdict``, ``note``, ``largest_strain`` (the panels' bars),
+    ``largest_triangle_strain`` (in the plane of the panels' triangles), ``progress``,
+    ``wrong_way_count``,
     ``collision`` (thick panels run into each other), ``thick``, ``clearance`` (m),
     ``status`` (the status line), ``seconds`` (wall time of this record), then ``fold``: the
     FoldResult's own small fields. ``options`` are reader options (``unit``, ``tol``, ``frame``,
@@ -156,7 +158,8 @@ def check_pattern_file(path, setting, options=None, size=None, scale=None, time_
     p = Path(path)
     rec = {"file": str(p), "path": str(p.resolve()), "sha256": file_sha256(p)}
     rec.update(imported=False, reason=None, panels=None, reached=None, verdict=None, note=None)
-    rec.update(largest_strain=None, progress=None, wrong_way_count=None, collision=None)
+    rec.update(largest_strain=None, largest_triangle_strain=None, progress=None)
+    rec.update(wrong_way_count=None, collision=None)
     rec.update(thick=None, clearance=None, status=None, fold=None)  # same keys on every line
     t0 = time.perf_counter()
     stage = ["import"]
@@ -178,6 +181,7 @@ def check_pattern_file(path, setting, options=None, size=None, scale=None, time_
             imported=True, panels=int(pattern.n_faces), reached=float(f.reached),
             verdict=f.verdict, note=f.note,
             largest_strain=float(f.energy.panel_strain.max(initial=0.0)),
+            largest_triangle_strain=float(f.energy.triangle_strain.max(initial=0.0)),
             progress=float(f.progress), wrong_way_count=int(len(f.wrong_way)),
             collision=bool(sim.collision), thick=sim.thick, clearance=_plain(sim.clearance),
             status=sim.status_line(),
@@ -201,8 +205,8 @@ def _failed(path, reason: str) -> dict:
     p = Path(path)
     rec = {"file": str(p), "path": str(p.resolve()), "sha256": file_sha256(p)}
     for key in ("imported", "reason", "panels", "reached", "verdict", "note", "largest_strain",
-                "progress", "wrong_way_count", "collision", "thick", "clearance", "status",
-                "fold"):  # fmt: skip
+                "largest_triangle_strain", "progress", "wrong_way_count", "collision", "thick",
+                "clearance", "status", "fold"):  # fmt: skip
         rec[key] = None
     rec.update(imported=None, reason=reason, seconds=None)
     return rec
