@@ -61,7 +61,6 @@ import numpy as np
 
 from holofold.geometry.errors import ParameterError, check_range, record_or_keywords
 from holofold.geometry.pattern import CreasePattern
-from holofold.mechanics.bars import bar_strain
 from holofold.mechanics.compat import PHYSICAL, Profile
 from holofold.mechanics.hinges import build_compliant, build_concentrated, crease_rest_targets
 from holofold.mechanics.measures import ModelEnergy, model_energy, triangle_strain
@@ -94,7 +93,7 @@ RIGID_STRAIN = 1e-3
 BEND_NOTE_DEG = 5.0
 #: a fold whose barrier solve fails stops at contact if the sheet without the barrier has an
 #: equilibrium beyond, or if the barrier's force where it stops is at least this share of
-#: the actuation's (the crease springs' force at flat for the full targets)
+#: the actuation's (the crease springs' force at flat for the requested fold)
 HELD_SHARE = 0.01
 #: a panel triangle whose in-plane principal strain passes this is a sliver squeezed or
 #: opened across (its bars change length by a few % or less), not a state of a sheet: the
@@ -698,7 +697,7 @@ def fold_pattern(
     share = energy.panel_share if energy.total > 1e-9 * e_flat else 0.0
     bend = float(np.degrees(energy.panel_bend.max(initial=0.0)))
     strain = float(energy.panel_strain.max(initial=0.0))
-    crushed = _crushed_triangle(structure, Uh[-1])
+    crushed = _crushed_triangle(structure, Uh[-1], energy)
     if held is not None and crushed:
         # the barrier solve failed where a sliver is crushed: the mesh, not contact, stops it
         stalled = (
@@ -785,7 +784,7 @@ def fold_pattern(
                 f"; panels {a} and {b} touch from {100 * contact_from:.1f} % and are held a "
                 "panel thickness apart"
             )
-    if crushed and crushed not in note:
+    if crushed and crushed not in stalled:  # (a stop at it says so already)
         note += f"; {crushed}"
     if flows:
         where = ", ".join(f"{100 * x:.1f}" for x in flows[:5])
@@ -807,30 +806,29 @@ def fold_pattern(
 def _barrier_carries(panels, U, free, scale: float) -> bool:
     """True where the barrier's force on the free DOFs at ``U`` is at least
     :data:`HELD_SHARE` x ``scale`` (N)."""
-    gb = panels.evaluate(np.asarray(U, float).ravel(), psd=False)[1]
+    gb = panels.gradient(np.asarray(U, float).ravel())
     return bool(np.linalg.norm(gb[free]) >= HELD_SHARE * scale)
 
 
-def _crushed_triangle(structure: Structure, U: np.ndarray) -> str:
+def _crushed_triangle(structure: Structure, U: np.ndarray, energy: ModelEnergy) -> str:
     """A note on the panel triangle most strained in its plane at ``U`` if that passes
-    :data:`CRUSH_STRAIN` (its sides and height in the model, mm), else ""."""
-    on = np.flatnonzero(structure.tri_panel >= 0)
-    if not on.size:
+    :data:`CRUSH_STRAIN` (its sides and height in the model, mm), else ""; ``energy`` is
+    :func:`model_energy` at ``U`` (its per-panel strains pick the panel)."""
+    panel = int(np.argmax(energy.triangle_strain)) if energy.triangle_strain.size else -1
+    if panel < 0 or energy.triangle_strain[panel] <= CRUSH_STRAIN:
         return ""
-    tri = structure.triangles[on]
+    tri = structure.triangles[structure.tri_panel == panel]
     ts = triangle_strain(structure.nodes, U, tri)
     k = int(np.argmax(ts))
-    if ts[k] <= CRUSH_STRAIN:
-        return ""
     X = structure.nodes[tri[k]]
     sides = np.linalg.norm(X[[1, 2, 0]] - X, axis=1)
     height = np.linalg.norm(np.cross(X[1] - X[0], X[2] - X[0])) / sides.max()
-    bars = np.abs(bar_strain(structure.nodes, U, structure.bars, structure.bar_length)).max()
+    bars = float(energy.panel_strain.max())
     return (
-        f"a thin triangle of panel {int(structure.tri_panel[on[k]])} (sides "
+        f"a thin triangle of panel {panel} (sides "
         f"{', '.join(f'{1e3 * x:.3g}' for x in sides)} mm, {1e3 * height:.2g} mm high) is "
-        f"strained {ts[k]:.2f} in its plane while no bar is strained more than {bars:.2g}: "
-        "a sliver its bars do not hold in shape, not a state the sheet can take"
+        f"strained {ts[k]:.2f} in its plane while no panel bar is strained more than "
+        f"{bars:.2g}: a sliver its bars do not hold in shape, not a state the sheet can take"
     )
 
 

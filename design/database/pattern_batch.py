@@ -148,8 +148,8 @@ def check_pattern_file(path, setting, options=None, size=None, scale=None, time_
     line why not imported, crashed or timed out; None when it folded), ``panels``,
     ``reached``, ``verdict``, ``note``, ``largest_strain`` (the panels' bars),
     ``largest_triangle_strain`` (in the plane of the panels' triangles), ``progress``,
-    ``wrong_way_count``,
-    ``collision`` (thick panels run into each other), ``thick``, ``clearance`` (m),
+    ``wrong_way_count``, ``collision`` (thick panels run into each other), ``thick``,
+    ``clearance`` (m),
     ``status`` (the status line), ``seconds`` (wall time of this record), then ``fold``: the
     FoldResult's own small fields. ``options`` are reader options (``unit``, ``tol``, ``frame``,
     ``curves``, ``split``; each given only to the readers that take it); ``size`` m or
